@@ -1,0 +1,513 @@
+//! Finite-length Reynolds equation with the Reynolds (Swift–Stieber) cavitation condition.
+//!
+//! Seed eq. 2 (isoviscous), with x = Rθ, z̄ = z/R, H = h/c and p = 6µ(R/c)²·Π (Π in 1/s):
+//!
+//! ```text
+//!   ∂/∂θ(H³ ∂Π/∂θ) + ∂/∂z̄(H³ ∂Π/∂z̄) = ω ∂H/∂θ + 2 ∂H/∂t ,
+//!   H = 1 − X cos θ − Y sin θ ,   ∂H/∂t = −Ẋ cos θ − Ẏ sin θ   (X = x/c, Ẋ = ẋ/c).
+//! ```
+//!
+//! Finite volumes on a uniform grid over one half of the bearing (symmetry at the mid-plane,
+//! p = 0 at the edge). The Reynolds condition (seed eq. 6: p ≥ 0, and p = ∂p/∂n = 0 where the
+//! film ruptures) is the linear complementarity problem
+//!
+//! ```text
+//!   Π ≥ 0,   A Π − b ≥ 0,   Π·(A Π − b) = 0 ,
+//! ```
+//!
+//! with A the (symmetric M-matrix) finite-volume operator. It is solved by a primal–dual active
+//! set iteration: each pass solves A Π = b on the pressurised nodes with a banded Cholesky factor,
+//! then frees active nodes whose complementarity multiplier is negative and deactivates free nodes
+//! whose pressure is negative; for an M-matrix this ends in a few passes. The active set of the
+//! previous solve is the first guess of the next (warm start).
+//!
+//! The eight coefficients (seed eq. 3–4) come from the perturbation equations: differentiating
+//! A(H) Π = b(H, Ḣ) on the converged pressure zone gives A ∂Π/∂q = ∂b/∂q − (∂A/∂q) Π, solved
+//! with the same factor. The moving zone boundary adds nothing to first order because p and
+//! ∂p/∂n vanish there (Lund 1987).
+
+use super::banded::BandMatrix;
+use super::coefficients::FilmCoefficients;
+use super::error::FilmError;
+use super::geometry::{BearingGeometry, FilmGrid, Lubricant};
+use super::{FilmModel, FilmResult, JournalKinematics};
+use std::f64::consts::TAU;
+
+/// Marks a node that is not in the current linear system.
+const NOT_FREE: u32 = u32::MAX;
+
+/// Most active-set passes allowed before the solve is declared failed.
+const MAX_ACTIVE_SET_PASSES: usize = 200;
+
+/// Finite-length film solver with its workspace (allocated once, reused by every solve).
+#[derive(Debug, Clone)]
+pub struct FiniteFilm {
+    geometry: BearingGeometry,
+    lubricant: Lubricant,
+    grid: FilmGrid,
+    /// Angular spacing Δθ (rad).
+    dtheta: f64,
+    /// Axial spacing Δz̄ = (L/2R)/n_z (dimensionless).
+    dz: f64,
+    /// p = pressure_scale · Π, pressure_scale = 6µ(R/c)² (Pa·s).
+    pressure_scale: f64,
+    cos_node: Vec<f64>,
+    sin_node: Vec<f64>,
+    /// cos, sin at the face between column i and i+1.
+    cos_face: Vec<f64>,
+    sin_face: Vec<f64>,
+    /// Per column: Π fixed by a supply groove, or NaN where the film is free.
+    groove_pi: Vec<f64>,
+    h_node: Vec<f64>,
+    h_face: Vec<f64>,
+    h3_node: Vec<f64>,
+    h3_face: Vec<f64>,
+    /// Per column: ω ∂H/∂θ + 2 ∂H/∂t (1/s).
+    source: Vec<f64>,
+    /// Per node: true where the film is pressurised (the free set of the complementarity problem).
+    free: Vec<bool>,
+    /// Per node: Π (1/s).
+    pi: Vec<f64>,
+    /// Per node: position in the linear system, or NOT_FREE.
+    slot: Vec<u32>,
+    /// Position in the linear system → node.
+    order: Vec<u32>,
+    /// Column sequence that keeps a periodic ring banded (0, 1, n−1, 2, n−2, …).
+    folded_columns: Vec<u32>,
+    band: BandMatrix,
+    rhs: Vec<f64>,
+    /// Right-hand sides / solutions of the four perturbation equations (x, y, ẋ, ẏ).
+    perturbation: [Vec<f64>; 4],
+    /// True once a solve has left an active set to start from.
+    warm: bool,
+    /// Active-set passes taken by the last solve.
+    last_passes: usize,
+    /// Unknowns in the last factored system (free nodes).
+    n_free: usize,
+}
+
+impl FiniteFilm {
+    /// A solver for `geometry` and `lubricant` on `grid`.
+    pub fn new(
+        geometry: BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+    ) -> Result<Self, FilmError> {
+        geometry.validate()?;
+        let lubricant = Lubricant::new(lubricant.density_kg_m3, lubricant.viscosity_pa_s)?;
+        let grid = FilmGrid::new(grid.n_theta, grid.n_z)?;
+        let (nt, nz) = (grid.n_theta, grid.n_z);
+        let dtheta = TAU / nt as f64;
+        let r = geometry.radius_m();
+        let c = geometry.radial_clearance_m;
+        let dz = 0.5 * geometry.length_m / r / nz as f64;
+        let pressure_scale = 6.0 * lubricant.viscosity_pa_s * (r / c).powi(2);
+        let theta = |i: usize| i as f64 * dtheta;
+        let groove_pi = (0..nt)
+            .map(|i| {
+                geometry
+                    .grooves
+                    .iter()
+                    .find(|g| g.contains(theta(i)))
+                    .map_or(f64::NAN, |g| g.supply_pressure_pa / pressure_scale)
+            })
+            .collect();
+        let folded_columns = (0..nt as u32)
+            .map(|m| {
+                if m == 0 {
+                    0
+                } else if m % 2 == 1 {
+                    m.div_ceil(2)
+                } else {
+                    nt as u32 - m / 2
+                }
+            })
+            .collect();
+        let nodes = nt * nz;
+        Ok(Self {
+            cos_node: (0..nt).map(|i| theta(i).cos()).collect(),
+            sin_node: (0..nt).map(|i| theta(i).sin()).collect(),
+            cos_face: (0..nt).map(|i| (theta(i) + 0.5 * dtheta).cos()).collect(),
+            sin_face: (0..nt).map(|i| (theta(i) + 0.5 * dtheta).sin()).collect(),
+            groove_pi,
+            h_node: vec![0.0; nt],
+            h_face: vec![0.0; nt],
+            h3_node: vec![0.0; nt],
+            h3_face: vec![0.0; nt],
+            source: vec![0.0; nt],
+            free: vec![false; nodes],
+            pi: vec![0.0; nodes],
+            slot: vec![NOT_FREE; nodes],
+            order: vec![0; nodes],
+            folded_columns,
+            band: BandMatrix::with_capacity(nodes, 2 * nz + 1),
+            rhs: vec![0.0; nodes],
+            perturbation: std::array::from_fn(|_| vec![0.0; nodes]),
+            warm: false,
+            last_passes: 0,
+            n_free: 0,
+            geometry,
+            lubricant,
+            grid,
+            dtheta,
+            dz,
+            pressure_scale,
+        })
+    }
+
+    /// The grid this solver was built on.
+    pub fn grid(&self) -> FilmGrid {
+        self.grid
+    }
+
+    /// The lubricant this solver was built for.
+    pub fn lubricant(&self) -> Lubricant {
+        self.lubricant
+    }
+
+    /// Active-set passes the last solve took (1 when the warm-started pressure zone held).
+    pub fn last_active_set_passes(&self) -> usize {
+        self.last_passes
+    }
+
+    /// Forgets the previous pressure zone: the next solve starts cold.
+    pub fn reset_warm_start(&mut self) {
+        self.warm = false;
+    }
+
+    /// Pressure at node (`i` around, `j` from mid-plane to edge) of the last solve (Pa).
+    /// `j = n_z` is the bearing edge (0). Angle of column i is i·2π/n_theta from `+x`.
+    pub fn pressure_pa(&self, i: usize, j: usize) -> f64 {
+        if j >= self.grid.n_z {
+            0.0
+        } else {
+            self.pressure_scale * self.pi[i * self.grid.n_z + j]
+        }
+    }
+
+    /// Width of a θ-face at axial row j (dimensionless, half a cell at the mid-plane).
+    #[inline]
+    fn row_width(&self, j: usize) -> f64 {
+        if j == 0 {
+            0.5 * self.dz
+        } else {
+            self.dz
+        }
+    }
+
+    /// Film thickness and the source term of the Reynolds equation for `kin`.
+    fn update_film_shape(&mut self, kin: &JournalKinematics) {
+        let c = self.geometry.radial_clearance_m;
+        let (x, y) = (kin.position_m[0] / c, kin.position_m[1] / c);
+        let (vx, vy) = (kin.velocity_m_s[0] / c, kin.velocity_m_s[1] / c);
+        let nt = self.grid.n_theta;
+        for i in 0..nt {
+            let hn = 1.0 - x * self.cos_node[i] - y * self.sin_node[i];
+            let hf = 1.0 - x * self.cos_face[i] - y * self.sin_face[i];
+            self.h_node[i] = hn;
+            self.h_face[i] = hf;
+            self.h3_node[i] = hn * hn * hn;
+            self.h3_face[i] = hf * hf * hf;
+        }
+        for i in 0..nt {
+            let west = if i == 0 { nt - 1 } else { i - 1 };
+            let squeeze = -vx * self.cos_node[i] - vy * self.sin_node[i];
+            self.source[i] = kin.speed_rad_s * (self.h_face[i] - self.h_face[west]) / self.dtheta
+                + 2.0 * squeeze;
+        }
+    }
+
+    /// Right-hand side b of node (i, j): −V·(ω ∂H/∂θ + 2 ∂H/∂t).
+    #[inline]
+    fn node_rhs(&self, i: usize, j: usize) -> f64 {
+        -self.dtheta * self.row_width(j) * self.source[i]
+    }
+
+    /// Calls `f(neighbour, conductance)` for each neighbour of node (i, j); the bearing edge is
+    /// passed as `None` (p = 0 there).
+    #[inline]
+    fn for_each_neighbour(
+        &self,
+        i: usize,
+        j: usize,
+        mut f: impl FnMut(Option<(usize, usize)>, f64),
+    ) {
+        let nt = self.grid.n_theta;
+        let west = if i == 0 { nt - 1 } else { i - 1 };
+        let east = if i + 1 == nt { 0 } else { i + 1 };
+        let w = self.row_width(j) / self.dtheta;
+        f(Some((west, j)), w * self.h3_face[west]);
+        f(Some((east, j)), w * self.h3_face[i]);
+        let cz = self.dtheta * self.h3_node[i] / self.dz;
+        if j + 1 < self.grid.n_z {
+            f(Some((i, j + 1)), cz);
+        } else {
+            f(None, cz);
+        }
+        if j > 0 {
+            f(Some((i, j - 1)), cz);
+        }
+    }
+
+    /// Orders the free nodes so that the matrix is banded: columns from just after a column with
+    /// no free node (bandwidth ≤ n_z), or folded around the ring if every column has one
+    /// (bandwidth ≤ 2·n_z). Returns (unknowns, half-bandwidth).
+    fn order_free_nodes(&mut self) -> (usize, usize) {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let empty_column = (0..nt).find(|&i| !self.free[i * nz..(i + 1) * nz].contains(&true));
+        let mut n = 0;
+        for m in 0..nt {
+            let i = match empty_column {
+                Some(e) => (e + 1 + m) % nt,
+                None => self.folded_columns[m] as usize,
+            };
+            for j in 0..nz {
+                let k = i * nz + j;
+                if self.free[k] {
+                    self.slot[k] = n as u32;
+                    self.order[n] = k as u32;
+                    n += 1;
+                } else {
+                    self.slot[k] = NOT_FREE;
+                }
+            }
+        }
+        let mut b = 0;
+        for r in 0..n {
+            let k = self.order[r] as usize;
+            let (i, j) = (k / nz, k % nz);
+            self.for_each_neighbour(i, j, |nb, _| {
+                if let Some((a, c)) = nb {
+                    let s = self.slot[a * nz + c];
+                    if s != NOT_FREE {
+                        b = b.max((s as usize).abs_diff(r));
+                    }
+                }
+            });
+        }
+        (n, b)
+    }
+
+    /// Assembles A and b on the free nodes and factors A. Returns the number of unknowns.
+    fn assemble_and_factor(&mut self) -> usize {
+        let nz = self.grid.n_z;
+        let (n, b) = self.order_free_nodes();
+        let mut band = std::mem::replace(&mut self.band, BandMatrix::with_capacity(0, 0));
+        band.reset(n, b);
+        for r in 0..n {
+            let k = self.order[r] as usize;
+            let (i, j) = (k / nz, k % nz);
+            let mut diag = 0.0;
+            let mut rhs = self.node_rhs(i, j);
+            self.for_each_neighbour(i, j, |nb, cond| {
+                diag += cond;
+                if let Some((a, c)) = nb {
+                    let s = self.slot[a * nz + c];
+                    if s != NOT_FREE {
+                        if (s as usize) < r {
+                            band.add(r, s as usize, -cond);
+                        }
+                    } else if self.groove_pi[a].is_finite() {
+                        rhs += cond * self.groove_pi[a];
+                    }
+                }
+            });
+            band.add(r, r, diag);
+            self.rhs[r] = rhs;
+        }
+        let ok = band.factor();
+        debug_assert!(
+            ok,
+            "film matrix is an M-matrix with a Dirichlet edge: always SPD"
+        );
+        self.band = band;
+        self.n_free = n;
+        n
+    }
+
+    /// Solves the complementarity problem for the current film shape.
+    fn solve_complementarity(&mut self) -> Result<(), FilmError> {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        if !self.warm {
+            for i in 0..nt {
+                let pressurising = self.source[i] < 0.0 && !self.groove_pi[i].is_finite();
+                self.free[i * nz..(i + 1) * nz].fill(pressurising);
+            }
+        }
+        for pass in 1..=MAX_ACTIVE_SET_PASSES {
+            let n = self.assemble_and_factor();
+            let mut x = std::mem::take(&mut self.rhs);
+            self.band.solve(&mut x[..n]);
+            for i in 0..nt {
+                for j in 0..nz {
+                    let k = i * nz + j;
+                    self.pi[k] = match self.slot[k] {
+                        NOT_FREE if self.groove_pi[i].is_finite() => self.groove_pi[i],
+                        NOT_FREE => 0.0,
+                        s => x[s as usize],
+                    };
+                }
+            }
+            self.rhs = x;
+            let changed = self.update_active_set();
+            if !changed {
+                self.last_passes = pass;
+                self.warm = true;
+                return Ok(());
+            }
+        }
+        self.warm = false;
+        Err(FilmError::CavitationNotConverged {
+            iterations: MAX_ACTIVE_SET_PASSES,
+        })
+    }
+
+    /// One primal–dual update of the active set; true if anything changed.
+    fn update_active_set(&mut self) -> bool {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let scale = self.pi.iter().fold(0.0_f64, |m, p| m.max(p.abs()));
+        let p_tol = 1e-12 * scale;
+        let mut changed = false;
+        for i in 0..nt {
+            if self.groove_pi[i].is_finite() {
+                continue;
+            }
+            for j in 0..nz {
+                let k = i * nz + j;
+                if self.free[k] {
+                    if self.pi[k] < -p_tol {
+                        self.free[k] = false;
+                        changed = true;
+                    }
+                } else {
+                    // multiplier λ = (A Π − b) at a node held at Π = 0
+                    let mut flow_in = 0.0;
+                    let mut size = 0.0;
+                    self.for_each_neighbour(i, j, |nb, cond| {
+                        if let Some((a, c)) = nb {
+                            let q = cond * self.pi[a * nz + c];
+                            flow_in += q;
+                            size += q.abs();
+                        }
+                    });
+                    let b = self.node_rhs(i, j);
+                    let lambda = -flow_in - b;
+                    if lambda < -1e-12 * (size + b.abs()) {
+                        self.free[k] = true;
+                        changed = true;
+                    }
+                }
+            }
+        }
+        changed
+    }
+
+    /// Film force on the journal `[F_x, F_y]` (N) from a nodal field `field` (Π or ∂Π/∂q).
+    fn force_from(&self, field: impl Fn(usize) -> f64) -> [f64; 2] {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let (mut sx, mut sy) = (0.0, 0.0);
+        for i in 0..nt {
+            let mut column = 0.0;
+            for j in 0..nz {
+                column += self.row_width(j) * field(i * nz + j);
+            }
+            sx += column * self.cos_node[i];
+            sy += column * self.sin_node[i];
+        }
+        // F = −∫∫ p (cos θ, sin θ) R dθ dz over both halves
+        let r = self.geometry.radius_m();
+        let k = -2.0 * r * r * self.pressure_scale * self.dtheta;
+        [k * sx, k * sy]
+    }
+
+    /// Solves the four perturbation equations on the converged pressure zone (seed eq. 3–4).
+    fn perturbation_coefficients(&mut self, speed_rad_s: f64) -> FilmCoefficients {
+        let nz = self.grid.n_z;
+        let n = self.n_free;
+        let mut rhs = std::mem::take(&mut self.perturbation);
+        for r in 0..n {
+            let k = self.order[r] as usize;
+            let (i, j) = (k / nz, k % nz);
+            let volume = self.dtheta * self.row_width(j);
+            let west = if i == 0 { self.grid.n_theta - 1 } else { i - 1 };
+            // ∂b/∂X = V ω (cos θ_{i+½} − cos θ_{i−½})/Δθ, since ∂H/∂X = −cos θ
+            let mut bx =
+                volume * speed_rad_s * (self.cos_face[i] - self.cos_face[west]) / self.dtheta;
+            let mut by =
+                volume * speed_rad_s * (self.sin_face[i] - self.sin_face[west]) / self.dtheta;
+            // − (∂A/∂X) Π: each conductance ∝ H³ changes by 3H² ∂H/∂X
+            let pk = self.pi[k];
+            let w = self.row_width(j) / self.dtheta;
+            let (ce, se) = (self.cos_face[i], self.sin_face[i]);
+            let (cw, sw) = (self.cos_face[west], self.sin_face[west]);
+            let east = if i + 1 == self.grid.n_theta { 0 } else { i + 1 };
+            let d_east = pk - self.pi[east * nz + j];
+            let d_west = pk - self.pi[west * nz + j];
+            let g_east = 3.0 * w * self.h_face[i] * self.h_face[i];
+            let g_west = 3.0 * w * self.h_face[west] * self.h_face[west];
+            let north = if j + 1 < nz {
+                self.pi[i * nz + j + 1]
+            } else {
+                0.0
+            };
+            let mut d_axial = pk - north;
+            if j > 0 {
+                d_axial += pk - self.pi[i * nz + j - 1];
+            }
+            let g_axial = 3.0 * self.dtheta * self.h_node[i] * self.h_node[i] / self.dz;
+            // ∂C/∂X = −3H² cos θ · (geometric factor)
+            bx +=
+                g_east * ce * d_east + g_west * cw * d_west + g_axial * self.cos_node[i] * d_axial;
+            by +=
+                g_east * se * d_east + g_west * sw * d_west + g_axial * self.sin_node[i] * d_axial;
+            rhs[0][r] = bx;
+            rhs[1][r] = by;
+            // ∂b/∂Ẋ = −V·2·∂Ḣ/∂Ẋ = 2 V cos θ
+            rhs[2][r] = 2.0 * volume * self.cos_node[i];
+            rhs[3][r] = 2.0 * volume * self.sin_node[i];
+        }
+        let mut derivative = [[0.0; 2]; 4];
+        for (q, v) in rhs.iter_mut().enumerate() {
+            self.band.solve(&mut v[..n]);
+            let v: &[f64] = v;
+            derivative[q] = self.force_from(|k| match self.slot[k] {
+                NOT_FREE => 0.0,
+                s => v[s as usize],
+            });
+        }
+        self.perturbation = rhs;
+        // k_ij = −∂F_i/∂q_j = −(1/c) ∂F_i/∂Q_j
+        let c = self.geometry.radial_clearance_m;
+        let mut out = FilmCoefficients::default();
+        for i in 0..2 {
+            for j in 0..2 {
+                out.stiffness_n_per_m[i][j] = -derivative[j][i] / c;
+                out.damping_n_s_per_m[i][j] = -derivative[2 + j][i] / c;
+            }
+        }
+        out
+    }
+}
+
+impl FilmModel for FiniteFilm {
+    fn geometry(&self) -> &BearingGeometry {
+        &self.geometry
+    }
+
+    fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
+        kin.validate(self.geometry.radial_clearance_m)?;
+        self.update_film_shape(kin);
+        self.solve_complementarity()?;
+        Ok(self.outputs(kin.speed_rad_s))
+    }
+
+    fn solve_with_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let result = self.solve(kin)?;
+        Ok((result, self.perturbation_coefficients(kin.speed_rad_s)))
+    }
+}
+
+mod outputs;

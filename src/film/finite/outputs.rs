@@ -1,0 +1,167 @@
+//! What a converged finite-film solution reports: force, peak pressure, the pressure-zone
+//! boundaries ζ1 and ζ2, friction and flows.
+
+use super::FiniteFilm;
+use crate::film::{wrap_angle_rad, FilmResult};
+
+impl FiniteFilm {
+    /// Every reported quantity of the last converged solve at speed `speed_rad_s` (rad/s).
+    pub(super) fn outputs(&self, speed_rad_s: f64) -> FilmResult {
+        let force_n = self.force_from(|k| self.pi[k]);
+        let (max_pressure_pa, max_pressure_angle_rad) = self.peak_pressure();
+        let zone = self.midplane_zone();
+        let (film_start_rad, film_end_rad) = match zone {
+            Some((s, e)) => (self.zone_start_angle(s), self.zone_end_angle(e)),
+            None => (0.0, 0.0),
+        };
+        let friction_torque_n_m = self.friction_torque(speed_rad_s);
+        FilmResult {
+            force_n,
+            max_pressure_pa,
+            max_pressure_angle_rad,
+            film_start_rad,
+            film_end_rad,
+            friction_torque_n_m,
+            power_loss_w: friction_torque_n_m * speed_rad_s,
+            side_flow_m3_s: self.side_flow(),
+            inflow_m3_s: zone.map_or(0.0, |(s, _)| self.inflow(s, speed_rad_s)),
+        }
+    }
+
+    /// Largest pressure (Pa) and its angle (rad), refined by a parabola through the peak node
+    /// and its two neighbours around the circumference.
+    fn peak_pressure(&self) -> (f64, f64) {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let (mut best, mut at) = (0.0, 0);
+        for (k, &p) in self.pi.iter().enumerate() {
+            if p > best {
+                best = p;
+                at = k;
+            }
+        }
+        if best <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let (i, j) = (at / nz, at % nz);
+        let pw = self.pi[((i + nt - 1) % nt) * nz + j];
+        let pe = self.pi[((i + 1) % nt) * nz + j];
+        let curvature = pw - 2.0 * best + pe;
+        let shift = if curvature < 0.0 {
+            (0.5 * (pw - pe) / curvature).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        let peak = best - 0.25 * (pw - pe) * shift;
+        (
+            self.pressure_scale * peak.max(best),
+            wrap_angle_rad((i as f64 + shift) * self.dtheta),
+        )
+    }
+
+    /// The longest circular run of pressurised nodes in the mid-plane: (first, last) column.
+    /// A film that is pressurised all round is reported as starting just after its lowest node.
+    fn midplane_zone(&self) -> Option<(usize, usize)> {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let positive = |i: usize| self.pi[(i % nt) * nz] > 0.0;
+        let Some(gap) = (0..nt).find(|&i| !positive(i)) else {
+            let lowest = (0..nt)
+                .min_by(|&a, &b| self.pi[a * nz].total_cmp(&self.pi[b * nz]))
+                .unwrap_or(0);
+            return Some(((lowest + 1) % nt, lowest));
+        };
+        let (mut best, mut run_start, mut len) = (None::<(usize, usize)>, 0, 0);
+        for m in 1..=nt {
+            let i = gap + m;
+            if positive(i) {
+                if len == 0 {
+                    run_start = i;
+                }
+                len += 1;
+                if best.is_none_or(|(_, l)| len > l) {
+                    best = Some((run_start, len));
+                }
+            } else {
+                len = 0;
+            }
+        }
+        best.map(|(s, l)| (s % nt, (s + l - 1) % nt))
+    }
+
+    /// ζ1 (rad): where the pressure rises from zero before column `s`, by linear extrapolation
+    /// of the first two pressurised nodes (the pressure leaves zero with a finite slope).
+    fn zone_start_angle(&self, s: usize) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let p0 = self.pi[s * nz];
+        let p1 = self.pi[((s + 1) % nt) * nz];
+        let back = if p1 > p0 {
+            (p0 / (p1 - p0)).min(1.0)
+        } else {
+            0.5
+        };
+        wrap_angle_rad((s as f64 - back) * self.dtheta)
+    }
+
+    /// ζ2 (rad): where the film ruptures after column `e`. There p = ∂p/∂θ = 0 (seed eq. 6), so
+    /// p grows quadratically away from ζ2 and √p is extrapolated linearly to zero.
+    fn zone_end_angle(&self, e: usize) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let pe = self.pi[e * nz].max(0.0).sqrt();
+        let pb = self.pi[((e + nt - 1) % nt) * nz].max(0.0).sqrt();
+        let ahead = if pb > pe {
+            (pe / (pb - pe)).min(1.0)
+        } else {
+            0.5
+        };
+        wrap_angle_rad((e as f64 + ahead) * self.dtheta)
+    }
+
+    /// Friction torque on the journal (N·m): Couette shear µωR/h over the full 360° (the
+    /// Raimondi–Boyd convention) plus the pressure-flow shear (h/2R) ∂p/∂θ where the film is whole.
+    fn friction_torque(&self, speed_rad_s: f64) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let r = self.geometry.radius_m();
+        let c = self.geometry.radial_clearance_m;
+        let mu = self.lubricant.viscosity_pa_s;
+        let inverse_h: f64 = self.h_node.iter().map(|h| 1.0 / h).sum();
+        let couette =
+            mu * speed_rad_s * r.powi(3) * self.geometry.length_m / c * inverse_h * self.dtheta;
+        // (R/2) ∫∫ h ∂p/∂θ dθ dz over both halves = R² c ps Σ_j w_j Σ_i H_{i+½} (Π_{i+1} − Π_i)
+        let mut poiseuille = 0.0;
+        for j in 0..nz {
+            let mut row = 0.0;
+            for i in 0..nt {
+                let east = (i + 1) % nt;
+                row += self.h_face[i] * (self.pi[east * nz + j] - self.pi[i * nz + j]);
+            }
+            poiseuille += self.row_width(j) * row;
+        }
+        couette + r * r * c * self.pressure_scale * poiseuille
+    }
+
+    /// Flow out of both bearing ends (m³/s): the finite-volume flux through the edge faces.
+    fn side_flow(&self) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let r = self.geometry.radius_m();
+        let c = self.geometry.radial_clearance_m;
+        let flux: f64 = (0..nt)
+            .map(|i| self.h3_node[i] * self.pi[i * nz + nz - 1])
+            .sum();
+        flux * self.dtheta * c * r * r / self.dz
+    }
+
+    /// Circumferential flow into the pressure zone through the face before column `s` (m³/s):
+    /// Couette flow ωR h/2 less the pressure flow, over the whole length.
+    fn inflow(&self, s: usize, speed_rad_s: f64) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let west = (s + nt - 1) % nt;
+        let h = self.h_face[west];
+        let r = self.geometry.radius_m();
+        let c = self.geometry.radial_clearance_m;
+        let mut q = 0.0;
+        for j in 0..nz {
+            let dpi = self.pi[s * nz + j] - self.pi[west * nz + j];
+            q += self.row_width(j) * (speed_rad_s * h - h * h * h * dpi / self.dtheta);
+        }
+        r * r * c * q
+    }
+}

@@ -1,0 +1,138 @@
+//! The oil film of a plain journal bearing.
+//!
+//! Frame used throughout (as in Lund & Thomsen 1978): `x` is the first fixed axis (in a bearing
+//! analysis, the direction of the static load), `y` is 90° ahead of `x` in the direction of
+//! rotation. The angle θ is measured from `+x` in the direction of rotation. The journal centre
+//! position `(x, y)` is relative to the bearing centre, in metres.
+//!
+//! Two film models stand behind one interface ([`FilmModel`]):
+//! - [`FiniteFilm`]: the finite-length Reynolds equation (seed eq. 2, isoviscous) by finite
+//!   volumes, with the Reynolds (Swift–Stieber) cavitation condition solved as the
+//!   complementarity problem it is (primal–dual active set with a banded Cholesky factor);
+//! - [`ShortFilm`]: Ocvirk's short-bearing closed form with the π-film condition.
+
+mod banded;
+mod coefficients;
+mod equilibrium;
+mod error;
+mod finite;
+mod geometry;
+mod short;
+
+pub use coefficients::FilmCoefficients;
+pub use equilibrium::{
+    equilibrium_at_eccentricity, equilibrium_under_load, short_bearing_eccentricity,
+    sommerfeld_number, Equilibrium,
+};
+pub use error::FilmError;
+pub use finite::FiniteFilm;
+pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
+pub use short::ShortFilm;
+
+/// Position and velocity of the journal centre relative to the bearing centre, and its speed.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JournalKinematics {
+    /// Journal centre position `[x, y]` relative to the bearing centre (m).
+    pub position_m: [f64; 2],
+    /// Journal centre velocity `[ẋ, ẏ]` (m/s).
+    pub velocity_m_s: [f64; 2],
+    /// Journal angular speed ω (rad/s), positive when turning from `x` towards `y`.
+    pub speed_rad_s: f64,
+}
+
+impl JournalKinematics {
+    /// A journal at rest in position, turning at `speed_rad_s` (rad/s).
+    pub fn at_position(position_m: [f64; 2], speed_rad_s: f64) -> Self {
+        Self {
+            position_m,
+            velocity_m_s: [0.0, 0.0],
+            speed_rad_s,
+        }
+    }
+
+    /// Eccentricity ratio ε = e / c (dimensionless) for radial clearance `clearance_m` (m).
+    pub fn eccentricity_ratio(&self, clearance_m: f64) -> f64 {
+        self.position_m[0].hypot(self.position_m[1]) / clearance_m
+    }
+
+    /// Checks that every field is finite and the journal is inside the clearance circle.
+    pub fn validate(&self, clearance_m: f64) -> Result<(), FilmError> {
+        let fields = [
+            ("journal position x (m)", self.position_m[0]),
+            ("journal position y (m)", self.position_m[1]),
+            ("journal velocity x (m/s)", self.velocity_m_s[0]),
+            ("journal velocity y (m/s)", self.velocity_m_s[1]),
+            ("journal speed (rad/s)", self.speed_rad_s),
+        ];
+        for (name, value) in fields {
+            if !value.is_finite() {
+                return Err(FilmError::InvalidParameter {
+                    name,
+                    value,
+                    rule: "must be a finite number",
+                });
+            }
+        }
+        let eps = self.eccentricity_ratio(clearance_m);
+        if eps >= MAX_ECCENTRICITY_RATIO {
+            return Err(FilmError::JournalOutsideFilm {
+                eccentricity_ratio: eps,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Largest eccentricity ratio a film solve accepts: beyond it the minimum film is below 0.1 % of
+/// the clearance and the journal is in contact (a contact model, not the film, must carry it).
+pub const MAX_ECCENTRICITY_RATIO: f64 = 0.999;
+
+/// What one film solve reports. All angles are measured from `+x` in the direction of rotation,
+/// in radians, wrapped to [0, 2π).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FilmResult {
+    /// Film force on the journal `[F_x, F_y]` in the fixed frame (N).
+    pub force_n: [f64; 2],
+    /// Largest film pressure (Pa, gauge).
+    pub max_pressure_pa: f64,
+    /// Angle of the largest pressure (rad).
+    pub max_pressure_angle_rad: f64,
+    /// ζ1: where the positive-pressure zone starts in the mid-plane (rad).
+    pub film_start_rad: f64,
+    /// ζ2: where the film ruptures in the mid-plane (rad), p = ∂p/∂θ = 0 there (seed eq. 6).
+    pub film_end_rad: f64,
+    /// Viscous friction torque on the journal, opposing rotation (N·m).
+    pub friction_torque_n_m: f64,
+    /// Power dissipated in the film, torque × ω (W).
+    pub power_loss_w: f64,
+    /// Flow leaving both ends of the bearing (m³/s).
+    pub side_flow_m3_s: f64,
+    /// Circumferential flow entering the pressure zone at ζ1 (m³/s).
+    pub inflow_m3_s: f64,
+}
+
+/// A film model: maps the journal kinematics to the film force and its derivatives.
+pub trait FilmModel {
+    /// Bearing geometry this model was built for.
+    fn geometry(&self) -> &BearingGeometry;
+
+    /// Solves the film for `kin`. A model may start from its previous solution (warm start).
+    fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError>;
+
+    /// Solves the film for `kin` and returns the eight dynamic coefficients there (seed eq. 3–4),
+    /// obtained by perturbation of the film equations about this position and velocity.
+    fn solve_with_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError>;
+}
+
+/// Wraps an angle (rad) to [0, 2π).
+pub fn wrap_angle_rad(angle: f64) -> f64 {
+    let a = angle.rem_euclid(std::f64::consts::TAU);
+    if a >= std::f64::consts::TAU {
+        0.0
+    } else {
+        a
+    }
+}

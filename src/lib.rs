@@ -1,0 +1,8 @@
+//! rotor-twin: a live digital twin of a rotor on fluid-film bearings.
+//!
+//! Built after Kiciński & Żywica, *Modelling fluid-film bearings in high-speed rotating machinery
+//! considering the prehistory of dynamic phenomena*, Sci. Rep. 15:43354 (2025) ("the seed").
+//! SI units everywhere inside; names carry the unit where it is not SI.
+
+pub mod film;
+pub mod units;
