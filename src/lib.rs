@@ -4,5 +4,6 @@
 //! considering the prehistory of dynamic phenomena*, Sci. Rep. 15:43354 (2025) ("the seed").
 //! SI units everywhere inside; names carry the unit where it is not SI.
 
+pub mod cli;
 pub mod film;
 pub mod units;

@@ -4,9 +4,10 @@
 //! whose bandwidth is the number of axial nodes (columns ordered around the circumference, nodes
 //! within a column along the axis). Factor cost n·b²/2, solve cost 2·n·b.
 
-/// Lower band of an n × n symmetric matrix with half-bandwidth `b`; row `i` holds the entries
-/// `A[i][i-b] … A[i][i]` (the last is the diagonal). Storage is reserved once for the largest
-/// `n` and `b` the owner will ever need.
+/// Lower band of an n × n symmetric matrix with half-bandwidth `b`, stored by columns (LAPACK's
+/// `dpbtrf` 'L' layout): column `j` holds `A[j][j] … A[j+b][j]` contiguously, so the factor's
+/// updates are unit-stride `axpy`s. Storage is reserved once for the largest `n` and `b` the
+/// owner will ever need.
 #[derive(Debug, Clone)]
 pub(crate) struct BandMatrix {
     data: Vec<f64>,
@@ -18,7 +19,7 @@ impl BandMatrix {
     /// Reserves room for matrices up to `max_n` rows with half-bandwidth up to `max_b`.
     pub(crate) fn with_capacity(max_n: usize, max_b: usize) -> Self {
         Self {
-            data: vec![0.0; max_n * (max_b + 1)],
+            data: vec![0.0; (max_n + max_b) * (max_b + 1)],
             n: 0,
             b: 0,
         }
@@ -26,78 +27,142 @@ impl BandMatrix {
 
     /// Starts a new zero matrix of `n` rows and half-bandwidth `b` within the reserved room.
     pub(crate) fn reset(&mut self, n: usize, b: usize) {
-        let len = n * (b + 1);
+        // b extra columns of padding let the last columns' updates run unclipped
+        let len = (n + b) * (b + 1);
         assert!(len <= self.data.len(), "band matrix capacity exceeded");
         self.n = n;
         self.b = b;
         self.data[..len].fill(0.0);
     }
 
-    #[inline]
-    fn idx(&self, i: usize, j: usize) -> usize {
-        // j in i-b..=i
-        i * (self.b + 1) + (self.b + j - i)
-    }
-
-    /// Adds `value` to `A[i][j]` for `j ≤ i` (the symmetric entry is implied).
+    /// Adds `value` to `A[i][j]` for `j ≤ i ≤ j + b` (the symmetric entry is implied).
     #[inline]
     pub(crate) fn add(&mut self, i: usize, j: usize, value: f64) {
         debug_assert!(j <= i && i - j <= self.b);
-        let k = self.idx(i, j);
-        self.data[k] += value;
+        self.data[j * (self.b + 1) + (i - j)] += value;
     }
 
-    /// Factors A = L Lᵀ in place. Returns false if a pivot is not positive (A not SPD).
+    /// Factors A = L Lᵀ in place (right-looking). Returns false if a pivot is not positive.
     pub(crate) fn factor(&mut self) -> bool {
-        let (n, b) = (self.n, self.b);
-        let w = b + 1;
-        for i in 0..n {
-            let j0 = i.saturating_sub(b);
-            for j in j0..=i {
-                // s = A[i][j] − Σ_{k=max(j0, j−b)}^{j−1} L[i][k] L[j][k]
-                let k0 = j0.max(j.saturating_sub(b));
-                let mut s = self.data[i * w + (b + j - i)];
-                let ri = i * w + b - i;
-                let rj = j * w + b - j;
-                for k in k0..j {
-                    s -= self.data[ri + k] * self.data[rj + k];
-                }
-                if i == j {
-                    if s <= 0.0 || !s.is_finite() {
-                        return false;
-                    }
-                    self.data[ri + i] = s.sqrt();
-                } else {
-                    self.data[ri + j] = s / self.data[rj + j];
-                }
-            }
+        let n = self.n;
+        let d = &mut self.data;
+        // constant widths let the compiler unroll the short column updates
+        match self.b + 1 {
+            3 => factor_width(d, n, 3),
+            4 => factor_width(d, n, 4),
+            5 => factor_width(d, n, 5),
+            6 => factor_width(d, n, 6),
+            7 => factor_width(d, n, 7),
+            8 => factor_width(d, n, 8),
+            9 => factor_width(d, n, 9),
+            10 => factor_width(d, n, 10),
+            11 => factor_width(d, n, 11),
+            12 => factor_width(d, n, 12),
+            13 => factor_width(d, n, 13),
+            17 => factor_width(d, n, 17),
+            21 => factor_width(d, n, 21),
+            w => factor_width(d, n, w),
         }
-        true
     }
 
     /// Solves L Lᵀ x = r in place (after [`factor`](Self::factor)); `x` holds r on entry.
     pub(crate) fn solve(&self, x: &mut [f64]) {
-        let (n, b) = (self.n, self.b);
-        let w = b + 1;
-        // forward: L y = r
-        for i in 0..n {
-            let ri = i * w + b - i;
-            let mut s = x[i];
-            for (k, xk) in x.iter().enumerate().take(i).skip(i.saturating_sub(b)) {
-                s -= self.data[ri + k] * xk;
-            }
-            x[i] = s / self.data[ri + i];
+        let (n, d) = (self.n, &self.data);
+        match self.b + 1 {
+            3 => solve_width(d, n, 3, x),
+            4 => solve_width(d, n, 4, x),
+            5 => solve_width(d, n, 5, x),
+            6 => solve_width(d, n, 6, x),
+            7 => solve_width(d, n, 7, x),
+            8 => solve_width(d, n, 8, x),
+            9 => solve_width(d, n, 9, x),
+            10 => solve_width(d, n, 10, x),
+            11 => solve_width(d, n, 11, x),
+            12 => solve_width(d, n, 12, x),
+            13 => solve_width(d, n, 13, x),
+            17 => solve_width(d, n, 17, x),
+            21 => solve_width(d, n, 21, x),
+            w => solve_width(d, n, w, x),
         }
-        // backward: Lᵀ x = y
-        for i in (0..n).rev() {
-            let ri = i * w + b - i;
-            let xi = x[i] / self.data[ri + i];
-            x[i] = xi;
-            for k in i.saturating_sub(b)..i {
-                x[k] -= self.data[ri + k] * xi;
+    }
+}
+
+/// Band Cholesky of `n` columns of width `w` = b + 1 (see [`BandMatrix`]).
+#[inline(always)]
+fn factor_width(data: &mut [f64], n: usize, w: usize) -> bool {
+    for k in 0..n {
+        let (head, tail) = data.split_at_mut((k + 1) * w);
+        let col_k = &mut head[k * w..];
+        let pivot = col_k[0];
+        if pivot <= 0.0 || !pivot.is_finite() {
+            return false;
+        }
+        let inv = 1.0 / pivot.sqrt();
+        // the diagonal is kept as its reciprocal: the solves multiply instead of divide
+        col_k[0] = inv;
+        for v in &mut col_k[1..] {
+            *v *= inv;
+        }
+        // A[i][j] −= L[i][k] L[j][k] for k < j ≤ i ≤ k + b (padding past n is harmless)
+        for m in 1..w {
+            let ljk = col_k[m];
+            let col_j = &mut tail[(m - 1) * w..(m - 1) * w + (w - m)];
+            for (a, l) in col_j.iter_mut().zip(&col_k[m..]) {
+                *a -= l * ljk;
             }
         }
     }
+    true
+}
+
+/// Forward and back substitution with the factor of [`factor_width`].
+#[inline(always)]
+fn solve_width(data: &[f64], n: usize, w: usize, x: &mut [f64]) {
+    let x = &mut x[..n];
+    let body = n.saturating_sub(w);
+    // forward: L y = r
+    for k in 0..n {
+        let col = &data[k * w..(k + 1) * w];
+        let yk = x[k] * col[0];
+        x[k] = yk;
+        if k < body {
+            for (xi, l) in x[k + 1..k + w].iter_mut().zip(&col[1..]) {
+                *xi -= l * yk;
+            }
+        } else {
+            for (xi, l) in x[k + 1..].iter_mut().zip(&col[1..]) {
+                *xi -= l * yk;
+            }
+        }
+    }
+    // backward: Lᵀ x = y
+    for k in (0..n).rev() {
+        let col = &data[k * w..(k + 1) * w];
+        let s = if k < body {
+            dot(&col[1..], &x[k + 1..k + w])
+        } else {
+            dot(&col[1..n - k], &x[k + 1..])
+        };
+        x[k] = (x[k] - s) * col[0];
+    }
+}
+
+/// Dot product of two equal-length slices with four independent partial sums.
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
 }
 
 #[cfg(test)]

@@ -70,8 +70,8 @@ pub struct FiniteFilm {
     pi: Vec<f64>,
     /// Per node: position in the linear system, or NOT_FREE.
     slot: Vec<u32>,
-    /// Position in the linear system → node.
-    order: Vec<u32>,
+    /// Position in the linear system → node (column i, axial row j).
+    order: Vec<(u32, u32)>,
     /// Column sequence that keeps a periodic ring banded (0, 1, n−1, 2, n−2, …).
     folded_columns: Vec<u32>,
     band: BandMatrix,
@@ -138,7 +138,7 @@ impl FiniteFilm {
             free: vec![false; nodes],
             pi: vec![0.0; nodes],
             slot: vec![NOT_FREE; nodes],
-            order: vec![0; nodes],
+            order: vec![(0, 0); nodes],
             folded_columns,
             band: BandMatrix::with_capacity(nodes, 2 * nz + 1),
             rhs: vec![0.0; nodes],
@@ -265,7 +265,7 @@ impl FiniteFilm {
                 let k = i * nz + j;
                 if self.free[k] {
                     self.slot[k] = n as u32;
-                    self.order[n] = k as u32;
+                    self.order[n] = (i as u32, j as u32);
                     n += 1;
                 } else {
                     self.slot[k] = NOT_FREE;
@@ -274,8 +274,7 @@ impl FiniteFilm {
         }
         let mut b = 0;
         for r in 0..n {
-            let k = self.order[r] as usize;
-            let (i, j) = (k / nz, k % nz);
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
             self.for_each_neighbour(i, j, |nb, _| {
                 if let Some((a, c)) = nb {
                     let s = self.slot[a * nz + c];
@@ -295,8 +294,7 @@ impl FiniteFilm {
         let mut band = std::mem::replace(&mut self.band, BandMatrix::with_capacity(0, 0));
         band.reset(n, b);
         for r in 0..n {
-            let k = self.order[r] as usize;
-            let (i, j) = (k / nz, k % nz);
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
             let mut diag = 0.0;
             let mut rhs = self.node_rhs(i, j);
             self.for_each_neighbour(i, j, |nb, cond| {
@@ -426,8 +424,8 @@ impl FiniteFilm {
         let n = self.n_free;
         let mut rhs = std::mem::take(&mut self.perturbation);
         for r in 0..n {
-            let k = self.order[r] as usize;
-            let (i, j) = (k / nz, k % nz);
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
+            let k = i * nz + j;
             let volume = self.dtheta * self.row_width(j);
             let west = if i == 0 { self.grid.n_theta - 1 } else { i - 1 };
             // ∂b/∂X = V ω (cos θ_{i+½} − cos θ_{i−½})/Δθ, since ∂H/∂X = −cos θ

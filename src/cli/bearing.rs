@@ -1,0 +1,260 @@
+//! `rotor-twin bearing`: static analysis of one journal bearing.
+
+use crate::film::{
+    equilibrium_at_eccentricity, equilibrium_under_load, BearingGeometry, Equilibrium, FilmGrid,
+    FilmModel, FiniteFilm, Lubricant, ShortFilm,
+};
+use crate::units::rpm_to_rad_s;
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+
+/// The frame every bearing result is given in.
+pub const FRAME: &str = "x along the static load, y perpendicular to it, 90 deg ahead of x in the \
+direction of rotation; angles from +x in the direction of rotation; force on the journal \
+F = -K q - C qdot";
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub(crate) enum Grooves {
+    /// Plain 360° bearing.
+    None,
+    /// Two axial grooves on the split line, 90° either side of the load (Lund & Thomsen).
+    TwoAxial,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub(crate) enum ModelKind {
+    /// Finite-length Reynolds equation with the Reynolds cavitation condition.
+    Finite,
+    /// Ocvirk's short bearing, π-film.
+    Short,
+}
+
+/// Static analysis of one journal bearing (defaults: the seed's microturbine bearing).
+#[derive(Debug, Clone, Args)]
+pub struct BearingArgs {
+    /// Journal diameter D (m).
+    #[arg(long, default_value_t = 0.06)]
+    diameter_m: f64,
+    /// Bearing length L (m).
+    #[arg(long, default_value_t = 0.03)]
+    length_m: f64,
+    /// Radial clearance c (m).
+    #[arg(long, default_value_t = 40e-6)]
+    clearance_m: f64,
+    /// Lubricant dynamic viscosity µ (Pa·s).
+    #[arg(long, default_value_t = 0.0008)]
+    viscosity_pa_s: f64,
+    /// Lubricant density ρ (kg/m³); used for the film Reynolds number.
+    #[arg(long, default_value_t = 900.0)]
+    density_kg_m3: f64,
+    /// Journal speed (rpm).
+    #[arg(long, default_value_t = 9000.0)]
+    speed_rpm: f64,
+    /// Static load on the bearing (N), along +x. Default 275 N when no eccentricity is given.
+    #[arg(long, conflicts_with = "eccentricity_ratio")]
+    load_n: Option<f64>,
+    /// Eccentricity ratio ε = e/c instead of a load: the load it carries is computed.
+    #[arg(long)]
+    eccentricity_ratio: Option<f64>,
+    /// Supply grooves.
+    #[arg(long, value_enum, default_value_t = Grooves::None)]
+    grooves: Grooves,
+    /// Arc width of each axial groove (deg).
+    #[arg(long, default_value_t = 20.0)]
+    groove_width_deg: f64,
+    /// Gauge supply pressure at the grooves (Pa).
+    #[arg(long, default_value_t = 0.0)]
+    supply_pressure_pa: f64,
+    /// Film grid over the half bearing: nodes around × intervals from mid-plane to edge.
+    #[arg(long, default_value = "60x10", value_parser = FilmGrid::parse)]
+    grid: FilmGrid,
+    /// Film model.
+    #[arg(long, value_enum, default_value_t = ModelKind::Finite)]
+    model: ModelKind,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+impl BearingArgs {
+    /// The built-in default bearing (seed: D 60 mm, L 30 mm, c 40 µm, µ 0.0008 Pa·s, 9000 rpm, 275 N).
+    pub(crate) fn default_bearing() -> Self {
+        Self {
+            diameter_m: 0.06,
+            length_m: 0.03,
+            clearance_m: 40e-6,
+            viscosity_pa_s: 0.0008,
+            density_kg_m3: 900.0,
+            speed_rpm: 9000.0,
+            load_n: None,
+            eccentricity_ratio: None,
+            grooves: Grooves::None,
+            groove_width_deg: 20.0,
+            supply_pressure_pa: 0.0,
+            grid: FilmGrid::DEFAULT,
+            model: ModelKind::Finite,
+            json: false,
+        }
+    }
+}
+
+/// The `--json` report (field names carry their units).
+#[derive(Debug, Serialize)]
+struct BearingReport {
+    model: ModelKind,
+    grid: String,
+    grooves: Grooves,
+    speed_rpm: f64,
+    load_n: f64,
+    eccentricity_ratio: f64,
+    attitude_angle_deg: f64,
+    journal_position_m: [f64; 2],
+    min_film_thickness_m: f64,
+    sommerfeld_number: f64,
+    max_pressure_pa: f64,
+    max_pressure_angle_deg: f64,
+    film_start_deg: f64,
+    film_end_deg: f64,
+    friction_torque_n_m: f64,
+    power_loss_w: f64,
+    side_flow_m3_s: f64,
+    inflow_m3_s: f64,
+    film_reynolds_number: f64,
+    stiffness_n_per_m: [[f64; 2]; 2],
+    damping_n_s_per_m: [[f64; 2]; 2],
+    stiffness_dimensionless: [[f64; 2]; 2],
+    damping_dimensionless: [[f64; 2]; 2],
+    frame: &'static str,
+}
+
+pub(crate) fn run(args: &BearingArgs) -> anyhow::Result<()> {
+    let report = analyse(args)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}
+
+fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
+    let geometry = match args.grooves {
+        Grooves::None => BearingGeometry::plain(args.diameter_m, args.length_m, args.clearance_m),
+        Grooves::TwoAxial => BearingGeometry::two_axial_grooves(
+            args.diameter_m,
+            args.length_m,
+            args.clearance_m,
+            args.groove_width_deg.to_radians(),
+            args.supply_pressure_pa,
+        ),
+    }
+    .context("bearing geometry")?;
+    let lubricant =
+        Lubricant::new(args.density_kg_m3, args.viscosity_pa_s).context("lubricant")?;
+    if args.model == ModelKind::Short && args.grooves != Grooves::None {
+        anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
+    }
+    let mut model: Box<dyn FilmModel> = match args.model {
+        ModelKind::Finite => Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?),
+        ModelKind::Short => Box::new(ShortFilm::new(geometry, lubricant)?),
+    };
+    let omega = rpm_to_rad_s(args.speed_rpm);
+    let eq: Equilibrium = match args.eccentricity_ratio {
+        Some(e) => equilibrium_at_eccentricity(model.as_mut(), args.viscosity_pa_s, e, omega),
+        None => {
+            let w = args.load_n.unwrap_or(275.0);
+            equilibrium_under_load(model.as_mut(), args.viscosity_pa_s, [w, 0.0], omega)
+        }
+    }
+    .context("static equilibrium")?;
+    let w = eq.load_n[0].hypot(eq.load_n[1]);
+    let c = args.clearance_m;
+    let f = &eq.film;
+    let report = BearingReport {
+        model: args.model,
+        grid: match args.model {
+            ModelKind::Finite => format!("{}x{}", args.grid.n_theta, args.grid.n_z),
+            ModelKind::Short => "closed form".into(),
+        },
+        grooves: args.grooves,
+        speed_rpm: args.speed_rpm,
+        load_n: w,
+        eccentricity_ratio: eq.eccentricity_ratio,
+        attitude_angle_deg: eq.attitude_angle_rad.to_degrees(),
+        journal_position_m: eq.position_m,
+        min_film_thickness_m: c * (1.0 - eq.eccentricity_ratio),
+        sommerfeld_number: eq.sommerfeld_number,
+        max_pressure_pa: f.max_pressure_pa,
+        max_pressure_angle_deg: f.max_pressure_angle_rad.to_degrees(),
+        film_start_deg: f.film_start_rad.to_degrees(),
+        film_end_deg: f.film_end_rad.to_degrees(),
+        friction_torque_n_m: f.friction_torque_n_m,
+        power_loss_w: f.power_loss_w,
+        side_flow_m3_s: f.side_flow_m3_s,
+        inflow_m3_s: f.inflow_m3_s,
+        film_reynolds_number: lubricant.film_reynolds_number(omega, 0.5 * args.diameter_m, c),
+        stiffness_n_per_m: eq.coefficients.stiffness_n_per_m,
+        damping_n_s_per_m: eq.coefficients.damping_n_s_per_m,
+        stiffness_dimensionless: eq.coefficients.dimensionless_stiffness(w, c),
+        damping_dimensionless: eq.coefficients.dimensionless_damping(w, c, omega),
+        frame: FRAME,
+    };
+    anyhow::ensure!(
+        report_is_finite(&report),
+        "the film solution holds a non-finite number; nothing printed"
+    );
+    Ok(report)
+}
+
+fn report_is_finite(r: &BearingReport) -> bool {
+    let scalars = [
+        r.eccentricity_ratio,
+        r.attitude_angle_deg,
+        r.sommerfeld_number,
+        r.max_pressure_pa,
+        r.max_pressure_angle_deg,
+        r.film_start_deg,
+        r.film_end_deg,
+        r.friction_torque_n_m,
+        r.power_loss_w,
+        r.side_flow_m3_s,
+        r.inflow_m3_s,
+        r.film_reynolds_number,
+    ];
+    let matrices = [
+        r.stiffness_n_per_m,
+        r.damping_n_s_per_m,
+        r.stiffness_dimensionless,
+        r.damping_dimensionless,
+    ];
+    scalars.iter().all(|v| v.is_finite())
+        && matrices.iter().flatten().flatten().all(|v| v.is_finite())
+}
+
+fn print_table(r: &BearingReport) {
+    let m = |a: [[f64; 2]; 2]| format!("[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]", a[0][0], a[0][1], a[1][0], a[1][1]);
+    let d = |a: [[f64; 2]; 2]| format!("[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]", a[0][0], a[0][1], a[1][0], a[1][1]);
+    println!("rotor-twin bearing: {:?} film, grid {}, grooves {:?}", r.model, r.grid, r.grooves);
+    println!("  speed                      {:>12.1} rpm", r.speed_rpm);
+    println!("  static load                {:>12.2} N", r.load_n);
+    println!("  Sommerfeld number S        {:>12.5}", r.sommerfeld_number);
+    println!("  eccentricity ratio ε       {:>12.4}", r.eccentricity_ratio);
+    println!("  attitude angle φ           {:>12.2} deg", r.attitude_angle_deg);
+    println!("  minimum film               {:>12.2} µm", r.min_film_thickness_m * 1e6);
+    println!("  peak pressure              {:>12.4} MPa at {:.1} deg", r.max_pressure_pa * 1e-6, r.max_pressure_angle_deg);
+    println!("  pressure zone ζ1 → ζ2      {:>6.1} → {:.1} deg", r.film_start_deg, r.film_end_deg);
+    println!("  friction torque            {:>12.4} N·m", r.friction_torque_n_m);
+    println!("  power loss                 {:>12.1} W", r.power_loss_w);
+    println!("  side flow                  {:>12.3} cm³/s", r.side_flow_m3_s * 1e6);
+    println!("  inflow at ζ1               {:>12.3} cm³/s", r.inflow_m3_s * 1e6);
+    println!("  film Reynolds number       {:>12.0}{}", r.film_reynolds_number,
+        if r.film_reynolds_number > 1000.0 { "  (near the laminar limit: a turbulent film would differ)" } else { "" });
+    println!("  stiffness k (N/m)          {}", m(r.stiffness_n_per_m));
+    println!("  damping c (N·s/m)          {}", m(r.damping_n_s_per_m));
+    println!("  K = k c/W                  {}", d(r.stiffness_dimensionless));
+    println!("  B = c ω c_r/W              {}", d(r.damping_dimensionless));
+    println!("  frame: {}", r.frame);
+}

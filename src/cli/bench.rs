@@ -1,0 +1,139 @@
+//! `rotor-twin bench`: measures the hot paths and prints the figures (speed is measured here,
+//! never in timed tests).
+
+use crate::film::{
+    equilibrium_under_load, BearingGeometry, FilmGrid, FilmModel, FiniteFilm, JournalKinematics,
+    Lubricant,
+};
+use crate::units::rpm_to_rad_s;
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Workload {
+    /// One film solve of the seed's bearing (9,000 rpm, 275 N) on a 60 × 10 half-grid.
+    Film,
+}
+
+/// Measure the cost of the hot paths.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// What to measure.
+    #[arg(value_enum, default_value_t = Workload::Film)]
+    workload: Workload,
+    /// Seconds to spend on each measured case.
+    #[arg(long, default_value_t = 2.0)]
+    seconds: f64,
+    /// Film grid over the half bearing.
+    #[arg(long, default_value = "60x10", value_parser = FilmGrid::parse)]
+    grid: FilmGrid,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Timing of one case (µs).
+#[derive(Debug, Serialize)]
+struct CaseFigures {
+    case: &'static str,
+    samples: usize,
+    median_us: f64,
+    p99_us: f64,
+    mean_active_set_passes: f64,
+}
+
+pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 600.0,
+        "--seconds {} must be between 0 and 600",
+        args.seconds
+    );
+    let figures = match args.workload {
+        Workload::Film => film_cases(args)?,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&figures)?);
+    } else {
+        println!(
+            "film solve, seed bearing (D 60 mm, L 30 mm, c 40 µm, 9000 rpm, 275 N), grid {}x{}:",
+            args.grid.n_theta, args.grid.n_z
+        );
+        for f in &figures {
+            println!(
+                "  {:<44} median {:>8.2} µs   p99 {:>8.2} µs   ({} samples, {:.2} active-set passes)",
+                f.case, f.median_us, f.p99_us, f.samples, f.mean_active_set_passes
+            );
+        }
+    }
+    Ok(())
+}
+
+fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
+    let geometry = BearingGeometry::plain(0.06, 0.03, 40e-6)?;
+    let lubricant = Lubricant::new(900.0, 0.0008)?;
+    let omega = rpm_to_rad_s(9000.0);
+    let mut film = FiniteFilm::new(geometry, lubricant, args.grid)?;
+    let eq = equilibrium_under_load(&mut film, 0.0008, [275.0, 0.0], omega)?;
+    let c = 40e-6;
+    let q0 = eq.position_m;
+    // a journal move of 1 % of the clearance, across the line of centres
+    let moved = [q0[0] - 0.01 * c * 0.6, q0[1] + 0.01 * c * 0.8];
+    let at = |q| JournalKinematics::at_position(q, omega);
+    let budget = Duration::from_secs_f64(args.seconds);
+
+    let cold = measure("cold (no previous solution)", budget, &mut film, |f, _| {
+        f.reset_warm_start();
+        f.solve(&at(q0)).map(|r| r.force_n[0])
+    })?;
+    let warm = measure("warm, after a 1 % c journal move", budget, &mut film, |f, k| {
+        let q = if k % 2 == 0 { moved } else { q0 };
+        f.solve(&at(q)).map(|r| r.force_n[0])
+    })?;
+    let warm_same = measure("warm, same position (zone unchanged)", budget, &mut film, |f, _| {
+        f.solve(&at(q0)).map(|r| r.force_n[0])
+    })?;
+    let coefficients = measure(
+        "warm + 8 coefficients, after a 1 % c move",
+        budget,
+        &mut film,
+        |f, k| {
+            let q = if k % 2 == 0 { moved } else { q0 };
+            f.solve_with_coefficients(&at(q))
+                .map(|(r, c)| r.force_n[0] + c.stiffness_n_per_m[0][0])
+        },
+    )?;
+    Ok(vec![cold, warm, warm_same, coefficients])
+}
+
+fn measure(
+    case: &'static str,
+    budget: Duration,
+    film: &mut FiniteFilm,
+    mut once: impl FnMut(&mut FiniteFilm, usize) -> Result<f64, crate::film::FilmError>,
+) -> anyhow::Result<CaseFigures> {
+    for k in 0..100 {
+        black_box(once(film, k)?);
+    }
+    let mut times = Vec::with_capacity(1 << 20);
+    let mut passes = 0usize;
+    let start = Instant::now();
+    let mut k = 0;
+    while start.elapsed() < budget && times.len() < (1 << 20) {
+        let t = Instant::now();
+        black_box(once(film, k)?);
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+        passes += film.last_active_set_passes();
+        k += 1;
+    }
+    times.sort_by(f64::total_cmp);
+    let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    Ok(CaseFigures {
+        case,
+        samples: times.len(),
+        median_us: pick(0.5),
+        p99_us: pick(0.99),
+        mean_active_set_passes: passes as f64 / times.len() as f64,
+    })
+}

@@ -1,0 +1,31 @@
+//! The `rotor-twin` command line: one subcommand per job.
+
+mod bearing;
+mod bench;
+
+use clap::{Parser, Subcommand};
+
+/// rotor-twin: a live digital twin of a rotor on fluid-film bearings.
+#[derive(Debug, Parser)]
+#[command(name = "rotor-twin", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Static analysis of one journal bearing: equilibrium, film, eight coefficients.
+    Bearing(bearing::BearingArgs),
+    /// Measure the cost of the hot paths (prints its figures).
+    Bench(bench::BenchArgs),
+}
+
+/// Runs the command line; with no subcommand, the main job on the built-in default machine.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Some(Command::Bearing(args)) => bearing::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        None => bearing::run(&bearing::BearingArgs::default_bearing()),
+    }
+}
