@@ -34,6 +34,7 @@ pub(crate) enum ModelKind {
 
 /// Static analysis of one journal bearing (defaults: the seed's microturbine bearing).
 #[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct BearingArgs {
     /// Journal diameter D (m).
     #[arg(long, default_value_t = 0.06)]
@@ -152,8 +153,7 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
         ),
     }
     .context("bearing geometry")?;
-    let lubricant =
-        Lubricant::new(args.density_kg_m3, args.viscosity_pa_s).context("lubricant")?;
+    let lubricant = Lubricant::new(args.density_kg_m3, args.viscosity_pa_s).context("lubricant")?;
     if args.model == ModelKind::Short && args.grooves != Grooves::None {
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
@@ -166,6 +166,10 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
         Some(e) => equilibrium_at_eccentricity(model.as_mut(), args.viscosity_pa_s, e, omega),
         None => {
             let w = args.load_n.unwrap_or(275.0);
+            anyhow::ensure!(
+                w.is_finite() && w > 0.0,
+                "invalid --load-n {w}: the static load (N) must be a finite number greater than zero"
+            );
             equilibrium_under_load(model.as_mut(), args.viscosity_pa_s, [w, 0.0], omega)
         }
     }
@@ -235,26 +239,77 @@ fn report_is_finite(r: &BearingReport) -> bool {
 }
 
 fn print_table(r: &BearingReport) {
-    let m = |a: [[f64; 2]; 2]| format!("[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]", a[0][0], a[0][1], a[1][0], a[1][1]);
-    let d = |a: [[f64; 2]; 2]| format!("[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]", a[0][0], a[0][1], a[1][0], a[1][1]);
-    println!("rotor-twin bearing: {:?} film, grid {}, grooves {:?}", r.model, r.grid, r.grooves);
+    let m = |a: [[f64; 2]; 2]| {
+        format!(
+            "[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]",
+            a[0][0], a[0][1], a[1][0], a[1][1]
+        )
+    };
+    let d = |a: [[f64; 2]; 2]| {
+        format!(
+            "[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]",
+            a[0][0], a[0][1], a[1][0], a[1][1]
+        )
+    };
+    println!(
+        "rotor-twin bearing: {:?} film, grid {}, grooves {:?}",
+        r.model, r.grid, r.grooves
+    );
     println!("  speed                      {:>12.1} rpm", r.speed_rpm);
     println!("  static load                {:>12.2} N", r.load_n);
     println!("  Sommerfeld number S        {:>12.5}", r.sommerfeld_number);
-    println!("  eccentricity ratio ε       {:>12.4}", r.eccentricity_ratio);
-    println!("  attitude angle φ           {:>12.2} deg", r.attitude_angle_deg);
-    println!("  minimum film               {:>12.2} µm", r.min_film_thickness_m * 1e6);
-    println!("  peak pressure              {:>12.4} MPa at {:.1} deg", r.max_pressure_pa * 1e-6, r.max_pressure_angle_deg);
-    println!("  pressure zone ζ1 → ζ2      {:>6.1} → {:.1} deg", r.film_start_deg, r.film_end_deg);
-    println!("  friction torque            {:>12.4} N·m", r.friction_torque_n_m);
+    println!(
+        "  eccentricity ratio ε       {:>12.4}",
+        r.eccentricity_ratio
+    );
+    println!(
+        "  attitude angle φ           {:>12.2} deg",
+        r.attitude_angle_deg
+    );
+    println!(
+        "  minimum film               {:>12.2} µm",
+        r.min_film_thickness_m * 1e6
+    );
+    println!(
+        "  peak pressure              {:>12.4} MPa at {:.1} deg",
+        r.max_pressure_pa * 1e-6,
+        r.max_pressure_angle_deg
+    );
+    println!(
+        "  pressure zone ζ1 → ζ2      {:>6.1} → {:.1} deg",
+        r.film_start_deg, r.film_end_deg
+    );
+    println!(
+        "  friction torque            {:>12.4} N·m",
+        r.friction_torque_n_m
+    );
     println!("  power loss                 {:>12.1} W", r.power_loss_w);
-    println!("  side flow                  {:>12.3} cm³/s", r.side_flow_m3_s * 1e6);
-    println!("  inflow at ζ1               {:>12.3} cm³/s", r.inflow_m3_s * 1e6);
-    println!("  film Reynolds number       {:>12.0}{}", r.film_reynolds_number,
-        if r.film_reynolds_number > 1000.0 { "  (near the laminar limit: a turbulent film would differ)" } else { "" });
+    println!(
+        "  side flow                  {:>12.3} cm³/s",
+        r.side_flow_m3_s * 1e6
+    );
+    println!(
+        "  inflow at ζ1               {:>12.3} cm³/s",
+        r.inflow_m3_s * 1e6
+    );
+    println!(
+        "  film Reynolds number       {:>12.0}{}",
+        r.film_reynolds_number,
+        if r.film_reynolds_number > 1000.0 {
+            "  (near the laminar limit: a turbulent film would differ)"
+        } else {
+            ""
+        }
+    );
     println!("  stiffness k (N/m)          {}", m(r.stiffness_n_per_m));
     println!("  damping c (N·s/m)          {}", m(r.damping_n_s_per_m));
-    println!("  K = k c/W                  {}", d(r.stiffness_dimensionless));
-    println!("  B = c ω c_r/W              {}", d(r.damping_dimensionless));
+    println!(
+        "  K = k c/W                  {}",
+        d(r.stiffness_dimensionless)
+    );
+    println!(
+        "  B = c ω c_r/W              {}",
+        d(r.damping_dimensionless)
+    );
     println!("  frame: {}", r.frame);
 }

@@ -87,13 +87,21 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
         f.reset_warm_start();
         f.solve(&at(q0)).map(|r| r.force_n[0])
     })?;
-    let warm = measure("warm, after a 1 % c journal move", budget, &mut film, |f, k| {
-        let q = if k % 2 == 0 { moved } else { q0 };
-        f.solve(&at(q)).map(|r| r.force_n[0])
-    })?;
-    let warm_same = measure("warm, same position (zone unchanged)", budget, &mut film, |f, _| {
-        f.solve(&at(q0)).map(|r| r.force_n[0])
-    })?;
+    let warm = measure(
+        "warm, after a 1 % c journal move",
+        budget,
+        &mut film,
+        |f, k| {
+            let q = if k % 2 == 0 { moved } else { q0 };
+            f.solve(&at(q)).map(|r| r.force_n[0])
+        },
+    )?;
+    let warm_same = measure(
+        "warm, same position (zone unchanged)",
+        budget,
+        &mut film,
+        |f, _| f.solve(&at(q0)).map(|r| r.force_n[0]),
+    )?;
     let coefficients = measure(
         "warm + 8 coefficients, after a 1 % c move",
         budget,
