@@ -115,41 +115,34 @@ fn factor_width(data: &mut [f64], n: usize, w: usize) -> bool {
     true
 }
 
-/// Forward and back substitution with the factor of [`factor_width`].
+/// Forward and back substitution with the factor of [`factor_width`]: column `axpy`s forward,
+/// column dot products backward, both unit-stride.
 #[inline(always)]
 fn solve_width(data: &[f64], n: usize, w: usize, x: &mut [f64]) {
     let x = &mut x[..n];
-    let body = n.saturating_sub(w);
     // forward: L y = r
-    for k in 0..n {
-        let col = &data[k * w..(k + 1) * w];
-        let yk = x[k] * col[0];
-        x[k] = yk;
-        if k < body {
-            for (xi, l) in x[k + 1..k + w].iter_mut().zip(&col[1..]) {
-                *xi -= l * yk;
-            }
-        } else {
-            for (xi, l) in x[k + 1..].iter_mut().zip(&col[1..]) {
-                *xi -= l * yk;
-            }
+    for (k, col) in data.chunks_exact(w).take(n).enumerate() {
+        let (done, rest) = x.split_at_mut(k + 1);
+        let yk = done[k] * col[0];
+        done[k] = yk;
+        for (xi, l) in rest.iter_mut().zip(&col[1..]) {
+            *xi -= l * yk;
         }
     }
     // backward: Lᵀ x = y
     for k in (0..n).rev() {
         let col = &data[k * w..(k + 1) * w];
-        let s = if k < body {
-            dot(&col[1..], &x[k + 1..k + w])
-        } else {
-            dot(&col[1..n - k], &x[k + 1..])
-        };
-        x[k] = (x[k] - s) * col[0];
+        let (head, rest) = x.split_at_mut(k + 1);
+        let s = dot(&col[1..], rest);
+        head[k] = (head[k] - s) * col[0];
     }
 }
 
 /// Dot product of two equal-length slices with four independent partial sums.
 #[inline]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let len = a.len().min(b.len());
+    let (a, b) = (&a[..len], &b[..len]);
     let mut acc = [0.0; 4];
     let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
     let (ra, rb) = (ca.remainder(), cb.remainder());

@@ -223,32 +223,6 @@ impl FiniteFilm {
         -self.dtheta * self.row_width(j) * self.source[i]
     }
 
-    /// Calls `f(neighbour, conductance)` for each neighbour of node (i, j); the bearing edge is
-    /// passed as `None` (p = 0 there).
-    #[inline]
-    fn for_each_neighbour(
-        &self,
-        i: usize,
-        j: usize,
-        mut f: impl FnMut(Option<(usize, usize)>, f64),
-    ) {
-        let nt = self.grid.n_theta;
-        let west = if i == 0 { nt - 1 } else { i - 1 };
-        let east = if i + 1 == nt { 0 } else { i + 1 };
-        let w = self.row_width(j) / self.dtheta;
-        f(Some((west, j)), w * self.h3_face[west]);
-        f(Some((east, j)), w * self.h3_face[i]);
-        let cz = self.dtheta * self.h3_node[i] / self.dz;
-        if j + 1 < self.grid.n_z {
-            f(Some((i, j + 1)), cz);
-        } else {
-            f(None, cz);
-        }
-        if j > 0 {
-            f(Some((i, j - 1)), cz);
-        }
-    }
-
     /// Orders the free nodes so that the matrix is banded: columns from just after a column with
     /// no free node (bandwidth ≤ n_z), or folded around the ring if every column has one
     /// (bandwidth ≤ 2·n_z). Returns (unknowns, half-bandwidth).
@@ -272,17 +246,16 @@ impl FiniteFilm {
                 }
             }
         }
-        let mut b = 0;
+        // each coupled pair once: east neighbour (same row, next column) and north neighbour
+        // (same column, next row; always the next slot when both are free)
+        let mut b = 1;
         for r in 0..n {
             let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
-            self.for_each_neighbour(i, j, |nb, _| {
-                if let Some((a, c)) = nb {
-                    let s = self.slot[a * nz + c];
-                    if s != NOT_FREE {
-                        b = b.max((s as usize).abs_diff(r));
-                    }
-                }
-            });
+            let east = if i + 1 == nt { 0 } else { i + 1 };
+            let s = self.slot[east * nz + j];
+            if s != NOT_FREE {
+                b = b.max((s as usize).abs_diff(r));
+            }
         }
         (n, b)
     }
@@ -293,23 +266,36 @@ impl FiniteFilm {
         let (n, b) = self.order_free_nodes();
         let mut band = std::mem::replace(&mut self.band, BandMatrix::with_capacity(0, 0));
         band.reset(n, b);
+        let nt = self.grid.n_theta;
         for r in 0..n {
             let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
-            let mut diag = 0.0;
+            let k = i * nz + j;
+            let west = if i == 0 { nt - 1 } else { i - 1 };
+            let east = if i + 1 == nt { 0 } else { i + 1 };
+            let w = self.row_width(j) / self.dtheta;
+            let (c_west, c_east) = (w * self.h3_face[west], w * self.h3_face[i]);
+            let c_axial = self.dtheta * self.h3_node[i] / self.dz;
             let mut rhs = self.node_rhs(i, j);
-            self.for_each_neighbour(i, j, |nb, cond| {
-                diag += cond;
-                if let Some((a, c)) = nb {
-                    let s = self.slot[a * nz + c];
-                    if s != NOT_FREE {
-                        if (s as usize) < r {
-                            band.add(r, s as usize, -cond);
-                        }
-                    } else if self.groove_pi[a].is_finite() {
-                        rhs += cond * self.groove_pi[a];
+            // θ-neighbours: free (matrix entry), a supply groove (known pressure) or cavitated (0)
+            for (col, cond) in [(west, c_west), (east, c_east)] {
+                let s = self.slot[col * nz + j];
+                if s != NOT_FREE {
+                    if (s as usize) < r {
+                        band.add(r, s as usize, -cond);
                     }
+                } else if self.groove_pi[col].is_finite() {
+                    rhs += cond * self.groove_pi[col];
                 }
-            });
+            }
+            // the node below in the same column, if free, is the previous slot; the node above
+            // (or the edge, p = 0) comes later
+            let mut diag = c_west + c_east + c_axial;
+            if j > 0 {
+                diag += c_axial;
+                if self.slot[k - 1] != NOT_FREE {
+                    band.add(r, r - 1, -c_axial);
+                }
+            }
             band.add(r, r, diag);
             self.rhs[r] = rhs;
         }
@@ -337,14 +323,15 @@ impl FiniteFilm {
             let mut x = std::mem::take(&mut self.rhs);
             self.band.solve(&mut x[..n]);
             for i in 0..nt {
-                for j in 0..nz {
-                    let k = i * nz + j;
-                    self.pi[k] = match self.slot[k] {
-                        NOT_FREE if self.groove_pi[i].is_finite() => self.groove_pi[i],
-                        NOT_FREE => 0.0,
-                        s => x[s as usize],
-                    };
-                }
+                let value = if self.groove_pi[i].is_finite() {
+                    self.groove_pi[i]
+                } else {
+                    0.0
+                };
+                self.pi[i * nz..(i + 1) * nz].fill(value);
+            }
+            for (&(i, j), &p) in self.order[..n].iter().zip(&x[..n]) {
+                self.pi[i as usize * nz + j as usize] = p;
             }
             self.rhs = x;
             let changed = self.update_active_set();
@@ -379,18 +366,22 @@ impl FiniteFilm {
                     }
                 } else {
                     // multiplier λ = (A Π − b) at a node held at Π = 0
-                    let mut flow_in = 0.0;
-                    let mut size = 0.0;
-                    self.for_each_neighbour(i, j, |nb, cond| {
-                        if let Some((a, c)) = nb {
-                            let q = cond * self.pi[a * nz + c];
-                            flow_in += q;
-                            size += q.abs();
-                        }
-                    });
+                    let west = if i == 0 { nt - 1 } else { i - 1 };
+                    let east = if i + 1 == nt { 0 } else { i + 1 };
+                    let w = self.row_width(j) / self.dtheta;
+                    let c_axial = self.dtheta * self.h3_node[i] / self.dz;
+                    let mut flow_in = w
+                        * (self.h3_face[west] * self.pi[west * nz + j]
+                            + self.h3_face[i] * self.pi[east * nz + j]);
+                    if j + 1 < nz {
+                        flow_in += c_axial * self.pi[k + 1];
+                    }
+                    if j > 0 {
+                        flow_in += c_axial * self.pi[k - 1];
+                    }
                     let b = self.node_rhs(i, j);
                     let lambda = -flow_in - b;
-                    if lambda < -1e-12 * (size + b.abs()) {
+                    if lambda < -1e-12 * (flow_in.abs() + b.abs()) {
                         self.free[k] = true;
                         changed = true;
                     }

@@ -32,16 +32,11 @@ impl FiniteFilm {
     /// and its two neighbours around the circumference.
     fn peak_pressure(&self) -> (f64, f64) {
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
-        let (mut best, mut at) = (0.0, 0);
-        for (k, &p) in self.pi.iter().enumerate() {
-            if p > best {
-                best = p;
-                at = k;
-            }
-        }
+        let best = self.pi.iter().copied().fold(0.0, f64::max);
         if best <= 0.0 {
             return (0.0, 0.0);
         }
+        let at = self.pi.iter().position(|&p| p == best).unwrap_or(0);
         let (i, j) = (at / nz, at % nz);
         let pw = self.pi[((i + nt - 1) % nt) * nz + j];
         let pe = self.pi[((i + 1) % nt) * nz + j];
