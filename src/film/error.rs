@@ -30,6 +30,9 @@ pub enum FilmError {
         /// Iterations made.
         iterations: usize,
     },
+    /// The film matrix was not positive definite (film thickness not positive somewhere).
+    #[error("film matrix not positive definite: the film thickness is not positive everywhere")]
+    SingularFilm,
     /// The static equilibrium search did not converge.
     #[error("static equilibrium not found after {iterations} iterations (force residual {residual_n:.3e} N)")]
     EquilibriumNotFound {

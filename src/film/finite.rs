@@ -261,7 +261,7 @@ impl FiniteFilm {
     }
 
     /// Assembles A and b on the free nodes and factors A. Returns the number of unknowns.
-    fn assemble_and_factor(&mut self) -> usize {
+    fn assemble_and_factor(&mut self) -> Result<usize, FilmError> {
         let nz = self.grid.n_z;
         let (n, b) = self.order_free_nodes();
         let mut band = std::mem::replace(&mut self.band, BandMatrix::with_capacity(0, 0));
@@ -299,14 +299,18 @@ impl FiniteFilm {
             band.add(r, r, diag);
             self.rhs[r] = rhs;
         }
+        // an M-matrix with a Dirichlet edge is positive definite; a failed pivot means the film
+        // thickness was not positive somewhere (the journal state was not checked)
         let ok = band.factor();
-        debug_assert!(
-            ok,
-            "film matrix is an M-matrix with a Dirichlet edge: always SPD"
-        );
         self.band = band;
         self.n_free = n;
-        n
+        if ok {
+            Ok(n)
+        } else {
+            self.n_free = 0;
+            self.warm = false;
+            Err(FilmError::SingularFilm)
+        }
     }
 
     /// Solves the complementarity problem for the current film shape.
@@ -319,7 +323,7 @@ impl FiniteFilm {
             }
         }
         for pass in 1..=MAX_ACTIVE_SET_PASSES {
-            let n = self.assemble_and_factor();
+            let n = self.assemble_and_factor()?;
             let mut x = std::mem::take(&mut self.rhs);
             self.band.solve(&mut x[..n]);
             for i in 0..nt {
