@@ -6,4 +6,5 @@
 
 pub mod cli;
 pub mod film;
+pub mod rotor;
 pub mod units;

@@ -1,0 +1,516 @@
+//! The machine description: one YAML file describes one machine (config/*.yaml).
+//!
+//! Nodes are numbered from 0 at `z = 0` along the shaft; shaft sections are listed in order and
+//! each is split into `elements` equal Timoshenko elements. Field names carry their unit where it
+//! is not SI. Angles are measured from `+x` towards `+y`, the direction of rotation.
+
+use super::error::ConfigError;
+use crate::film::FilmGrid;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The built-in default machine: the seed's 100 kW ORC microturbine.
+pub const DEFAULT_MACHINE_YAML: &str = include_str!("../../config/orc_microturbine_100kw.yaml");
+/// File name reported for the built-in machine.
+pub const DEFAULT_MACHINE_NAME: &str = "config/orc_microturbine_100kw.yaml (built in)";
+
+/// One machine, as written in its YAML file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineDescription {
+    /// Short name.
+    pub name: String,
+    /// Free text: what the machine is and where its figures come from.
+    #[serde(default)]
+    pub description: String,
+    /// Rated speed (rpm).
+    pub rated_speed_rpm: f64,
+    /// Gravity `[g_x, g_y]` in the machine frame (m/s²); `[0, -9.81]` for y up.
+    #[serde(default = "default_gravity")]
+    pub gravity_m_s2: [f64; 2],
+    /// Materials by name.
+    pub materials: BTreeMap<String, MaterialSpec>,
+    /// Shaft sections from `z = 0`.
+    pub shaft: Vec<ShaftSection>,
+    /// Rigid discs.
+    #[serde(default)]
+    pub discs: Vec<DiscSpec>,
+    /// Bearings (each at a shaft node, with an optional flexible support).
+    pub bearings: Vec<BearingSpec>,
+    /// Unbalance planes.
+    #[serde(default)]
+    pub unbalance: Vec<UnbalanceSpec>,
+    /// Proximity-probe stations (pairs of probes) for comparing with measured orbits.
+    #[serde(default)]
+    pub probes: Vec<ProbeSpec>,
+}
+
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.81]
+}
+
+fn one() -> usize {
+    1
+}
+
+/// An isotropic material.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Young's modulus E (Pa).
+    pub youngs_modulus_pa: f64,
+    /// Poisson's ratio ν.
+    pub poisson_ratio: f64,
+    /// Density ρ (kg/m³).
+    pub density_kg_m3: f64,
+}
+
+/// A uniform length of shaft.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShaftSection {
+    /// Section length (m).
+    pub length_m: f64,
+    /// Outer diameter (m).
+    pub outer_diameter_m: f64,
+    /// Bore diameter (m), 0 for solid.
+    #[serde(default)]
+    pub inner_diameter_m: f64,
+    /// Name of a material in `materials`.
+    pub material: String,
+    /// Equal elements the section is split into.
+    #[serde(default = "one")]
+    pub elements: usize,
+}
+
+/// A rigid disc.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiscSpec {
+    /// Name for reports.
+    #[serde(default)]
+    pub name: String,
+    /// Shaft node.
+    pub node: usize,
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Polar moment of inertia (kg·m²).
+    pub polar_inertia_kg_m2: f64,
+    /// Diametral moment of inertia (kg·m²).
+    pub diametral_inertia_kg_m2: f64,
+}
+
+/// How a bearing is modelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BearingModelKind {
+    /// Fluid film, finite-length Reynolds equation.
+    Finite,
+    /// Fluid film, short-bearing (Ocvirk) closed form.
+    Short,
+    /// Constant stiffness and damping.
+    Linear,
+    /// Rigid: the journal cannot move (a pinned support).
+    Rigid,
+}
+
+/// Supply grooves of a film bearing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum GroovesSpec {
+    /// Plain 360° bearing.
+    #[default]
+    None,
+    /// Two axial grooves, 90° either side of the static load.
+    TwoAxial,
+}
+
+/// Lubricant properties.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LubricantSpec {
+    /// Density ρ (kg/m³).
+    pub density_kg_m3: f64,
+    /// Dynamic viscosity µ (Pa·s).
+    pub viscosity_pa_s: f64,
+}
+
+/// A bearing at a shaft node.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingSpec {
+    /// Name (also the ROS frame suffix later).
+    pub name: String,
+    /// Shaft node at the journal centre.
+    pub node: usize,
+    /// How it is modelled.
+    pub model: BearingModelKind,
+    /// Film bearings: journal diameter D (m).
+    #[serde(default)]
+    pub diameter_m: Option<f64>,
+    /// Film bearings: length L (m).
+    #[serde(default)]
+    pub length_m: Option<f64>,
+    /// Film bearings: radial clearance c (m).
+    #[serde(default)]
+    pub radial_clearance_m: Option<f64>,
+    /// Film bearings: lubricant.
+    #[serde(default)]
+    pub lubricant: Option<LubricantSpec>,
+    /// Film bearings: grid over the half bearing, `NTHxNZ` (default 60x10).
+    #[serde(default)]
+    pub grid: Option<String>,
+    /// Film bearings: supply grooves.
+    #[serde(default)]
+    pub grooves: GroovesSpec,
+    /// Linear bearings: `[[kxx, kxy], [kyx, kyy]]` (N/m).
+    #[serde(default)]
+    pub stiffness_n_per_m: Option<[[f64; 2]; 2]>,
+    /// Linear bearings: `[[cxx, cxy], [cyx, cyy]]` (N·s/m).
+    #[serde(default)]
+    pub damping_n_s_per_m: Option<[[f64; 2]; 2]>,
+    /// Flexible support under the bearing (the seed's C_mn, D_mn); rigid if absent.
+    #[serde(default)]
+    pub support: Option<SupportSpec>,
+}
+
+/// A pedestal: a mass on a spring–damper to the ground, carrying the bearing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// Pedestal mass (kg), greater than zero.
+    pub mass_kg: f64,
+    /// `[[kxx, kxy], [kyx, kyy]]` to the ground (N/m).
+    pub stiffness_n_per_m: [[f64; 2]; 2],
+    /// `[[cxx, cxy], [cyx, cyy]]` to the ground (N·s/m).
+    #[serde(default)]
+    pub damping_n_s_per_m: [[f64; 2]; 2],
+}
+
+/// A residual unbalance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnbalanceSpec {
+    /// Shaft node of the unbalance plane.
+    pub node: usize,
+    /// Unbalance m·e (g·mm).
+    pub magnitude_g_mm: f64,
+    /// Angle of the heavy spot at t = 0, from `+x` towards `+y` (deg).
+    #[serde(default)]
+    pub phase_deg: f64,
+}
+
+/// A probe station: two proximity probes looking at the shaft at one node.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    /// Station name.
+    pub name: String,
+    /// Shaft node.
+    pub node: usize,
+    /// Mounting angles of the two probes, from `+x` towards `+y` (deg).
+    pub angles_deg: [f64; 2],
+}
+
+impl MachineDescription {
+    /// Reads and checks a machine file.
+    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
+            file: file.clone(),
+            field: "(file)".into(),
+            value: String::new(),
+            rule: format!("cannot be read: {e}"),
+        })?;
+        Self::from_yaml(&text, &file)
+    }
+
+    /// The built-in default machine.
+    pub fn builtin_default() -> Self {
+        Self::from_yaml(DEFAULT_MACHINE_YAML, DEFAULT_MACHINE_NAME)
+            .expect("the built-in machine description is valid (checked by a test)")
+    }
+
+    /// Parses and checks YAML text; `file` names it in errors.
+    pub fn from_yaml(text: &str, file: &str) -> Result<Self, ConfigError> {
+        let de = serde_yaml_ng::Deserializer::from_str(text);
+        let desc: Self = serde_path_to_error::deserialize(de).map_err(|e| {
+            let field = e.path().to_string();
+            let inner = e.into_inner();
+            ConfigError {
+                file: file.to_string(),
+                field: if field == "." {
+                    "(document)".into()
+                } else {
+                    field
+                },
+                value: String::new(),
+                rule: inner.to_string(),
+            }
+        })?;
+        desc.validate(file)?;
+        Ok(desc)
+    }
+
+    /// Number of shaft nodes.
+    pub fn node_count(&self) -> usize {
+        self.shaft.iter().map(|s| s.elements).sum::<usize>() + 1
+    }
+
+    /// Checks every field against its rule; the first broken rule is reported.
+    pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        let err = |field: String, value: String, rule: &str| ConfigError {
+            file: file.to_string(),
+            field,
+            value,
+            rule: rule.to_string(),
+        };
+        let positive = |field: String, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(err(
+                    field,
+                    v.to_string(),
+                    "must be a finite number greater than zero",
+                ))
+            }
+        };
+        let non_negative = |field: String, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(err(
+                    field,
+                    v.to_string(),
+                    "must be a finite number, zero or more",
+                ))
+            }
+        };
+        positive("rated_speed_rpm".into(), self.rated_speed_rpm)?;
+        for (i, g) in self.gravity_m_s2.iter().enumerate() {
+            if !g.is_finite() || g.abs() > 100.0 {
+                return Err(err(
+                    format!("gravity_m_s2[{i}]"),
+                    g.to_string(),
+                    "must be finite and at most 100 m/s² in size",
+                ));
+            }
+        }
+        for (name, m) in &self.materials {
+            positive(
+                format!("materials.{name}.youngs_modulus_pa"),
+                m.youngs_modulus_pa,
+            )?;
+            positive(format!("materials.{name}.density_kg_m3"), m.density_kg_m3)?;
+            if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+                return Err(err(
+                    format!("materials.{name}.poisson_ratio"),
+                    m.poisson_ratio.to_string(),
+                    "must lie between -1 and 0.5",
+                ));
+            }
+        }
+        if self.shaft.is_empty() {
+            return Err(err(
+                "shaft".into(),
+                "[]".into(),
+                "needs at least one section",
+            ));
+        }
+        for (i, s) in self.shaft.iter().enumerate() {
+            positive(format!("shaft[{i}].length_m"), s.length_m)?;
+            positive(format!("shaft[{i}].outer_diameter_m"), s.outer_diameter_m)?;
+            non_negative(format!("shaft[{i}].inner_diameter_m"), s.inner_diameter_m)?;
+            if s.inner_diameter_m >= s.outer_diameter_m {
+                return Err(err(
+                    format!("shaft[{i}].inner_diameter_m"),
+                    s.inner_diameter_m.to_string(),
+                    "must be smaller than outer_diameter_m",
+                ));
+            }
+            if !self.materials.contains_key(&s.material) {
+                return Err(err(
+                    format!("shaft[{i}].material"),
+                    s.material.clone(),
+                    "must name an entry of materials",
+                ));
+            }
+            if !(1..=200).contains(&s.elements) {
+                return Err(err(
+                    format!("shaft[{i}].elements"),
+                    s.elements.to_string(),
+                    "must be between 1 and 200",
+                ));
+            }
+        }
+        let nodes = self.node_count();
+        let node_ok = |field: String, node: usize| {
+            if node < nodes {
+                Ok(())
+            } else {
+                Err(err(
+                    field,
+                    node.to_string(),
+                    &format!("must be a shaft node, 0 to {}", nodes - 1),
+                ))
+            }
+        };
+        for (i, d) in self.discs.iter().enumerate() {
+            node_ok(format!("discs[{i}].node"), d.node)?;
+            positive(format!("discs[{i}].mass_kg"), d.mass_kg)?;
+            non_negative(
+                format!("discs[{i}].polar_inertia_kg_m2"),
+                d.polar_inertia_kg_m2,
+            )?;
+            non_negative(
+                format!("discs[{i}].diametral_inertia_kg_m2"),
+                d.diametral_inertia_kg_m2,
+            )?;
+        }
+        if self.bearings.is_empty() {
+            return Err(err(
+                "bearings".into(),
+                "[]".into(),
+                "needs at least one bearing",
+            ));
+        }
+        for (i, b) in self.bearings.iter().enumerate() {
+            let f = |name: &str| format!("bearings[{i}].{name}");
+            node_ok(f("node"), b.node)?;
+            if self.bearings[..i].iter().any(|o| o.name == b.name) {
+                return Err(err(f("name"), b.name.clone(), "must be unique"));
+            }
+            match b.model {
+                BearingModelKind::Finite | BearingModelKind::Short => {
+                    for (name, v) in [
+                        ("diameter_m", b.diameter_m),
+                        ("length_m", b.length_m),
+                        ("radial_clearance_m", b.radial_clearance_m),
+                    ] {
+                        match v {
+                            Some(v) => positive(f(name), v)?,
+                            None => {
+                                return Err(err(
+                                    f(name),
+                                    "(missing)".into(),
+                                    "is required for a film bearing",
+                                ))
+                            }
+                        }
+                    }
+                    let Some(lub) = b.lubricant else {
+                        return Err(err(
+                            f("lubricant"),
+                            "(missing)".into(),
+                            "is required for a film bearing",
+                        ));
+                    };
+                    positive(f("lubricant.density_kg_m3"), lub.density_kg_m3)?;
+                    positive(f("lubricant.viscosity_pa_s"), lub.viscosity_pa_s)?;
+                    if let Some(g) = &b.grid {
+                        FilmGrid::parse(g).map_err(|e| err(f("grid"), g.clone(), &e))?;
+                    }
+                    if b.model == BearingModelKind::Short && b.grooves != GroovesSpec::None {
+                        return Err(err(
+                            f("grooves"),
+                            "two-axial".into(),
+                            "the short-bearing model has no grooves",
+                        ));
+                    }
+                    let (dm, cm) = (
+                        b.diameter_m.unwrap_or(0.0),
+                        b.radial_clearance_m.unwrap_or(0.0),
+                    );
+                    if cm > 0.025 * dm {
+                        return Err(err(
+                            f("radial_clearance_m"),
+                            cm.to_string(),
+                            "must be below 5 % of the journal radius",
+                        ));
+                    }
+                }
+                BearingModelKind::Linear => {
+                    let Some(k) = b.stiffness_n_per_m else {
+                        return Err(err(
+                            f("stiffness_n_per_m"),
+                            "(missing)".into(),
+                            "is required for a linear bearing",
+                        ));
+                    };
+                    finite_matrix(&f("stiffness_n_per_m"), &k)
+                        .map_err(|(fld, v)| err(fld, v, "must be finite"))?;
+                    if let Some(c) = b.damping_n_s_per_m {
+                        finite_matrix(&f("damping_n_s_per_m"), &c)
+                            .map_err(|(fld, v)| err(fld, v, "must be finite"))?;
+                    }
+                }
+                BearingModelKind::Rigid => {
+                    if b.support.is_some() {
+                        return Err(err(
+                            f("support"),
+                            "(given)".into(),
+                            "a rigid bearing has no flexible support",
+                        ));
+                    }
+                }
+            }
+            if let Some(s) = &b.support {
+                positive(f("support.mass_kg"), s.mass_kg)?;
+                finite_matrix(&f("support.stiffness_n_per_m"), &s.stiffness_n_per_m)
+                    .map_err(|(fld, v)| err(fld, v, "must be finite"))?;
+                finite_matrix(&f("support.damping_n_s_per_m"), &s.damping_n_s_per_m)
+                    .map_err(|(fld, v)| err(fld, v, "must be finite"))?;
+            }
+        }
+        for (i, u) in self.unbalance.iter().enumerate() {
+            node_ok(format!("unbalance[{i}].node"), u.node)?;
+            non_negative(format!("unbalance[{i}].magnitude_g_mm"), u.magnitude_g_mm)?;
+            if u.magnitude_g_mm > 1e6 {
+                return Err(err(
+                    format!("unbalance[{i}].magnitude_g_mm"),
+                    u.magnitude_g_mm.to_string(),
+                    "is absurd (more than 1 kg·m)",
+                ));
+            }
+            if !u.phase_deg.is_finite() {
+                return Err(err(
+                    format!("unbalance[{i}].phase_deg"),
+                    u.phase_deg.to_string(),
+                    "must be finite",
+                ));
+            }
+        }
+        for (i, p) in self.probes.iter().enumerate() {
+            node_ok(format!("probes[{i}].node"), p.node)?;
+            if p.angles_deg.iter().any(|a| !a.is_finite()) {
+                return Err(err(
+                    format!("probes[{i}].angles_deg"),
+                    format!("{:?}", p.angles_deg),
+                    "must be finite",
+                ));
+            }
+            let gap = (p.angles_deg[1] - p.angles_deg[0]).to_radians().sin().abs();
+            if gap < 0.1 {
+                return Err(err(
+                    format!("probes[{i}].angles_deg"),
+                    format!("{:?}", p.angles_deg),
+                    "the two probes must not look along the same line",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn finite_matrix(field: &str, m: &[[f64; 2]; 2]) -> Result<(), (String, String)> {
+    for (i, row) in m.iter().enumerate() {
+        for (j, v) in row.iter().enumerate() {
+            if !v.is_finite() {
+                return Err((format!("{field}[{i}][{j}]"), v.to_string()));
+            }
+        }
+    }
+    Ok(())
+}

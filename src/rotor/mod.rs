@@ -1,0 +1,339 @@
+//! The rotor: Timoshenko finite-element model of the shaft (4 DOF a node: x, y, θx, θy), rigid
+//! discs, bearings and their supports, assembled into global M, K, G and C (seed §"Model").
+//!
+//! Global DOFs: node n holds `4n … 4n+3` = (x, y, θx, θy); each flexible pedestal adds two DOFs
+//! (x, y) after the shaft's. The equations of motion are M q̈ + (C + Ω G) q̇ + K q = F plus the
+//! bearing forces between each journal and its pedestal (or the ground).
+
+mod element;
+mod error;
+mod forces;
+mod machine;
+mod modal;
+mod statics;
+
+pub use element::{Disc, ElementMatrix, Material, ShaftElement};
+pub use error::{ConfigError, RotorError};
+pub use machine::{
+    BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec, MachineDescription,
+    MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec, DEFAULT_MACHINE_NAME,
+    DEFAULT_MACHINE_YAML,
+};
+pub use modal::{
+    campbell, critical_speeds_rpm, damped_modes, stability_threshold, undamped_frequencies_hz,
+    BearingCoefficientSet, CampbellPoint, Constraint, Mode, Threshold, WhirlDirection,
+};
+pub use statics::{static_solution, StaticSolution};
+
+use crate::film::{
+    BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FiniteFilm, Lubricant, ShortFilm,
+};
+use crate::units::rpm_to_rad_s;
+use faer::Mat;
+
+/// How a bearing acts on its journal.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BearingModel {
+    /// A fluid film (finite-length Reynolds or short bearing).
+    Film(FilmBearing),
+    /// Constant coefficients.
+    Linear(FilmCoefficients),
+    /// A rigid, pinned support.
+    Rigid,
+}
+
+/// A fluid-film bearing's data, from which film solvers are built.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilmBearing {
+    /// Geometry.
+    pub geometry: BearingGeometry,
+    /// Lubricant.
+    pub lubricant: Lubricant,
+    /// Finite-volume grid (finite model).
+    pub grid: FilmGrid,
+    /// Short-bearing closed form instead of the finite solver.
+    pub short: bool,
+}
+
+impl FilmBearing {
+    /// A film solver for this bearing (each user owns one: it carries the warm start).
+    pub fn solver(&self) -> Box<dyn FilmModel + Send> {
+        if self.short {
+            Box::new(
+                ShortFilm::new(self.geometry.clone(), self.lubricant)
+                    .expect("geometry checked when the machine was read"),
+            )
+        } else {
+            Box::new(
+                FiniteFilm::new(self.geometry.clone(), self.lubricant, self.grid)
+                    .expect("geometry checked when the machine was read"),
+            )
+        }
+    }
+}
+
+/// A bearing at a shaft node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BearingSite {
+    /// Name.
+    pub name: String,
+    /// Shaft node of the journal.
+    pub node: usize,
+    /// Global DOFs of the journal centre (x, y).
+    pub journal_dofs: [usize; 2],
+    /// Global DOFs of the pedestal (x, y), if the support is flexible.
+    pub pedestal_dofs: Option<[usize; 2]>,
+    /// How the bearing acts.
+    pub model: BearingModel,
+}
+
+/// A residual unbalance m·e at a node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unbalance {
+    /// Shaft node.
+    pub node: usize,
+    /// m·e (kg·m).
+    pub magnitude_kg_m: f64,
+    /// Angle of the heavy spot at rotor angle 0, from +x towards +y (rad).
+    pub phase_rad: f64,
+}
+
+/// A probe station: two probes at a node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProbeStation {
+    /// Name.
+    pub name: String,
+    /// Shaft node.
+    pub node: usize,
+    /// Probe mounting angles from +x towards +y (rad).
+    pub angles_rad: [f64; 2],
+}
+
+/// The assembled rotor model.
+#[derive(Debug, Clone)]
+pub struct Rotor {
+    /// Machine name.
+    pub name: String,
+    /// Axial position of each shaft node (m).
+    pub node_z_m: Vec<f64>,
+    /// Shaft elements; element e joins nodes e and e+1.
+    pub elements: Vec<ShaftElement>,
+    /// Rigid discs.
+    pub discs: Vec<Disc>,
+    /// Bearings.
+    pub bearings: Vec<BearingSite>,
+    /// Unbalances.
+    pub unbalance: Vec<Unbalance>,
+    /// Probe stations.
+    pub probes: Vec<ProbeStation>,
+    /// Gravity (m/s²) in the machine frame.
+    pub gravity_m_s2: [f64; 2],
+    /// Rated speed (rad/s).
+    pub rated_speed_rad_s: f64,
+    /// Global mass matrix (kg, kg·m²).
+    pub mass: Mat<f64>,
+    /// Global stiffness: shaft plus support springs (N/m, N·m/rad).
+    pub stiffness: Mat<f64>,
+    /// Global gyroscopic matrix per unit spin (multiplied by Ω in the equations).
+    pub gyroscopic: Mat<f64>,
+    /// Global constant damping: support dampers (N·s/m).
+    pub damping: Mat<f64>,
+}
+
+impl Rotor {
+    /// Assembles the rotor of a (checked) machine description.
+    pub fn from_description(desc: &MachineDescription) -> Self {
+        let materials = |name: &str| {
+            let m = &desc.materials[name];
+            Material::from_poisson(m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3)
+        };
+        let mut elements = Vec::new();
+        let mut node_z_m = vec![0.0];
+        for s in &desc.shaft {
+            let l = s.length_m / s.elements as f64;
+            for _ in 0..s.elements {
+                elements.push(ShaftElement {
+                    length_m: l,
+                    outer_diameter_m: s.outer_diameter_m,
+                    inner_diameter_m: s.inner_diameter_m,
+                    material: materials(&s.material),
+                });
+                node_z_m.push(node_z_m.last().copied().unwrap_or(0.0) + l);
+            }
+        }
+        let nodes = node_z_m.len();
+        let pedestals = desc.bearings.iter().filter(|b| b.support.is_some()).count();
+        let n_dof = 4 * nodes + 2 * pedestals;
+        let mut next_pedestal = 4 * nodes;
+        let bearings: Vec<BearingSite> = desc
+            .bearings
+            .iter()
+            .map(|b| {
+                let pedestal_dofs = b.support.as_ref().map(|_| {
+                    let d = [next_pedestal, next_pedestal + 1];
+                    next_pedestal += 2;
+                    d
+                });
+                BearingSite {
+                    name: b.name.clone(),
+                    node: b.node,
+                    journal_dofs: [4 * b.node, 4 * b.node + 1],
+                    pedestal_dofs,
+                    model: bearing_model(b),
+                }
+            })
+            .collect();
+        let discs: Vec<Disc> = desc
+            .discs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| Disc {
+                name: if d.name.is_empty() {
+                    format!("disc {i}")
+                } else {
+                    d.name.clone()
+                },
+                node: d.node,
+                mass_kg: d.mass_kg,
+                polar_inertia_kg_m2: d.polar_inertia_kg_m2,
+                diametral_inertia_kg_m2: d.diametral_inertia_kg_m2,
+            })
+            .collect();
+
+        let mut mass = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut stiffness = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut gyroscopic = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut damping = Mat::<f64>::zeros(n_dof, n_dof);
+        for (e, el) in elements.iter().enumerate() {
+            let at = 4 * e;
+            add_block(&mut stiffness, at, &el.stiffness());
+            add_block(&mut mass, at, &el.mass());
+            add_block(&mut gyroscopic, at, &el.gyroscopic());
+        }
+        for d in &discs {
+            add_block(&mut mass, 4 * d.node, &d.mass());
+            add_block(&mut gyroscopic, 4 * d.node, &d.gyroscopic());
+        }
+        for (b, spec) in bearings.iter().zip(&desc.bearings) {
+            if let (Some(p), Some(s)) = (b.pedestal_dofs, &spec.support) {
+                for i in 0..2 {
+                    mass[(p[i], p[i])] += s.mass_kg;
+                    for j in 0..2 {
+                        stiffness[(p[i], p[j])] += s.stiffness_n_per_m[i][j];
+                        damping[(p[i], p[j])] += s.damping_n_s_per_m[i][j];
+                    }
+                }
+            }
+        }
+        Rotor {
+            name: desc.name.clone(),
+            unbalance: desc
+                .unbalance
+                .iter()
+                .map(|u| Unbalance {
+                    node: u.node,
+                    magnitude_kg_m: u.magnitude_g_mm * 1e-6,
+                    phase_rad: u.phase_deg.to_radians(),
+                })
+                .collect(),
+            probes: desc
+                .probes
+                .iter()
+                .map(|p| ProbeStation {
+                    name: p.name.clone(),
+                    node: p.node,
+                    angles_rad: p.angles_deg.map(f64::to_radians),
+                })
+                .collect(),
+            gravity_m_s2: desc.gravity_m_s2,
+            rated_speed_rad_s: rpm_to_rad_s(desc.rated_speed_rpm),
+            node_z_m,
+            elements,
+            discs,
+            bearings,
+            mass,
+            stiffness,
+            gyroscopic,
+            damping,
+        }
+    }
+
+    /// Number of global DOFs.
+    pub fn n_dof(&self) -> usize {
+        self.mass.nrows()
+    }
+
+    /// Number of shaft nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.node_z_m.len()
+    }
+
+    /// Mass of the rotor: shaft elements and discs (kg); pedestals excluded.
+    pub fn rotor_mass_kg(&self) -> f64 {
+        self.elements.iter().map(|e| e.mass_kg()).sum::<f64>()
+            + self.discs.iter().map(|d| d.mass_kg).sum::<f64>()
+    }
+
+    /// Axial position of the rotor's centre of mass (m).
+    pub fn centre_of_mass_z_m(&self) -> f64 {
+        let mut m = 0.0;
+        let mut mz = 0.0;
+        for (e, el) in self.elements.iter().enumerate() {
+            let zc = 0.5 * (self.node_z_m[e] + self.node_z_m[e + 1]);
+            m += el.mass_kg();
+            mz += el.mass_kg() * zc;
+        }
+        for d in &self.discs {
+            m += d.mass_kg;
+            mz += d.mass_kg * self.node_z_m[d.node];
+        }
+        mz / m
+    }
+}
+
+fn bearing_model(b: &BearingSpec) -> BearingModel {
+    match b.model {
+        BearingModelKind::Finite | BearingModelKind::Short => {
+            let (d, l, c) = (
+                b.diameter_m.unwrap_or_default(),
+                b.length_m.unwrap_or_default(),
+                b.radial_clearance_m.unwrap_or_default(),
+            );
+            let geometry = match b.grooves {
+                GroovesSpec::None => BearingGeometry::plain(d, l, c),
+                GroovesSpec::TwoAxial => {
+                    BearingGeometry::two_axial_grooves(d, l, c, 20f64.to_radians(), 0.0)
+                }
+            }
+            .expect("checked by MachineDescription::validate");
+            let lub = b
+                .lubricant
+                .expect("checked by MachineDescription::validate");
+            BearingModel::Film(FilmBearing {
+                geometry,
+                lubricant: Lubricant::new(lub.density_kg_m3, lub.viscosity_pa_s)
+                    .expect("checked by MachineDescription::validate"),
+                grid: b
+                    .grid
+                    .as_deref()
+                    .map(|g| FilmGrid::parse(g).expect("checked by MachineDescription::validate"))
+                    .unwrap_or_default(),
+                short: b.model == BearingModelKind::Short,
+            })
+        }
+        BearingModelKind::Linear => BearingModel::Linear(FilmCoefficients {
+            stiffness_n_per_m: b.stiffness_n_per_m.unwrap_or_default(),
+            damping_n_s_per_m: b.damping_n_s_per_m.unwrap_or_default(),
+        }),
+        BearingModelKind::Rigid => BearingModel::Rigid,
+    }
+}
+
+/// Adds an N × N block at (at, at).
+fn add_block<const N: usize>(m: &mut Mat<f64>, at: usize, block: &[[f64; N]; N]) {
+    for (i, row) in block.iter().enumerate() {
+        for (j, v) in row.iter().enumerate() {
+            m[(at + i, at + j)] += v;
+        }
+    }
+}
