@@ -138,21 +138,12 @@ fn mesh_refinement_converges() {
 /// 1e-3 kg/m³, so its inertia is below 1e-7 of the disc's.
 #[test]
 fn disc_on_massless_shaft_whirls_as_the_gyroscopic_two_dof_rotor() {
+    // config/textbook_disc_midspan.yaml: d 30 mm, L 0.8 m, disc 20 kg, Ip 0.25, Id 0.15 kg·m²
     let (d, l): (f64, f64) = (0.03, 0.8);
     let (m, ip, id): (f64, f64, f64) = (20.0, 0.25, 0.15);
-    let yaml = format!(
-        r#"
-name: disc at midspan
-rated_speed_rpm: 3000
-materials: {{light: {{youngs_modulus_pa: {E}, poisson_ratio: {NU}, density_kg_m3: 1.0e-3}}}}
-shaft: [{{length_m: {l}, outer_diameter_m: {d}, material: light, elements: 8}}]
-discs: [{{node: 4, mass_kg: {m}, polar_inertia_kg_m2: {ip}, diametral_inertia_kg_m2: {id}}}]
-bearings:
-  - {{name: left, node: 0, model: rigid}}
-  - {{name: right, node: 8, model: rigid}}
-"#
-    );
-    let rotor = Rotor::from_description(&MachineDescription::from_yaml(&yaml, "test").unwrap());
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/textbook_disc_midspan.yaml");
+    let rotor = Rotor::from_description(&MachineDescription::from_file(&path).unwrap());
+    assert!((rotor.discs[0].mass_kg - m).abs() < 1e-12 && (rotor.elements[0].outer_diameter_m - d).abs() < 1e-12);
     let ei = E * PI * d.powi(4) / 64.0;
     let kga = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * E / (2.0 * (1.0 + NU)) * PI * d * d / 4.0;
     let k_translation = 1.0 / (l.powi(3) / (48.0 * ei) + l / (4.0 * kga));

@@ -1,0 +1,85 @@
+//! A malformed machine description gives an error naming the file, the field, the value and the
+//! rule it breaks; nothing panics.
+
+use rotor_twin::rotor::{ConfigError, MachineDescription, DEFAULT_MACHINE_YAML};
+
+fn error_of(yaml: &str) -> ConfigError {
+    MachineDescription::from_yaml(yaml, "machine.yaml").unwrap_err()
+}
+
+/// The built-in machine with one line replaced.
+fn with(from: &str, to: &str) -> String {
+    assert!(DEFAULT_MACHINE_YAML.contains(from), "fixture line not found: {from}");
+    DEFAULT_MACHINE_YAML.replacen(from, to, 1)
+}
+
+fn says(e: &ConfigError, field: &str, value: &str, rule: &str) {
+    let text = e.to_string();
+    assert!(text.starts_with("machine.yaml: "), "{text}");
+    assert!(text.contains(field), "'{text}' does not name field {field}");
+    assert!(text.contains(value), "'{text}' does not show value {value}");
+    assert!(text.contains(rule), "'{text}' does not state rule '{rule}'");
+}
+
+#[test]
+fn out_of_range_values_are_named_with_field_value_and_rule() {
+    says(
+        &error_of(&with("outer_diameter_m: 0.055", "outer_diameter_m: -0.055")),
+        "shaft[3].outer_diameter_m",
+        "-0.055",
+        "greater than zero",
+    );
+    says(
+        &error_of(&with("radial_clearance_m: 40.0e-6", "radial_clearance_m: 0.0")),
+        "bearings[0].radial_clearance_m",
+        "0",
+        "greater than zero",
+    );
+    says(
+        &error_of(&with("{node: 15, magnitude_g_mm: 140.0", "{node: 99, magnitude_g_mm: 140.0")),
+        "unbalance[0].node",
+        "99",
+        "must be a shaft node, 0 to 30",
+    );
+    says(
+        &error_of(&with("material: steel, elements: 22", "material: unobtainium, elements: 22")),
+        "shaft[3].material",
+        "unobtainium",
+        "must name an entry of materials",
+    );
+    says(
+        &error_of(&with("viscosity_pa_s: 0.0008}", "viscosity_pa_s: .nan}")),
+        "bearings[0].lubricant.viscosity_pa_s",
+        "NaN",
+        "finite",
+    );
+    says(
+        &error_of(&with("angles_deg: [45.0, 135.0]", "angles_deg: [45.0, 225.0]")),
+        "probes[0].angles_deg",
+        "225",
+        "same line",
+    );
+}
+
+#[test]
+fn structural_mistakes_are_named_by_their_path() {
+    // a misspelt field
+    let e = error_of(&with("rated_speed_rpm: 9000", "rated_speed_rmp: 9000"));
+    says(&e, "rated_speed_rmp", "", "unknown field");
+    // a word where a number belongs
+    let e = error_of(&with("mass_kg: 1.50", "mass_kg: heavy"));
+    says(&e, "discs[0].mass_kg", "", "invalid type");
+    // a film bearing without its clearance
+    let e = error_of(&with("    radial_clearance_m: 40.0e-6\n", ""));
+    says(&e, "bearings[0].radial_clearance_m", "(missing)", "required for a film bearing");
+    // not YAML at all
+    let e = error_of("{ this is: [not closed");
+    assert!(e.to_string().starts_with("machine.yaml: "), "{e}");
+}
+
+#[test]
+fn a_missing_file_is_named() {
+    let e = MachineDescription::from_file(std::path::Path::new("/nonexistent/machine.yaml")).unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("/nonexistent/machine.yaml") && text.contains("cannot be read"), "{text}");
+}
