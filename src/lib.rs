@@ -6,5 +6,6 @@
 
 pub mod cli;
 pub mod film;
+pub mod plot;
 pub mod rotor;
 pub mod units;

@@ -9,7 +9,10 @@ fn error_of(yaml: &str) -> ConfigError {
 
 /// The built-in machine with one line replaced.
 fn with(from: &str, to: &str) -> String {
-    assert!(DEFAULT_MACHINE_YAML.contains(from), "fixture line not found: {from}");
+    assert!(
+        DEFAULT_MACHINE_YAML.contains(from),
+        "fixture line not found: {from}"
+    );
     DEFAULT_MACHINE_YAML.replacen(from, to, 1)
 }
 
@@ -30,19 +33,28 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
         "greater than zero",
     );
     says(
-        &error_of(&with("radial_clearance_m: 40.0e-6", "radial_clearance_m: 0.0")),
+        &error_of(&with(
+            "radial_clearance_m: 40.0e-6",
+            "radial_clearance_m: 0.0",
+        )),
         "bearings[0].radial_clearance_m",
         "0",
         "greater than zero",
     );
     says(
-        &error_of(&with("{node: 15, magnitude_g_mm: 140.0", "{node: 99, magnitude_g_mm: 140.0")),
+        &error_of(&with(
+            "{node: 15, magnitude_g_mm: 140.0",
+            "{node: 99, magnitude_g_mm: 140.0",
+        )),
         "unbalance[0].node",
         "99",
         "must be a shaft node, 0 to 30",
     );
     says(
-        &error_of(&with("material: steel, elements: 22", "material: unobtainium, elements: 22")),
+        &error_of(&with(
+            "material: steel, elements: 22",
+            "material: unobtainium, elements: 22",
+        )),
         "shaft[3].material",
         "unobtainium",
         "must name an entry of materials",
@@ -54,7 +66,10 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
         "finite",
     );
     says(
-        &error_of(&with("angles_deg: [45.0, 135.0]", "angles_deg: [45.0, 225.0]")),
+        &error_of(&with(
+            "angles_deg: [45.0, 135.0]",
+            "angles_deg: [45.0, 225.0]",
+        )),
         "probes[0].angles_deg",
         "225",
         "same line",
@@ -71,7 +86,12 @@ fn structural_mistakes_are_named_by_their_path() {
     says(&e, "discs[0].mass_kg", "", "invalid type");
     // a film bearing without its clearance
     let e = error_of(&with("    radial_clearance_m: 40.0e-6\n", ""));
-    says(&e, "bearings[0].radial_clearance_m", "(missing)", "required for a film bearing");
+    says(
+        &e,
+        "bearings[0].radial_clearance_m",
+        "(missing)",
+        "required for a film bearing",
+    );
     // not YAML at all
     let e = error_of("{ this is: [not closed");
     assert!(e.to_string().starts_with("machine.yaml: "), "{e}");
@@ -79,7 +99,11 @@ fn structural_mistakes_are_named_by_their_path() {
 
 #[test]
 fn a_missing_file_is_named() {
-    let e = MachineDescription::from_file(std::path::Path::new("/nonexistent/machine.yaml")).unwrap_err();
+    let e = MachineDescription::from_file(std::path::Path::new("/nonexistent/machine.yaml"))
+        .unwrap_err();
     let text = e.to_string();
-    assert!(text.contains("/nonexistent/machine.yaml") && text.contains("cannot be read"), "{text}");
+    assert!(
+        text.contains("/nonexistent/machine.yaml") && text.contains("cannot be read"),
+        "{text}"
+    );
 }

@@ -2,7 +2,7 @@
 //! Lund's closed-form rigid-rotor criterion, and the shipped machine descriptions.
 
 use rotor_twin::rotor::{
-    static_solution, stability_threshold, MachineDescription, Rotor, DEFAULT_MACHINE_YAML,
+    stability_threshold, static_solution, MachineDescription, Rotor, DEFAULT_MACHINE_YAML,
 };
 use std::f64::consts::PI;
 
@@ -15,7 +15,10 @@ fn load(path: &str) -> Rotor {
 /// (Σ F_i z_i = m g z_cm): static equilibrium of the whole rotor, to round-off.
 #[test]
 fn bearing_reactions_balance_weight_and_moment() {
-    for path in ["config/orc_microturbine_100kw.yaml", "config/test_rig_three_support.yaml"] {
+    for path in [
+        "config/orc_microturbine_100kw.yaml",
+        "config/test_rig_three_support.yaml",
+    ] {
         let rotor = load(path);
         let st = static_solution(&rotor).unwrap();
         let w = rotor.rotor_mass_kg() * 9.81;
@@ -27,9 +30,16 @@ fn bearing_reactions_balance_weight_and_moment() {
             .map(|(b, f)| f[1] * rotor.node_z_m[b.node])
             .sum();
         // loads point down (−y): the journal presses on the bearing
-        assert!((sum + w).abs() < 1e-9 * w, "{path}: Σ loads {sum} vs weight {w}");
+        assert!(
+            (sum + w).abs() < 1e-9 * w,
+            "{path}: Σ loads {sum} vs weight {w}"
+        );
         let z_cm = rotor.centre_of_mass_z_m();
-        assert!((moment + w * z_cm).abs() < 1e-9 * w * z_cm, "{path}: moment {moment} vs {}", w * z_cm);
+        assert!(
+            (moment + w * z_cm).abs() < 1e-9 * w * z_cm,
+            "{path}: moment {moment} vs {}",
+            w * z_cm
+        );
         assert!(st.bearing_loads_n.iter().all(|f| f[0].abs() < 1e-9 * w));
     }
 }
@@ -39,11 +49,19 @@ fn bearing_reactions_balance_weight_and_moment() {
 #[test]
 fn microturbine_matches_the_published_figures() {
     let rotor = load("config/orc_microturbine_100kw.yaml");
-    assert!((rotor.rotor_mass_kg() - 56.0).abs() < 0.28, "mass {} kg", rotor.rotor_mass_kg());
+    assert!(
+        (rotor.rotor_mass_kg() - 56.0).abs() < 0.28,
+        "mass {} kg",
+        rotor.rotor_mass_kg()
+    );
     assert_eq!(rotor.elements.len(), 30);
     let length = rotor.node_z_m.last().unwrap();
     assert!((length - 1.020).abs() < 1e-6, "length {length}");
-    let zb: Vec<f64> = rotor.bearings.iter().map(|b| rotor.node_z_m[b.node]).collect();
+    let zb: Vec<f64> = rotor
+        .bearings
+        .iter()
+        .map(|b| rotor.node_z_m[b.node])
+        .collect();
     assert!((zb[1] - zb[0] - 0.800).abs() < 1e-6);
     let stages = rotor.discs.iter().filter(|d| {
         let z = rotor.node_z_m[d.node];
@@ -53,7 +71,8 @@ fn microturbine_matches_the_published_figures() {
     assert!((rotor.rated_speed_rad_s - 9000.0 * PI / 30.0).abs() < 1e-9);
     let builtin = MachineDescription::builtin_default();
     let file = MachineDescription::from_file(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/orc_microturbine_100kw.yaml"),
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("config/orc_microturbine_100kw.yaml"),
     )
     .unwrap();
     assert_eq!(builtin, file);
@@ -80,7 +99,10 @@ fn short_kb(e: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
     let bxy = 8.0 * h0 * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e);
     let b = [
         [2.0 * PI * h0 * (pi2 * q * q + 48.0 * e * e) / (e * s), bxy],
-        [bxy, 2.0 * PI * h0 * s * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e) / e],
+        [
+            bxy,
+            2.0 * PI * h0 * s * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e) / e,
+        ],
     ];
     (k, b)
 }
@@ -109,7 +131,9 @@ bearings:
     );
     let rotor = Rotor::from_description(&MachineDescription::from_yaml(&yaml, "test").unwrap());
     let st = static_solution(&rotor).unwrap();
-    let th = stability_threshold(&rotor, &st, 500.0, 60000.0, 500.0).unwrap().expect("a threshold");
+    let th = stability_threshold(&rotor, &st, 500.0, 60000.0, 500.0)
+        .unwrap()
+        .expect("a threshold");
 
     // closed form
     let m_b = 0.5 * rotor.rotor_mass_kg();
@@ -117,26 +141,41 @@ bearings:
     let margin = |omega: f64| {
         let s = mu * omega / (2.0 * PI) * lb * d / w * (0.5 * d / c).powi(2);
         let t = s * (lb / d).powi(2);
-        let f = |e: f64| (1.0 - e * e).powi(2) / (PI * e * (16.0 * e * e + PI * PI * (1.0 - e * e)).sqrt());
+        let f = |e: f64| {
+            (1.0 - e * e).powi(2) / (PI * e * (16.0 * e * e + PI * PI * (1.0 - e * e)).sqrt())
+        };
         let (mut lo, mut hi) = (1e-6, 0.999);
         for _ in 0..100 {
             let mid = 0.5 * (lo + hi);
-            if f(mid) > t { lo = mid } else { hi = mid }
+            if f(mid) > t {
+                lo = mid
+            } else {
+                hi = mid
+            }
         }
         let (k, b) = short_kb(0.5 * (lo + hi));
-        let k_eq = (k[0][0] * b[1][1] + k[1][1] * b[0][0] - k[0][1] * b[1][0] - k[1][0] * b[0][1]) / (b[0][0] + b[1][1]);
-        let g2 = ((k[0][0] - k_eq) * (k[1][1] - k_eq) - k[0][1] * k[1][0]) / (b[0][0] * b[1][1] - b[0][1] * b[1][0]);
+        let k_eq = (k[0][0] * b[1][1] + k[1][1] * b[0][0] - k[0][1] * b[1][0] - k[1][0] * b[0][1])
+            / (b[0][0] + b[1][1]);
+        let g2 = ((k[0][0] - k_eq) * (k[1][1] - k_eq) - k[0][1] * k[1][0])
+            / (b[0][0] * b[1][1] - b[0][1] * b[1][0]);
         (m_b * c * omega * omega / w - k_eq / g2, g2.sqrt())
     };
     let (mut lo, mut hi) = (500.0 * PI / 30.0, 60000.0 * PI / 30.0);
     assert!(margin(lo).0 < 0.0 && margin(hi).0 > 0.0);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if margin(mid).0 < 0.0 { lo = mid } else { hi = mid }
+        if margin(mid).0 < 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     let lund_rpm = lo * 30.0 / PI;
     let gamma = margin(lo).1;
-    println!("threshold: eigenvalues {:.1} rpm (whirl ratio {:.4}), Lund {:.1} rpm (γ {:.4})", th.speed_rpm, th.whirl_ratio, lund_rpm, gamma);
+    println!(
+        "threshold: eigenvalues {:.1} rpm (whirl ratio {:.4}), Lund {:.1} rpm (γ {:.4})",
+        th.speed_rpm, th.whirl_ratio, lund_rpm, gamma
+    );
     assert!((th.speed_rpm - lund_rpm).abs() < 0.01 * lund_rpm);
     assert!((th.whirl_ratio - gamma).abs() < 0.01 * gamma);
 }

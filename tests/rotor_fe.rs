@@ -141,9 +141,13 @@ fn disc_on_massless_shaft_whirls_as_the_gyroscopic_two_dof_rotor() {
     // config/textbook_disc_midspan.yaml: d 30 mm, L 0.8 m, disc 20 kg, Ip 0.25, Id 0.15 kg·m²
     let (d, l): (f64, f64) = (0.03, 0.8);
     let (m, ip, id): (f64, f64, f64) = (20.0, 0.25, 0.15);
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/textbook_disc_midspan.yaml");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/textbook_disc_midspan.yaml");
     let rotor = Rotor::from_description(&MachineDescription::from_file(&path).unwrap());
-    assert!((rotor.discs[0].mass_kg - m).abs() < 1e-12 && (rotor.elements[0].outer_diameter_m - d).abs() < 1e-12);
+    assert!(
+        (rotor.discs[0].mass_kg - m).abs() < 1e-12
+            && (rotor.elements[0].outer_diameter_m - d).abs() < 1e-12
+    );
     let ei = E * PI * d.powi(4) / 64.0;
     let kga = 6.0 * (1.0 + NU) / (7.0 + 6.0 * NU) * E / (2.0 * (1.0 + NU)) * PI * d * d / 4.0;
     let k_translation = 1.0 / (l.powi(3) / (48.0 * ei) + l / (4.0 * kga));

@@ -2,6 +2,7 @@
 
 mod bearing;
 mod bench;
+mod modes;
 
 use clap::{Parser, Subcommand};
 
@@ -17,6 +18,8 @@ pub struct Cli {
 enum Command {
     /// Static analysis of one journal bearing: equilibrium, film, eight coefficients.
     Bearing(bearing::BearingArgs),
+    /// Linear rotordynamics: natural frequencies, Campbell diagram, stability threshold.
+    Modes(modes::ModesArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
 }
@@ -25,6 +28,7 @@ enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bearing(args)) => bearing::run(&args),
+        Some(Command::Modes(args)) => modes::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         None => bearing::run(&bearing::BearingArgs::default_bearing()),
     }

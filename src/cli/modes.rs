@@ -1,0 +1,197 @@
+//! `rotor-twin modes`: natural frequencies, static loads, Campbell diagram, stability threshold.
+
+use crate::rotor::{
+    campbell, critical_speeds_rpm, stability_threshold, static_solution, undamped_frequencies_hz,
+    CampbellPoint, Constraint, MachineDescription, Rotor,
+};
+use crate::units::rad_s_to_rpm;
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Linear rotordynamics of a machine: modes, Campbell diagram, threshold of stability.
+#[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
+pub struct ModesArgs {
+    /// Machine description (YAML); the built-in ORC microturbine if absent.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Lowest speed of the Campbell diagram (rpm); default 10 % of rated.
+    #[arg(long)]
+    from_rpm: Option<f64>,
+    /// Highest speed (rpm); default 150 % of rated.
+    #[arg(long)]
+    to_rpm: Option<f64>,
+    /// Speed step (rpm); default 1/40 of the range.
+    #[arg(long)]
+    step_rpm: Option<f64>,
+    /// Modes listed per speed.
+    #[arg(long, default_value_t = 6)]
+    modes: usize,
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Write the Campbell diagram to this SVG file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// The `--json` report.
+#[derive(Debug, Serialize)]
+struct ModesReport {
+    machine: String,
+    rotor_mass_kg: f64,
+    nodes: usize,
+    elements: usize,
+    rated_speed_rpm: f64,
+    bearing_names: Vec<String>,
+    /// Static load on each bearing, force of the journal on it, [F_x, F_y] (N).
+    bearing_loads_n: Vec<[f64; 2]>,
+    static_max_deflection_m: f64,
+    free_free_hz: Vec<f64>,
+    pinned_hz: Vec<f64>,
+    critical_speeds_rpm: Vec<f64>,
+    threshold_speed_rpm: Option<f64>,
+    whirl_ratio_at_threshold: Option<f64>,
+    threshold_frequency_hz: Option<f64>,
+    campbell: Vec<CampbellPoint>,
+}
+
+pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
+    let desc = match &args.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    let rotor = Rotor::from_description(&desc);
+    let rated = desc.rated_speed_rpm;
+    let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));
+    let to = args.to_rpm.unwrap_or(1.5 * rated);
+    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
+        anyhow::ensure!(
+            v.is_finite() && v > 0.0,
+            "invalid {name} {v}: must be a finite speed above zero"
+        );
+    }
+    anyhow::ensure!(
+        to > from,
+        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
+    );
+    let step = args.step_rpm.unwrap_or((to - from) / 40.0);
+    anyhow::ensure!(
+        step.is_finite() && step > 0.0,
+        "invalid --step-rpm {step}: must be a finite speed above zero"
+    );
+    anyhow::ensure!(
+        (to - from) / step <= 2000.0,
+        "invalid --step-rpm {step}: more than 2,000 speeds"
+    );
+    anyhow::ensure!(
+        (1..=100).contains(&args.modes),
+        "invalid --modes {}: must be 1 to 100",
+        args.modes
+    );
+
+    let statics = static_solution(&rotor).context("static deflection")?;
+    let free_free_hz = undamped_frequencies_hz(&rotor, Constraint::FreeFree)?;
+    let pinned_hz = undamped_frequencies_hz(&rotor, Constraint::Pinned)?;
+    let n_speeds = ((to - from) / step).round() as usize;
+    let speeds: Vec<f64> = (0..=n_speeds)
+        .map(|k| (from + k as f64 * step).min(to))
+        .collect();
+    let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
+    let threshold =
+        stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
+    let report = ModesReport {
+        machine: desc.name.clone(),
+        rotor_mass_kg: rotor.rotor_mass_kg(),
+        nodes: rotor.n_nodes(),
+        elements: rotor.elements.len(),
+        rated_speed_rpm: rad_s_to_rpm(rotor.rated_speed_rad_s),
+        bearing_names: rotor.bearings.iter().map(|b| b.name.clone()).collect(),
+        bearing_loads_n: statics.bearing_loads_n.clone(),
+        static_max_deflection_m: statics.max_deflection_m,
+        free_free_hz: free_free_hz.into_iter().take(args.modes).collect(),
+        pinned_hz: pinned_hz.into_iter().take(args.modes).collect(),
+        critical_speeds_rpm: critical_speeds_rpm(&points),
+        threshold_speed_rpm: threshold.map(|t| t.speed_rpm),
+        whirl_ratio_at_threshold: threshold.map(|t| t.whirl_ratio),
+        threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
+        campbell: points,
+    };
+    if let Some(path) = &args.plot {
+        crate::plot::campbell_svg(
+            path,
+            &format!("Campbell diagram: {}", report.machine),
+            &report.campbell,
+            report.threshold_speed_rpm,
+        )
+        .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_tables(&report);
+    }
+    Ok(())
+}
+
+fn print_tables(r: &ModesReport) {
+    println!("rotor-twin modes: {}", r.machine);
+    println!(
+        "  rotor {:.2} kg, {} nodes, {} Timoshenko elements, rated {:.0} rpm",
+        r.rotor_mass_kg, r.nodes, r.elements, r.rated_speed_rpm
+    );
+    println!("  static loads (journal on bearing, rigid supports):");
+    for (name, f) in r.bearing_names.iter().zip(&r.bearing_loads_n) {
+        println!("    {name:<24} [{:>9.2}, {:>9.2}] N", f[0], f[1]);
+    }
+    println!(
+        "  largest static deflection {:.2} µm",
+        r.static_max_deflection_m * 1e6
+    );
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|f| format!("{f:.1}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "  natural frequencies at rest, free–free (Hz): {}",
+        list(&r.free_free_hz)
+    );
+    println!(
+        "  natural frequencies at rest, pinned at the bearings (Hz): {}",
+        list(&r.pinned_hz)
+    );
+    println!("  Campbell diagram (film bearings linearised at their static equilibrium):");
+    println!(
+        "    {:>8}  modes: frequency Hz / log dec / F(orward) B(ackward)",
+        "rpm"
+    );
+    for p in &r.campbell {
+        let modes: Vec<String> = p
+            .modes
+            .iter()
+            .map(|m| {
+                let d = if m.direction == crate::rotor::WhirlDirection::Forward {
+                    'F'
+                } else {
+                    'B'
+                };
+                format!("{:7.1}/{:6.3}/{d}", m.frequency_hz, m.log_dec)
+            })
+            .collect();
+        println!("    {:>8.0}  {}", p.speed_rpm, modes.join("  "));
+    }
+    println!(
+        "  forward critical speeds (rpm): {}",
+        list(&r.critical_speeds_rpm)
+    );
+    match (r.threshold_speed_rpm, r.whirl_ratio_at_threshold) {
+        (Some(t), Some(w)) => {
+            println!("  stability threshold {t:.0} rpm, whirl frequency ratio {w:.3} there")
+        }
+        _ => println!("  stable over the whole range"),
+    }
+}

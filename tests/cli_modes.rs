@@ -1,0 +1,93 @@
+//! The `rotor-twin modes` command-line contract: JSON keys, plot file, errors.
+
+use serde_json::Value;
+use std::process::Command;
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+        .args(args)
+        .output()
+        .expect("run rotor-twin");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The built-in microturbine: the contracted keys, a Campbell diagram, and the linear threshold in
+/// the window the seed reports (stable at 8,000 rpm, whip at 9,000: the shaft body diameter was
+/// identified for this, see config/orc_microturbine_100kw.yaml), with a half-frequency whirl.
+#[test]
+fn modes_json_and_plot_for_the_builtin_machine() {
+    let svg = std::env::temp_dir().join(format!("rotor-twin-campbell-{}.svg", std::process::id()));
+    let (ok, out, err) = run(&[
+        "modes",
+        "--json",
+        "--from-rpm",
+        "2000",
+        "--to-rpm",
+        "12000",
+        "--step-rpm",
+        "500",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    for key in [
+        "critical_speeds_rpm",
+        "threshold_speed_rpm",
+        "whirl_ratio_at_threshold",
+        "bearing_loads_n",
+        "campbell",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    let campbell = v["campbell"].as_array().unwrap();
+    assert_eq!(campbell.len(), 21);
+    let mode = &campbell[0]["modes"][0];
+    for key in ["frequency_hz", "log_dec", "direction"] {
+        assert!(mode.get(key).is_some(), "mode lacks {key}");
+    }
+    let threshold = v["threshold_speed_rpm"].as_f64().unwrap();
+    assert!(
+        (8000.0..9000.0).contains(&threshold),
+        "threshold {threshold}"
+    );
+    let ratio = v["whirl_ratio_at_threshold"].as_f64().unwrap();
+    assert!((0.4..0.5).contains(&ratio), "whirl ratio {ratio}");
+    let loads: f64 = v["bearing_loads_n"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f[1].as_f64().unwrap())
+        .sum();
+    assert!(
+        (loads + 56.0 * 9.81).abs() < 0.01 * 56.0 * 9.81,
+        "Σ loads {loads}"
+    );
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("Campbell diagram"));
+    std::fs::remove_file(svg).ok();
+}
+
+#[test]
+fn bad_modes_input_is_named() {
+    for (args, word) in [
+        (vec!["modes", "--from-rpm", "-5"], "--from-rpm"),
+        (
+            vec!["modes", "--from-rpm", "5000", "--to-rpm", "4000"],
+            "--to-rpm",
+        ),
+        (vec!["modes", "--step-rpm", "0.001"], "--step-rpm"),
+        (
+            vec!["modes", "--config", "/nonexistent.yaml"],
+            "/nonexistent.yaml",
+        ),
+    ] {
+        let (ok, _, err) = run(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(word), "{args:?}: '{err}' does not name {word}");
+    }
+}
