@@ -44,6 +44,9 @@ pub struct MachineDescription {
     /// Proximity-probe stations (pairs of probes) for comparing with measured orbits.
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
+    /// Optional stiffness-proportional structural damping of the shaft, C = β K_shaft (β in s).
+    #[serde(default)]
+    pub shaft_damping_beta_s: f64,
 }
 
 fn default_gravity() -> [f64; 2] {
@@ -289,6 +292,14 @@ impl MachineDescription {
             }
         };
         positive("rated_speed_rpm".into(), self.rated_speed_rpm)?;
+        non_negative("shaft_damping_beta_s".into(), self.shaft_damping_beta_s)?;
+        if self.shaft_damping_beta_s > 1e-2 {
+            return Err(err(
+                "shaft_damping_beta_s".into(),
+                self.shaft_damping_beta_s.to_string(),
+                "is absurd (more than 0.01 s)",
+            ));
+        }
         for (i, g) in self.gravity_m_s2.iter().enumerate() {
             if !g.is_finite() || g.abs() > 100.0 {
                 return Err(err(

@@ -136,7 +136,7 @@ pub struct Rotor {
     pub stiffness: Mat<f64>,
     /// Global gyroscopic matrix per unit spin (multiplied by Ω in the equations).
     pub gyroscopic: Mat<f64>,
-    /// Global constant damping: support dampers (N·s/m).
+    /// Global constant damping: support dampers and the shaft's structural damping (N·s/m).
     pub damping: Mat<f64>,
 }
 
@@ -209,6 +209,13 @@ impl Rotor {
             add_block(&mut stiffness, at, &el.stiffness());
             add_block(&mut mass, at, &el.mass());
             add_block(&mut gyroscopic, at, &el.gyroscopic());
+        }
+        if desc.shaft_damping_beta_s > 0.0 {
+            for e in 0..elements.len() {
+                let k = elements[e].stiffness();
+                let c = k.map(|row| row.map(|v| desc.shaft_damping_beta_s * v));
+                add_block(&mut damping, 4 * e, &c);
+            }
         }
         for d in &discs {
             add_block(&mut mass, 4 * d.node, &d.mass());
