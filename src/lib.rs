@@ -5,6 +5,7 @@
 //! SI units everywhere inside; names carry the unit where it is not SI.
 
 pub mod cli;
+pub mod dynamics;
 pub mod film;
 pub mod plot;
 pub mod rotor;

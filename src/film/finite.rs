@@ -487,6 +487,10 @@ impl FilmModel for FiniteFilm {
         &self.geometry
     }
 
+    fn clone_box(&self) -> Box<dyn FilmModel + Send> {
+        Box::new(self.clone())
+    }
+
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
         kin.validate(self.geometry.radial_clearance_m)?;
         self.update_film_shape(kin);
@@ -500,6 +504,16 @@ impl FilmModel for FiniteFilm {
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
         let result = self.solve(kin)?;
         Ok((result, self.perturbation_coefficients(kin.speed_rad_s)))
+    }
+
+    fn midplane_pressure(&self, out: &mut [f64]) {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let len = out.len().max(1);
+        for (k, p) in out.iter_mut().enumerate() {
+            // nearest grid column
+            let i = (k * nt + len / 2) / len % nt;
+            *p = self.pressure_scale * self.pi[i * nz];
+        }
     }
 }
 

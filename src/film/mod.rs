@@ -116,6 +116,9 @@ pub trait FilmModel {
     /// Bearing geometry this model was built for.
     fn geometry(&self) -> &BearingGeometry;
 
+    /// A copy with the same warm-start state (for checkpoints).
+    fn clone_box(&self) -> Box<dyn FilmModel + Send>;
+
     /// Solves the film for `kin`. A model may start from its previous solution (warm start).
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError>;
 
@@ -125,6 +128,10 @@ pub trait FilmModel {
         &mut self,
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError>;
+
+    /// The mid-plane pressure of the last solve at `out.len()` equally spaced angles
+    /// θ_k = 2πk/len from `+x` (Pa). Allocates nothing.
+    fn midplane_pressure(&self, out: &mut [f64]);
 }
 
 /// Wraps an angle (rad) to [0, 2π).

@@ -41,6 +41,8 @@ const PANELS: usize = 32;
 pub struct ShortFilm {
     geometry: BearingGeometry,
     lubricant: Lubricant,
+    /// The state of the last solve (for the pressure profile).
+    last: JournalKinematics,
 }
 
 /// Integrals over the pressure zone gathered by one quadrature pass.
@@ -64,6 +66,7 @@ impl ShortFilm {
         Ok(Self {
             geometry,
             lubricant,
+            last: JournalKinematics::default(),
         })
     }
 
@@ -175,8 +178,30 @@ impl FilmModel for ShortFilm {
         &self.geometry
     }
 
+    fn clone_box(&self) -> Box<dyn FilmModel + Send> {
+        Box::new(self.clone())
+    }
+
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
-        self.solve_inner(kin, false).map(|(r, _)| r)
+        let r = self.solve_inner(kin, false).map(|(r, _)| r)?;
+        self.last = *kin;
+        Ok(r)
+    }
+
+    fn midplane_pressure(&self, out: &mut [f64]) {
+        // p(θ, 0) = −(3µL²/4) g/h³ where g < 0 (π-film)
+        let [x, y] = self.last.position_m;
+        let [vx, vy] = self.last.velocity_m_s;
+        let w = self.last.speed_rad_s;
+        let (a, b) = (w * x - 2.0 * vy, w * y + 2.0 * vx);
+        let c = self.geometry.radial_clearance_m;
+        let k = 0.75 * self.lubricant.viscosity_pa_s * self.geometry.length_m.powi(2);
+        let len = out.len().max(1) as f64;
+        for (i, p) in out.iter_mut().enumerate() {
+            let (s, co) = (std::f64::consts::TAU * i as f64 / len).sin_cos();
+            let h = c - x * co - y * s;
+            *p = (-k * (a * s - b * co) / (h * h * h)).max(0.0);
+        }
     }
 
     fn solve_with_coefficients(
@@ -184,6 +209,7 @@ impl FilmModel for ShortFilm {
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
         let (res, zi) = self.solve_inner(kin, true)?;
+        self.last = *kin;
         let k = 0.5
             * self.lubricant.viscosity_pa_s
             * self.geometry.radius_m()

@@ -1,0 +1,174 @@
+//! A film bearing inside the time step: the film force on the journal, its stiffness and damping,
+//! and the contact with the bearing wall when the film can no longer hold the journal.
+
+use crate::film::{FilmCoefficients, FilmError, FilmModel, FilmResult, JournalKinematics};
+
+/// Contact with the bearing wall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactModel {
+    /// Eccentricity ratio at which the wall takes over (the film is evaluated no further out):
+    /// 0.99 leaves a minimum film of 1 % of the clearance, the scale of surface roughness.
+    pub onset_eccentricity_ratio: f64,
+    /// Radial wall stiffness beyond the onset (N/m).
+    pub wall_stiffness_n_per_m: f64,
+    /// Coulomb friction coefficient of the rubbing contact.
+    pub friction_coefficient: f64,
+}
+
+impl Default for ContactModel {
+    fn default() -> Self {
+        Self {
+            onset_eccentricity_ratio: 0.99,
+            wall_stiffness_n_per_m: 2e9,
+            friction_coefficient: 0.15,
+        }
+    }
+}
+
+/// What one evaluation of a bearing gives the step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LinkEvaluation {
+    /// Total force on the journal: film plus wall contact (N).
+    pub force_n: [f64; 2],
+    /// −∂F/∂d (N/m).
+    pub stiffness: [[f64; 2]; 2],
+    /// −∂F/∂ḋ (N·s/m).
+    pub damping: [[f64; 2]; 2],
+    /// The film solution.
+    pub film: FilmResult,
+    /// True if the journal was in contact with the wall.
+    pub contact: bool,
+}
+
+/// The static equilibrium a linear coupling linearises about.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LinearReference {
+    /// Journal position relative to the bearing (m).
+    pub position_m: [f64; 2],
+    /// Film force there (N).
+    pub force_n: [f64; 2],
+    /// The eight coefficients there.
+    pub coefficients: FilmCoefficients,
+}
+
+/// A film bearing as the step sees it.
+pub(crate) struct BearingLink {
+    pub name: String,
+    /// Reduced DOF indices of the journal centre (x, y).
+    pub journal: [usize; 2],
+    /// Reduced DOF indices of the pedestal (x, y), if flexible.
+    pub pedestal: Option<[usize; 2]>,
+    /// Position of this bearing's journal x in the condensed vector q_B.
+    pub b_offset: usize,
+    pub clearance_m: f64,
+    pub radius_m: f64,
+    pub viscosity_pa_s: f64,
+    pub film: Box<dyn FilmModel + Send>,
+    /// Linear coupling: the static equilibrium (relative position, film force) and its coefficients.
+    pub linear_reference: Option<LinearReference>,
+    /// Prehistory: the raw coefficients of the previous step, c(k−1) of seed eq. 8.
+    pub previous_raw: Option<FilmCoefficients>,
+    /// The last evaluation.
+    pub last: LinkEvaluation,
+}
+
+impl BearingLink {
+    /// Number of condensed DOFs of this bearing (journal, and pedestal if any).
+    pub fn width(&self) -> usize {
+        if self.pedestal.is_some() {
+            4
+        } else {
+            2
+        }
+    }
+
+    /// Film (and wall) force, stiffness and damping at relative position `d` (m), velocity `v`
+    /// (m/s) and speed `speed` (rad/s). Allocates nothing.
+    pub fn evaluate(
+        &mut self,
+        d: [f64; 2],
+        v: [f64; 2],
+        speed: f64,
+        contact: &ContactModel,
+    ) -> Result<LinkEvaluation, FilmError> {
+        let c = self.clearance_m;
+        let e = d[0].hypot(d[1]);
+        let onset = contact.onset_eccentricity_ratio * c;
+        let in_contact = e > onset;
+        let d_film = if in_contact {
+            [d[0] * onset / e, d[1] * onset / e]
+        } else {
+            d
+        };
+        let kin = JournalKinematics {
+            position_m: d_film,
+            velocity_m_s: v,
+            speed_rad_s: speed,
+        };
+        let (film, coef) = self.film.solve_with_coefficients(&kin)?;
+        let mut out = LinkEvaluation {
+            force_n: film.force_n,
+            stiffness: coef.stiffness_n_per_m,
+            damping: coef.damping_n_s_per_m,
+            film,
+            contact: in_contact,
+        };
+        if in_contact {
+            let n = [d[0] / e, d[1] / e];
+            let t = [-n[1], n[0]];
+            // the film is evaluated on the onset circle: it sees only the tangential motion
+            let shrink = onset / e;
+            let k = coef.stiffness_n_per_m;
+            for i in 0..2 {
+                for j in 0..2 {
+                    // K_f · (I − n nᵀ) · (onset / e)
+                    out.stiffness[i][j] = shrink
+                        * (0..2)
+                            .map(|m| k[i][m] * (if m == j { 1.0 } else { 0.0 } - n[m] * n[j]))
+                            .sum::<f64>();
+                }
+            }
+            // wall: radial spring beyond the onset, Coulomb friction against the surface sliding
+            let penetration = e - onset;
+            let normal = contact.wall_stiffness_n_per_m * penetration;
+            let slide = speed * self.radius_m + (v[0] * t[0] + v[1] * t[1]);
+            let friction = -contact.friction_coefficient * normal * slide.signum();
+            for i in 0..2 {
+                out.force_n[i] += -normal * n[i] + friction * t[i];
+                for j in 0..2 {
+                    out.stiffness[i][j] += contact.wall_stiffness_n_per_m * n[i] * n[j];
+                }
+            }
+        }
+        self.last = out;
+        Ok(out)
+    }
+
+    /// The linear coupling's force law F = F₀ − K₀(d − d₀) − C₀ ḋ about the static equilibrium.
+    pub fn evaluate_linear(&mut self, d: [f64; 2], v: [f64; 2]) -> LinkEvaluation {
+        let LinearReference {
+            position_m: d0,
+            force_n: f0,
+            coefficients: coef,
+        } = self
+            .linear_reference
+            .expect("linear reference set at construction");
+        let k = coef.stiffness_n_per_m;
+        let cc = coef.damping_n_s_per_m;
+        let mut f = f0;
+        for i in 0..2 {
+            for j in 0..2 {
+                f[i] -= k[i][j] * (d[j] - d0[j]) + cc[i][j] * v[j];
+            }
+        }
+        let out = LinkEvaluation {
+            force_n: f,
+            stiffness: k,
+            damping: cc,
+            film: self.last.film,
+            contact: false,
+        };
+        self.last = out;
+        out
+    }
+}

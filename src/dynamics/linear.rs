@@ -1,0 +1,251 @@
+//! The linear part of the implicit Newmark step, factored once and reused.
+//!
+//! Average-acceleration Newmark (γ = ½, β = ¼) turns seed eq. 5 at t + h into
+//!
+//! ```text
+//!   K_eff q_{n+1} = r_n + F_b(q_{n+1}, q̇_{n+1}),   K_eff = K + (2/h) C_t + (4/h²) M,
+//!   r_n = F_ext + M(4/h² q_n + 4/h q̇_n + q̈_n) + C_t(2/h q_n + q̇_n),   C_t = C + Ω G,
+//! ```
+//!
+//! where F_b acts only on the bearing DOFs B. With Z = K_eff⁻¹ E_B and S = E_Bᵀ Z the step
+//! condenses exactly onto B: q_B = a + S f_B, a = (K_eff⁻¹ r_n)_B, and the full state follows as
+//! q = K_eff⁻¹ r_n + Z f_B. The nonlinear iteration therefore runs on a handful of unknowns.
+
+use faer::Mat;
+
+/// A square sparse matrix in compressed rows, for the per-step products (M, C, G).
+#[derive(Debug, Clone)]
+pub(crate) struct SparseRows {
+    start: Vec<usize>,
+    col: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl SparseRows {
+    /// The nonzero entries of a dense matrix.
+    pub(crate) fn from_dense(m: &Mat<f64>) -> Self {
+        let mut start = vec![0];
+        let (mut col, mut val) = (Vec::new(), Vec::new());
+        for i in 0..m.nrows() {
+            for j in 0..m.ncols() {
+                if m[(i, j)] != 0.0 {
+                    col.push(j);
+                    val.push(m[(i, j)]);
+                }
+            }
+            start.push(col.len());
+        }
+        Self { start, col, val }
+    }
+
+    /// out += scale · A x. Allocates nothing.
+    pub(crate) fn add_product(&self, scale: f64, x: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for k in self.start[i]..self.start[i + 1] {
+                s += self.val[k] * x[self.col[k]];
+            }
+            *o += scale * s;
+        }
+    }
+}
+
+/// K_eff⁻¹ and its condensation onto the bearing DOFs, for one time step and one spin speed.
+/// All storage is reserved at construction: refactoring for a new speed allocates nothing.
+#[derive(Debug, Clone)]
+pub(crate) struct StepFactor {
+    /// Time step h (s).
+    pub h: f64,
+    /// Spin speed the gyroscopic term was factored with (rad/s).
+    pub speed_rad_s: f64,
+    /// K_eff⁻¹ (dense, row-major for the per-step product).
+    inverse: Vec<f64>,
+    /// Z = K_eff⁻¹ E_B, row-major n × nb.
+    z: Vec<f64>,
+    /// S = E_Bᵀ K_eff⁻¹ E_B, row-major nb × nb.
+    pub s: Vec<f64>,
+    /// Scratch: K_eff, overwritten by its LU factors.
+    work: Vec<f64>,
+    pivots: Vec<usize>,
+    n: usize,
+    nb: usize,
+}
+
+impl StepFactor {
+    /// Reserves room for n DOFs and nb bearing DOFs, factored for step `h` (s) and `speed_rad_s`.
+    /// None if K_eff is singular.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        m: &Mat<f64>,
+        c: &Mat<f64>,
+        g: &Mat<f64>,
+        k: &Mat<f64>,
+        h: f64,
+        speed_rad_s: f64,
+        bearing_dofs: &[usize],
+    ) -> Option<Self> {
+        let n = m.nrows();
+        let nb = bearing_dofs.len();
+        let mut f = Self {
+            h,
+            speed_rad_s,
+            inverse: vec![0.0; n * n],
+            z: vec![0.0; n * nb],
+            s: vec![0.0; nb * nb],
+            work: vec![0.0; n * n],
+            pivots: vec![0; n],
+            n,
+            nb,
+        };
+        f.refactor(m, c, g, k, speed_rad_s, bearing_dofs)
+            .then_some(f)
+    }
+
+    /// Factors K + (2/h)(C + ΩG) + (4/h²) M again for spin `speed_rad_s` (rad/s), in place.
+    /// False if singular (the previous factor is then invalid).
+    pub(crate) fn refactor(
+        &mut self,
+        m: &Mat<f64>,
+        c: &Mat<f64>,
+        g: &Mat<f64>,
+        k: &Mat<f64>,
+        speed_rad_s: f64,
+        bearing_dofs: &[usize],
+    ) -> bool {
+        let (n, h) = (self.n, self.h);
+        for i in 0..n {
+            for j in 0..n {
+                self.work[i * n + j] = k[(i, j)]
+                    + 2.0 / h * (c[(i, j)] + speed_rad_s * g[(i, j)])
+                    + 4.0 / (h * h) * m[(i, j)];
+            }
+        }
+        if !lu_in_place(&mut self.work, &mut self.pivots, n) {
+            return false;
+        }
+        // columns of the inverse: solve LU x = e_j
+        self.inverse.fill(0.0);
+        for j in 0..n {
+            // column j of the inverse: L U x = P e_j, (P e_j)_i = 1 where pivots[i] = j
+            for i in 0..n {
+                self.inverse[i * n + j] = if self.pivots[i] == j { 1.0 } else { 0.0 };
+            }
+            lu_solve_column(&self.work, n, &mut self.inverse, j);
+        }
+        for (r, &b) in bearing_dofs.iter().enumerate() {
+            for i in 0..n {
+                self.z[i * self.nb + r] = self.inverse[i * n + b];
+            }
+            for (q, &a) in bearing_dofs.iter().enumerate() {
+                self.s[q * self.nb + r] = self.inverse[a * n + b];
+            }
+        }
+        self.speed_rad_s = speed_rad_s;
+        self.inverse.iter().all(|v| v.is_finite())
+    }
+
+    /// out = K_eff⁻¹ r. Allocates nothing.
+    pub(crate) fn solve(&self, r: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate().take(self.n) {
+            let row = &self.inverse[i * self.n..(i + 1) * self.n];
+            *o = row.iter().zip(r).map(|(a, b)| a * b).sum();
+        }
+    }
+
+    /// q += Z f_B. Allocates nothing.
+    pub(crate) fn add_bearing_response(&self, f_b: &[f64], q: &mut [f64]) {
+        for (i, qi) in q.iter_mut().enumerate().take(self.n) {
+            let row = &self.z[i * self.nb..(i + 1) * self.nb];
+            *qi += row.iter().zip(f_b).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+}
+
+/// LU factorisation with partial pivoting, in place (row-major n × n). `perm[i]` is the original
+/// row now at position i. False if singular.
+fn lu_in_place(a: &mut [f64], perm: &mut [usize], n: usize) -> bool {
+    for (i, p) in perm.iter_mut().enumerate() {
+        *p = i;
+    }
+    for k in 0..n {
+        let p = (k..n)
+            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
+            .unwrap_or(k);
+        let pivot = a[p * n + k];
+        if pivot == 0.0 || !pivot.is_finite() {
+            return false;
+        }
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+            perm.swap(k, p);
+        }
+        let inv = 1.0 / a[k * n + k];
+        for i in k + 1..n {
+            let f = a[i * n + k] * inv;
+            a[i * n + k] = f;
+            if f != 0.0 {
+                let (upper, lower) = a.split_at_mut(i * n);
+                let pivot_row = &upper[k * n + k + 1..k * n + n];
+                for (x, u) in lower[k + 1..n].iter_mut().zip(pivot_row) {
+                    *x -= f * u;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Solves L U x = b for column `col` of the row-major n × n array `x` (b there on entry, the
+/// right-hand side already permuted).
+fn lu_solve_column(lu: &[f64], n: usize, x: &mut [f64], col: usize) {
+    for i in 0..n {
+        let mut s = x[i * n + col];
+        for j in 0..i {
+            s -= lu[i * n + j] * x[j * n + col];
+        }
+        x[i * n + col] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = x[i * n + col];
+        for j in i + 1..n {
+            s -= lu[i * n + j] * x[j * n + col];
+        }
+        x[i * n + col] = s / lu[i * n + i];
+    }
+}
+
+/// Solves the small dense system A x = b in place (A row-major n × n, overwritten), by Gaussian
+/// elimination with partial pivoting. False if A is singular. Allocates nothing.
+pub(crate) fn solve_small(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+    for k in 0..n {
+        let p = (k..n)
+            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
+            .unwrap_or(k);
+        if a[p * n + k] == 0.0 || !a[p * n + k].is_finite() {
+            return false;
+        }
+        if p != k {
+            for j in 0..n {
+                a.swap(k * n + j, p * n + j);
+            }
+            b.swap(k, p);
+        }
+        for i in k + 1..n {
+            let f = a[i * n + k] / a[k * n + k];
+            for j in k..n {
+                a[i * n + j] -= f * a[k * n + j];
+            }
+            b[i] -= f * b[k];
+        }
+    }
+    for k in (0..n).rev() {
+        let mut s = b[k];
+        for j in k + 1..n {
+            s -= a[k * n + j] * b[j];
+        }
+        b[k] = s / a[k * n + k];
+    }
+    true
+}
