@@ -1,0 +1,244 @@
+//! The engine: state, construction at the static equilibrium, and the time step.
+
+use super::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
+use super::linear::{SparseRows, StepFactor};
+use super::{BearingState, ProbeState, StepOutput, TwinConfig, TwinError};
+use crate::film::{FilmCoefficients, FilmModel, JournalKinematics};
+use crate::rotor::Unbalance;
+use faer::Mat;
+
+/// Marks a full DOF that is held (rigid bearing) and so not in the reduced system.
+const HELD: usize = usize::MAX;
+
+/// The dynamic state (explicit, copyable into checkpoints).
+#[derive(Debug, Clone, PartialEq)]
+struct State {
+    time_s: f64,
+    angle_rad: f64,
+    speed_rad_s: f64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    qdd: Vec<f64>,
+}
+
+/// A saved twin state: restoring it makes the following steps repeat exactly.
+pub struct Checkpoint {
+    state: State,
+    films: Vec<Box<dyn FilmModel + Send>>,
+    previous_raw: Vec<Option<FilmCoefficients>>,
+    linear_reference: Vec<Option<LinearReference>>,
+    last: Vec<LinkEvaluation>,
+    unbalance: Vec<Unbalance>,
+    external: Vec<f64>,
+}
+
+/// The twin core (see the module documentation of [`crate::dynamics`]).
+pub struct Twin {
+    config: TwinConfig,
+    m: Mat<f64>,
+    c: Mat<f64>,
+    g: Mat<f64>,
+    k: Mat<f64>,
+    m_rows: SparseRows,
+    c_rows: SparseRows,
+    g_rows: SparseRows,
+    /// full DOF → reduced index (or HELD)
+    reduced_of: Vec<usize>,
+    gravity: Vec<f64>,
+    unbalance: Vec<Unbalance>,
+    external: Vec<f64>,
+    links: Vec<BearingLink>,
+    b_dofs: Vec<usize>,
+    /// factors for h, h/2, h/4
+    factors: Vec<StepFactor>,
+    probes: Vec<([usize; 2], [f64; 2])>,
+    state: State,
+    rated_speed_rad_s: f64,
+    // scratch, sized once
+    rhs: Vec<f64>,
+    tmp: Vec<f64>,
+    q_lin: Vec<f64>,
+    next: State,
+    qb: Vec<f64>,
+    a_b: Vec<f64>,
+    f_b: Vec<f64>,
+    d_b: Vec<f64>,
+    jac: Vec<f64>,
+    delta: Vec<f64>,
+    raw: Vec<Option<FilmCoefficients>>,
+    output: StepOutput,
+}
+
+impl Twin {
+    /// The settings.
+    pub fn config(&self) -> &TwinConfig {
+        &self.config
+    }
+
+    /// The last step's output (the initial state before the first step).
+    pub fn output(&self) -> &StepOutput {
+        &self.output
+    }
+
+    /// Time (s).
+    pub fn time_s(&self) -> f64 {
+        self.state.time_s
+    }
+
+    /// Names of the film bearings, in output order.
+    pub fn bearing_names(&self) -> impl Iterator<Item = &str> {
+        self.links.iter().map(|l| l.name.as_str())
+    }
+
+    /// Radial clearance of each film bearing (m), in output order.
+    pub fn bearing_clearances_m(&self) -> Vec<f64> {
+        self.links.iter().map(|l| l.clearance_m).collect()
+    }
+
+    /// Mid-plane pressure of bearing `bearing` at the last solve (see
+    /// [`FilmModel::midplane_pressure`]).
+    pub fn midplane_pressure(&self, bearing: usize, out: &mut [f64]) {
+        self.links[bearing].film.midplane_pressure(out);
+    }
+
+    /// Sets unbalance plane `plane` (index in the machine's list): m·e (kg·m) and heavy-spot
+    /// angle (rad). Takes effect at the next step.
+    pub fn set_unbalance(
+        &mut self,
+        plane: usize,
+        magnitude_kg_m: f64,
+        phase_rad: f64,
+    ) -> Result<(), TwinError> {
+        if plane >= self.unbalance.len() {
+            return Err(TwinError::InvalidInput {
+                name: "unbalance plane",
+                value: plane as f64,
+                rule: "must be a plane of the machine",
+            });
+        }
+        if !(magnitude_kg_m.is_finite() && (0.0..=1.0).contains(&magnitude_kg_m)) {
+            return Err(TwinError::InvalidInput {
+                name: "unbalance (kg·m)",
+                value: magnitude_kg_m,
+                rule: "must be finite, 0 to 1 kg·m",
+            });
+        }
+        if !phase_rad.is_finite() {
+            return Err(TwinError::InvalidInput {
+                name: "unbalance phase (rad)",
+                value: phase_rad,
+                rule: "must be finite",
+            });
+        }
+        self.unbalance[plane].magnitude_kg_m = magnitude_kg_m;
+        self.unbalance[plane].phase_rad = phase_rad;
+        Ok(())
+    }
+
+    /// Sets a constant external force `[F_x, F_y]` (N) at shaft node `node` until changed.
+    pub fn set_external_force(&mut self, node: usize, force_n: [f64; 2]) -> Result<(), TwinError> {
+        if 4 * node + 1 >= self.reduced_of.len() {
+            return Err(TwinError::InvalidInput {
+                name: "external force node",
+                value: node as f64,
+                rule: "must be a shaft node",
+            });
+        }
+        for (i, f) in force_n.iter().enumerate() {
+            if !f.is_finite() {
+                return Err(TwinError::InvalidInput {
+                    name: "external force (N)",
+                    value: *f,
+                    rule: "must be finite",
+                });
+            }
+            let r = self.reduced_of[4 * node + i];
+            if r != HELD {
+                self.external[r] = *f;
+            }
+        }
+        Ok(())
+    }
+
+    /// Saves the complete state.
+    pub fn checkpoint(&self) -> Checkpoint {
+        Checkpoint {
+            state: self.state.clone(),
+            films: self.links.iter().map(|l| l.film.clone_box()).collect(),
+            previous_raw: self.links.iter().map(|l| l.previous_raw).collect(),
+            linear_reference: self.links.iter().map(|l| l.linear_reference).collect(),
+            last: self.links.iter().map(|l| l.last).collect(),
+            unbalance: self.unbalance.clone(),
+            external: self.external.clone(),
+        }
+    }
+
+    /// Restores a state saved by [`checkpoint`](Self::checkpoint) of this twin.
+    pub fn restore(&mut self, cp: &Checkpoint) {
+        self.state = cp.state.clone();
+        for (i, l) in self.links.iter_mut().enumerate() {
+            l.film = cp.films[i].clone_box();
+            l.previous_raw = cp.previous_raw[i];
+            l.linear_reference = cp.linear_reference[i];
+            l.last = cp.last[i];
+        }
+        self.unbalance = cp.unbalance.clone();
+        self.external = cp.external.clone();
+        self.fill_output(0, 1);
+    }
+
+    fn fill_output(&mut self, iterations: usize, substeps: usize) {
+        let s = &self.state;
+        let out = &mut self.output;
+        out.time_s = s.time_s;
+        out.angle_rad = s.angle_rad;
+        out.speed_rad_s = s.speed_rad_s;
+        out.newton_iterations = iterations;
+        out.substeps = substeps;
+        for (b, link) in out.bearings.iter_mut().zip(&self.links) {
+            let pos = |v: &[f64]| -> [f64; 2] {
+                let j = link.journal;
+                match link.pedestal {
+                    Some(p) => [v[j[0]] - v[p[0]], v[j[1]] - v[p[1]]],
+                    None => [v[j[0]], v[j[1]]],
+                }
+            };
+            let d = pos(&s.q);
+            let e = link.last;
+            *b = BearingState {
+                position_m: d,
+                velocity_m_s: pos(&s.qd),
+                eccentricity_ratio: d[0].hypot(d[1]) / link.clearance_m,
+                attitude_rad: crate::film::wrap_angle_rad(d[1].atan2(d[0])),
+                force_n: e.force_n,
+                max_pressure_pa: e.film.max_pressure_pa,
+                max_pressure_angle_rad: e.film.max_pressure_angle_rad,
+                film_start_rad: e.film.film_start_rad,
+                film_end_rad: e.film.film_end_rad,
+                power_loss_w: e.film.power_loss_w,
+                contact: e.contact,
+            };
+        }
+        for (p, (dofs, angles)) in out.probes.iter_mut().zip(&self.probes) {
+            let at = |r: usize| if r == HELD { 0.0 } else { s.q[r] };
+            let x = [at(dofs[0]), at(dofs[1])];
+            *p = ProbeState {
+                displacement_m: x,
+                readings_m: angles.map(|a| x[0] * a.cos() + x[1] * a.sin()),
+            };
+        }
+    }
+
+    /// Journal kinematics of bearing `bearing` now (relative to its pedestal).
+    pub fn journal_kinematics(&self, bearing: usize) -> JournalKinematics {
+        let b = &self.output.bearings[bearing];
+        JournalKinematics {
+            position_m: b.position_m,
+            velocity_m_s: b.velocity_m_s,
+            speed_rad_s: self.state.speed_rad_s,
+        }
+    }
+}
+
+mod setup;
+mod step;

@@ -1,0 +1,351 @@
+//! Building the twin: reduced matrices, film links, and the static equilibrium it starts from.
+
+use super::{State, Twin, HELD};
+use crate::dynamics::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
+use crate::dynamics::linear::{SparseRows, StepFactor};
+use crate::dynamics::{BearingState, Coupling, ProbeState, StepOutput, TwinConfig, TwinError};
+use crate::film::equilibrium_under_load;
+use crate::rotor::{static_solution, BearingModel, Rotor};
+use faer::Mat;
+
+impl Twin {
+    /// Builds the twin of `rotor`, at rest in its static equilibrium on the films at
+    /// `speed_rad_s` (rad/s): rigid-support bearing loads, each film's equilibrium under its load,
+    /// the shaft deflected statically and moved rigidly onto the journal positions.
+    pub fn new(rotor: &Rotor, config: TwinConfig, speed_rad_s: f64) -> Result<Self, TwinError> {
+        validate_config(&config)?;
+        if !(speed_rad_s.is_finite() && speed_rad_s > 0.0) {
+            return Err(TwinError::InvalidInput {
+                name: "initial speed (rad/s)",
+                value: speed_rad_s,
+                rule: "must be finite and greater than zero",
+            });
+        }
+        let n_full = rotor.n_dof();
+        let held: Vec<usize> = rotor
+            .bearings
+            .iter()
+            .filter(|b| matches!(b.model, BearingModel::Rigid))
+            .flat_map(|b| b.journal_dofs)
+            .collect();
+        let mut reduced_of = vec![HELD; n_full];
+        let mut full_of = Vec::new();
+        for d in 0..n_full {
+            if !held.contains(&d) {
+                reduced_of[d] = full_of.len();
+                full_of.push(d);
+            }
+        }
+        let n = full_of.len();
+        let sub = |a: &Mat<f64>| Mat::<f64>::from_fn(n, n, |i, j| a[(full_of[i], full_of[j])]);
+        let m = sub(&rotor.mass);
+        let mut k = sub(&rotor.stiffness);
+        let mut c = sub(&rotor.damping);
+        let g = sub(&rotor.gyroscopic);
+        // constant-coefficient bearings join the linear part
+        for b in &rotor.bearings {
+            if let BearingModel::Linear(coef) = &b.model {
+                let j = b.journal_dofs.map(|d| reduced_of[d]);
+                let p = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
+                add_relative_block(&mut k, j, p, &coef.stiffness_n_per_m);
+                add_relative_block(&mut c, j, p, &coef.damping_n_s_per_m);
+            }
+        }
+        let gravity_full = rotor.gravity_force();
+        let gravity: Vec<f64> = full_of.iter().map(|&d| gravity_full[d]).collect();
+
+        // film bearings and the condensed DOFs
+        let mut links = Vec::new();
+        let mut b_dofs = Vec::new();
+        for b in &rotor.bearings {
+            if let BearingModel::Film(f) = &b.model {
+                let journal = b.journal_dofs.map(|d| reduced_of[d]);
+                let pedestal = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
+                let b_offset = b_dofs.len();
+                b_dofs.extend(journal);
+                if let Some(p) = pedestal {
+                    b_dofs.extend(p);
+                }
+                links.push(BearingLink {
+                    name: b.name.clone(),
+                    journal,
+                    pedestal,
+                    b_offset,
+                    clearance_m: f.geometry.radial_clearance_m,
+                    radius_m: f.geometry.radius_m(),
+                    viscosity_pa_s: f.lubricant.viscosity_pa_s,
+                    film: f.solver(),
+                    linear_reference: None,
+                    previous_raw: None,
+                    last: LinkEvaluation::default(),
+                });
+            }
+        }
+        let nb = b_dofs.len();
+
+        // static equilibrium at the starting speed
+        let statics = static_solution(rotor).map_err(|e| TwinError::Setup(e.to_string()))?;
+        let mut q_full = statics.displacement.clone();
+        q_full.resize(n_full, 0.0);
+        let mut journal_abs: Vec<(f64, [f64; 2])> = Vec::new();
+        let mut link_index = 0;
+        for (b, load) in rotor.bearings.iter().zip(&statics.bearing_loads_n) {
+            let z = rotor.node_z_m[b.node];
+            let d = match &b.model {
+                BearingModel::Film(_) => {
+                    let link = &mut links[link_index];
+                    link_index += 1;
+                    let eq = equilibrium_under_load(
+                        link.film.as_mut(),
+                        link.viscosity_pa_s,
+                        *load,
+                        speed_rad_s,
+                    )
+                    .map_err(|source| TwinError::Film {
+                        bearing: link.name.clone(),
+                        time_s: 0.0,
+                        source,
+                    })?;
+                    link.linear_reference = Some(LinearReference {
+                        position_m: eq.position_m,
+                        force_n: eq.film.force_n,
+                        coefficients: eq.coefficients,
+                    });
+                    link.last = LinkEvaluation {
+                        force_n: eq.film.force_n,
+                        stiffness: eq.coefficients.stiffness_n_per_m,
+                        damping: eq.coefficients.damping_n_s_per_m,
+                        film: eq.film,
+                        contact: false,
+                    };
+                    eq.position_m
+                }
+                BearingModel::Linear(coef) => solve2(&coef.stiffness_n_per_m, *load),
+                BearingModel::Rigid => [0.0, 0.0],
+            };
+            // pedestal: its spring carries the journal's load and its own weight
+            let mut p_abs = [0.0, 0.0];
+            if let (Some(p), Some(spec_k)) =
+                (b.pedestal_dofs, pedestal_stiffness(rotor, b.pedestal_dofs))
+            {
+                let mp = rotor.mass[(p[0], p[0])];
+                let f = [
+                    load[0] + mp * rotor.gravity_m_s2[0],
+                    load[1] + mp * rotor.gravity_m_s2[1],
+                ];
+                p_abs = solve2(&spec_k, f);
+                q_full[p[0]] = p_abs[0];
+                q_full[p[1]] = p_abs[1];
+            }
+            if !matches!(b.model, BearingModel::Rigid) {
+                journal_abs.push((z, [p_abs[0] + d[0], p_abs[1] + d[1]]));
+            }
+        }
+        // move the statically deflected shaft rigidly onto the journal positions (exact for two
+        // bearings; a least-squares fit for more)
+        let fit = rigid_fit(&journal_abs);
+        for (node, &z) in rotor.node_z_m.iter().enumerate() {
+            for plane in 0..2 {
+                let (a, slope) = fit[plane];
+                q_full[4 * node + plane] += a + slope * z;
+            }
+            q_full[4 * node + 2] += -fit[1].1; // θx = −dy/dz
+            q_full[4 * node + 3] += fit[0].1; // θy = dx/dz
+        }
+        let q: Vec<f64> = full_of.iter().map(|&d| q_full[d]).collect();
+
+        let mut factors = Vec::new();
+        for level in 0..3 {
+            let h = config.time_step_s / f64::from(1u32 << level);
+            factors.push(
+                StepFactor::new(&m, &c, &g, &k, h, speed_rad_s, &b_dofs).ok_or_else(|| {
+                    TwinError::Setup("the effective stiffness K + 2C/h + 4M/h² is singular".into())
+                })?,
+            );
+        }
+        let probes = rotor
+            .probes
+            .iter()
+            .map(|p| {
+                (
+                    [reduced_of[4 * p.node], reduced_of[4 * p.node + 1]],
+                    p.angles_rad,
+                )
+            })
+            .collect();
+        let state = State {
+            time_s: 0.0,
+            angle_rad: 0.0,
+            speed_rad_s,
+            q,
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
+        let output = StepOutput {
+            bearings: vec![BearingState::default(); links.len()],
+            probes: vec![ProbeState::default(); rotor.probes.len()],
+            ..StepOutput::default()
+        };
+        let mut twin = Self {
+            config,
+            m_rows: SparseRows::from_dense(&m),
+            c_rows: SparseRows::from_dense(&c),
+            g_rows: SparseRows::from_dense(&g),
+            m,
+            c,
+            g,
+            k,
+            reduced_of,
+            gravity,
+            unbalance: rotor.unbalance.clone(),
+            external: vec![0.0; n],
+            raw: vec![None; links.len()],
+            links,
+            b_dofs,
+            factors,
+            probes,
+            next: state.clone(),
+            state,
+            rated_speed_rad_s: rotor.rated_speed_rad_s,
+            rhs: vec![0.0; n],
+            tmp: vec![0.0; n],
+            q_lin: vec![0.0; n],
+            qb: vec![0.0; nb],
+            a_b: vec![0.0; nb],
+            f_b: vec![0.0; nb],
+            d_b: vec![0.0; nb * nb],
+            jac: vec![0.0; nb * nb],
+            delta: vec![0.0; nb],
+            output,
+        };
+        twin.fill_output(0, 1);
+        Ok(twin)
+    }
+}
+
+fn validate_config(c: &TwinConfig) -> Result<(), TwinError> {
+    let bad = |name, value, rule| Err(TwinError::InvalidInput { name, value, rule });
+    if !(c.time_step_s.is_finite() && c.time_step_s > 0.0 && c.time_step_s < 0.1) {
+        return bad(
+            "time step (s)",
+            c.time_step_s,
+            "must be finite, above zero and below 0.1 s",
+        );
+    }
+    if !(c.newton_tolerance.is_finite() && c.newton_tolerance > 0.0 && c.newton_tolerance < 0.1) {
+        return bad(
+            "Newton tolerance (share of clearance)",
+            c.newton_tolerance,
+            "must lie in (0, 0.1)",
+        );
+    }
+    if c.max_newton_iterations == 0 || c.max_newton_iterations > 1000 {
+        return bad(
+            "Newton iterations",
+            c.max_newton_iterations as f64,
+            "must be 1 to 1000",
+        );
+    }
+    if let Coupling::Prehistory { delta } = c.coupling {
+        if !(delta.is_finite() && delta > 0.0 && delta <= 1.0) {
+            return bad("prehistory relaxation δ", delta, "must lie in (0, 1]");
+        }
+    }
+    let ct = &c.contact;
+    if !(ct.onset_eccentricity_ratio > 0.5 && ct.onset_eccentricity_ratio < 0.999) {
+        return bad(
+            "contact onset eccentricity ratio",
+            ct.onset_eccentricity_ratio,
+            "must lie in (0.5, 0.999)",
+        );
+    }
+    if !(ct.wall_stiffness_n_per_m.is_finite() && ct.wall_stiffness_n_per_m > 0.0) {
+        return bad(
+            "wall stiffness (N/m)",
+            ct.wall_stiffness_n_per_m,
+            "must be finite and above zero",
+        );
+    }
+    if !(ct.friction_coefficient.is_finite() && (0.0..=2.0).contains(&ct.friction_coefficient)) {
+        return bad(
+            "wall friction coefficient",
+            ct.friction_coefficient,
+            "must lie in [0, 2]",
+        );
+    }
+    Ok(())
+}
+
+/// Adds a 2 × 2 block acting on the relative motion journal − pedestal (or journal − ground).
+fn add_relative_block(
+    m: &mut Mat<f64>,
+    j: [usize; 2],
+    p: Option<[usize; 2]>,
+    block: &[[f64; 2]; 2],
+) {
+    for a in 0..2 {
+        for b in 0..2 {
+            let v = block[a][b];
+            if j[a] != HELD && j[b] != HELD {
+                m[(j[a], j[b])] += v;
+            }
+            if let Some(p) = p {
+                m[(p[a], p[b])] += v;
+                if j[a] != HELD {
+                    m[(j[a], p[b])] -= v;
+                }
+                if j[b] != HELD {
+                    m[(p[a], j[b])] -= v;
+                }
+            }
+        }
+    }
+}
+
+/// The pedestal's spring matrix (N/m), read back from the rotor's stiffness.
+fn pedestal_stiffness(rotor: &Rotor, p: Option<[usize; 2]>) -> Option<[[f64; 2]; 2]> {
+    p.map(|p| {
+        [
+            [rotor.stiffness[(p[0], p[0])], rotor.stiffness[(p[0], p[1])]],
+            [rotor.stiffness[(p[1], p[0])], rotor.stiffness[(p[1], p[1])]],
+        ]
+    })
+}
+
+/// x = A⁻¹ b for a 2 × 2 matrix (zero if singular).
+fn solve2(a: &[[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
+    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    if det == 0.0 || !det.is_finite() {
+        return [0.0, 0.0];
+    }
+    [
+        (a[1][1] * b[0] - a[0][1] * b[1]) / det,
+        (-a[1][0] * b[0] + a[0][0] * b[1]) / det,
+    ]
+}
+
+/// Least-squares straight lines x(z) = a + b z, y(z) = a + b z through the journal positions:
+/// [(a_x, b_x), (a_y, b_y)].
+fn rigid_fit(points: &[(f64, [f64; 2])]) -> [(f64, f64); 2] {
+    let n = points.len() as f64;
+    if points.is_empty() {
+        return [(0.0, 0.0); 2];
+    }
+    let zm = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let szz: f64 = points.iter().map(|p| (p.0 - zm).powi(2)).sum();
+    let mut out = [(0.0, 0.0); 2];
+    for (plane, o) in out.iter_mut().enumerate() {
+        let vm = points.iter().map(|p| p.1[plane]).sum::<f64>() / n;
+        let slope = if szz > 0.0 {
+            points
+                .iter()
+                .map(|p| (p.0 - zm) * (p.1[plane] - vm))
+                .sum::<f64>()
+                / szz
+        } else {
+            0.0
+        };
+        *o = (vm - slope * zm, slope);
+    }
+    out
+}
