@@ -7,6 +7,7 @@
 pub mod cli;
 pub mod dynamics;
 pub mod film;
+pub mod monitor;
 pub mod plot;
 pub mod rotor;
 pub mod units;

@@ -87,6 +87,62 @@ impl BandMatrix {
     }
 }
 
+impl BandMatrix {
+    /// Solves L Lᵀ X = R for four right-hand sides at once, stored interleaved (`x[k]` holds row
+    /// k of all four): one sweep over the factor serves all four, and the four independent
+    /// chains overlap in the pipeline.
+    pub(crate) fn solve4(&self, x: &mut [[f64; 4]]) {
+        let (n, d) = (self.n, &self.data);
+        match self.b + 1 {
+            9 => solve4_width(d, n, 9, x),
+            10 => solve4_width(d, n, 10, x),
+            11 => solve4_width(d, n, 11, x),
+            12 => solve4_width(d, n, 12, x),
+            w => solve4_width(d, n, w, x),
+        }
+    }
+}
+
+#[inline(always)]
+fn solve4_width(data: &[f64], n: usize, w: usize, x: &mut [[f64; 4]]) {
+    let x = &mut x[..n];
+    for (k, col) in data.chunks_exact(w).take(n).enumerate() {
+        let (done, rest) = x.split_at_mut(k + 1);
+        let inv = col[0];
+        let yk = done[k].map(|v| v * inv);
+        done[k] = yk;
+        for (xi, &l) in rest.iter_mut().zip(&col[1..]) {
+            for r in 0..4 {
+                xi[r] -= l * yk[r];
+            }
+        }
+    }
+    for k in (0..n).rev() {
+        let col = &data[k * w..(k + 1) * w];
+        let (head, rest) = x.split_at_mut(k + 1);
+        // two partial sums halve the dependency chain of the reduction
+        let (mut s0, mut s1) = ([0.0; 4], [0.0; 4]);
+        let band = &col[1..];
+        let mut pairs = rest.chunks_exact(2).zip(band.chunks_exact(2));
+        for (xs, ls) in &mut pairs {
+            for r in 0..4 {
+                s0[r] += ls[0] * xs[0][r];
+                s1[r] += ls[1] * xs[1][r];
+            }
+        }
+        let m = rest.len().min(band.len());
+        if m % 2 == 1 {
+            for r in 0..4 {
+                s0[r] += band[m - 1] * rest[m - 1][r];
+            }
+        }
+        let inv = col[0];
+        for r in 0..4 {
+            head[k][r] = (head[k][r] - s0[r] - s1[r]) * inv;
+        }
+    }
+}
+
 /// Band Cholesky of `n` columns of width `w` = b + 1 (see [`BandMatrix`]).
 #[inline(always)]
 fn factor_width(data: &mut [f64], n: usize, w: usize) -> bool {

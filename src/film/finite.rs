@@ -76,10 +76,13 @@ pub struct FiniteFilm {
     folded_columns: Vec<u32>,
     band: BandMatrix,
     rhs: Vec<f64>,
-    /// Right-hand sides / solutions of the four perturbation equations (x, y, ẋ, ẏ).
-    perturbation: [Vec<f64>; 4],
+    /// Right-hand sides / solutions of the four perturbation equations (x, y, ẋ, ẏ), interleaved.
+    perturbation: Vec<[f64; 4]>,
     /// True once a solve has left an active set to start from.
     warm: bool,
+    /// The dimensionless state (X, Y, Ẋ, Ẏ) of the last solve whose pressure sensitivities
+    /// ∂Π/∂(X, Y, Ẋ, Ẏ) are in `perturbation` (in that solve's slot order), if any.
+    sensitivity_base: Option<[f64; 4]>,
     /// Active-set passes taken by the last solve.
     last_passes: usize,
     /// Unknowns in the last factored system (free nodes).
@@ -142,8 +145,9 @@ impl FiniteFilm {
             folded_columns,
             band: BandMatrix::with_capacity(nodes, 2 * nz + 1),
             rhs: vec![0.0; nodes],
-            perturbation: std::array::from_fn(|_| vec![0.0; nodes]),
+            perturbation: vec![[0.0; 4]; nodes],
             warm: false,
+            sensitivity_base: None,
             last_passes: 0,
             n_free: 0,
             geometry,
@@ -173,6 +177,29 @@ impl FiniteFilm {
     /// Forgets the previous pressure zone: the next solve starts cold.
     pub fn reset_warm_start(&mut self) {
         self.warm = false;
+        self.sensitivity_base = None;
+    }
+
+    /// Predicts the pressure zone of the state `now` (X, Y, Ẋ, Ẏ, dimensionless) from the last
+    /// solve's pressure and its sensitivities, Π ≈ Π₀ + Σ ∂Π/∂q Δq, and updates the active set
+    /// with it: the first pass then usually lands on the final zone.
+    fn predict_active_set(&mut self, now: [f64; 4]) {
+        let Some(base) = self.sensitivity_base else {
+            return;
+        };
+        let dq = [
+            now[0] - base[0],
+            now[1] - base[1],
+            now[2] - base[2],
+            now[3] - base[3],
+        ];
+        let nz = self.grid.n_z;
+        for r in 0..self.n_free {
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
+            let s = &self.perturbation[r];
+            self.pi[i * nz + j] += s[0] * dq[0] + s[1] * dq[1] + s[2] * dq[2] + s[3] * dq[3];
+        }
+        self.update_active_set();
     }
 
     /// Pressure at node (`i` around, `j` from mid-plane to edge) of the last solve (Pa).
@@ -453,20 +480,33 @@ impl FiniteFilm {
                 g_east * ce * d_east + g_west * cw * d_west + g_axial * self.cos_node[i] * d_axial;
             by +=
                 g_east * se * d_east + g_west * sw * d_west + g_axial * self.sin_node[i] * d_axial;
-            rhs[0][r] = bx;
-            rhs[1][r] = by;
             // ∂b/∂Ẋ = −V·2·∂Ḣ/∂Ẋ = 2 V cos θ
-            rhs[2][r] = 2.0 * volume * self.cos_node[i];
-            rhs[3][r] = 2.0 * volume * self.sin_node[i];
+            rhs[r] = [
+                bx,
+                by,
+                2.0 * volume * self.cos_node[i],
+                2.0 * volume * self.sin_node[i],
+            ];
         }
+        self.band.solve4(&mut rhs[..n]);
+        // ∂F/∂Q_q = −2R² p_s Δθ Σ_free w_j ∂Π/∂Q_q (cos θ_i, sin θ_i)
         let mut derivative = [[0.0; 2]; 4];
-        for (q, v) in rhs.iter_mut().enumerate() {
-            self.band.solve(&mut v[..n]);
-            let v: &[f64] = v;
-            derivative[q] = self.force_from(|k| match self.slot[k] {
-                NOT_FREE => 0.0,
-                s => v[s as usize],
-            });
+        for (r, v) in rhs[..n].iter().enumerate() {
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
+            let (wc, ws) = (
+                self.row_width(j) * self.cos_node[i],
+                self.row_width(j) * self.sin_node[i],
+            );
+            for q in 0..4 {
+                derivative[q][0] += wc * v[q];
+                derivative[q][1] += ws * v[q];
+            }
+        }
+        let radius = self.geometry.radius_m();
+        let scale = -2.0 * radius * radius * self.pressure_scale * self.dtheta;
+        for d in &mut derivative {
+            d[0] *= scale;
+            d[1] *= scale;
         }
         self.perturbation = rhs;
         // k_ij = −∂F_i/∂q_j = −(1/c) ∂F_i/∂Q_j
@@ -494,7 +534,22 @@ impl FilmModel for FiniteFilm {
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
         kin.validate(self.geometry.radial_clearance_m)?;
         self.update_film_shape(kin);
-        self.solve_complementarity()?;
+        let c = self.geometry.radial_clearance_m;
+        let now = [
+            kin.position_m[0] / c,
+            kin.position_m[1] / c,
+            kin.velocity_m_s[0] / c,
+            kin.velocity_m_s[1] / c,
+        ];
+        if self.warm {
+            self.predict_active_set(now);
+        }
+        self.sensitivity_base = None;
+        let solved = self.solve_complementarity();
+        if solved.is_err() {
+            self.sensitivity_base = None;
+        }
+        solved?;
         Ok(self.outputs(kin.speed_rad_s))
     }
 
@@ -503,7 +558,15 @@ impl FilmModel for FiniteFilm {
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
         let result = self.solve(kin)?;
-        Ok((result, self.perturbation_coefficients(kin.speed_rad_s)))
+        let coefficients = self.perturbation_coefficients(kin.speed_rad_s);
+        let c = self.geometry.radial_clearance_m;
+        self.sensitivity_base = Some([
+            kin.position_m[0] / c,
+            kin.position_m[1] / c,
+            kin.velocity_m_s[0] / c,
+            kin.velocity_m_s[1] / c,
+        ]);
+        Ok((result, coefficients))
     }
 
     fn midplane_pressure(&self, out: &mut [f64]) {

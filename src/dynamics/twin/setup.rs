@@ -6,6 +6,7 @@ use crate::dynamics::linear::{SparseRows, StepFactor};
 use crate::dynamics::{BearingState, Coupling, ProbeState, StepOutput, TwinConfig, TwinError};
 use crate::film::equilibrium_under_load;
 use crate::rotor::{static_solution, BearingModel, Rotor};
+use faer::linalg::solvers::Solve;
 use faer::Mat;
 
 impl Twin {
@@ -152,7 +153,14 @@ impl Twin {
             q_full[4 * node + 2] += -fit[1].1; // θx = −dy/dz
             q_full[4 * node + 3] += fit[0].1; // θy = dx/dz
         }
-        let q: Vec<f64> = full_of.iter().map(|&d| q_full[d]).collect();
+        let mut q: Vec<f64> = full_of.iter().map(|&d| q_full[d]).collect();
+        // start on the synchronous orbit of the linearised system, so that only the nonlinear
+        // part of the response has to settle
+        let (response, velocity, acceleration) =
+            synchronous_response(rotor, &reduced_of, &m, &c, &g, &k, &links, speed_rad_s);
+        for i in 0..n {
+            q[i] += response[i];
+        }
 
         let mut factors = Vec::new();
         for level in 0..3 {
@@ -178,8 +186,8 @@ impl Twin {
             angle_rad: 0.0,
             speed_rad_s,
             q,
-            qd: vec![0.0; n],
-            qdd: vec![0.0; n],
+            qd: velocity,
+            qdd: acceleration,
         };
         let output = StepOutput {
             bearings: vec![BearingState::default(); links.len()],
@@ -221,6 +229,76 @@ impl Twin {
         twin.fill_output(0, 1);
         Ok(twin)
     }
+}
+
+/// The steady 1X unbalance response of the system linearised about the static equilibrium
+/// (film coefficients there): (K_t − Ω²M + iΩ C_t) Q = F_u, solved in real form. Returns
+/// displacement, velocity and acceleration at rotor angle 0 (reduced DOFs). Zeros if singular.
+#[allow(clippy::too_many_arguments)]
+fn synchronous_response(
+    rotor: &Rotor,
+    reduced_of: &[usize],
+    m: &Mat<f64>,
+    c: &Mat<f64>,
+    g: &Mat<f64>,
+    k: &Mat<f64>,
+    links: &[BearingLink],
+    speed: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = m.nrows();
+    let mut kt = k.clone();
+    let mut ct = Mat::<f64>::from_fn(n, n, |i, j| c[(i, j)] + speed * g[(i, j)]);
+    for l in links {
+        if let Some(r) = l.linear_reference {
+            add_relative_block(
+                &mut kt,
+                l.journal,
+                l.pedestal,
+                &r.coefficients.stiffness_n_per_m,
+            );
+            add_relative_block(
+                &mut ct,
+                l.journal,
+                l.pedestal,
+                &r.coefficients.damping_n_s_per_m,
+            );
+        }
+    }
+    // [A_r −A_i; A_i A_r], A_r = K_t − Ω²M, A_i = Ω C_t
+    let a = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| {
+        let (ii, jj) = (i % n, j % n);
+        let ar = kt[(ii, jj)] - speed * speed * m[(ii, jj)];
+        let ai = speed * ct[(ii, jj)];
+        match (i < n, j < n) {
+            (true, true) | (false, false) => ar,
+            (true, false) => -ai,
+            (false, true) => ai,
+        }
+    });
+    let mut f = Mat::<f64>::zeros(2 * n, 1);
+    for u in &rotor.unbalance {
+        let amp = u.magnitude_kg_m * speed * speed;
+        let (s, co) = u.phase_rad.sin_cos();
+        // x = Re(F e^{iΩt}) with F_x = A e^{iφ}; y = sin(Ωt+φ) → F_y = −i A e^{iφ}
+        let (rx, ry) = (reduced_of[4 * u.node], reduced_of[4 * u.node + 1]);
+        if rx != HELD {
+            f[(rx, 0)] += amp * co;
+            f[(n + rx, 0)] += amp * s;
+        }
+        if ry != HELD {
+            f[(ry, 0)] += amp * s;
+            f[(n + ry, 0)] -= amp * co;
+        }
+    }
+    let x = a.partial_piv_lu().solve(&f);
+    let ok = (0..2 * n).all(|i| x[(i, 0)].is_finite());
+    let re = |i: usize| if ok { x[(i, 0)] } else { 0.0 };
+    let im = |i: usize| if ok { x[(n + i, 0)] } else { 0.0 };
+    (
+        (0..n).map(re).collect(),
+        (0..n).map(|i| -speed * im(i)).collect(),
+        (0..n).map(|i| -speed * speed * re(i)).collect(),
+    )
 }
 
 fn validate_config(c: &TwinConfig) -> Result<(), TwinError> {
