@@ -10,4 +10,5 @@ pub mod film;
 pub mod monitor;
 pub mod plot;
 pub mod rotor;
+pub mod transient;
 pub mod units;

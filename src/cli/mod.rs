@@ -3,6 +3,7 @@
 mod bearing;
 mod bench;
 mod modes;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 
@@ -20,6 +21,10 @@ enum Command {
     Bearing(bearing::BearingArgs),
     /// Linear rotordynamics: natural frequencies, Campbell diagram, stability threshold.
     Modes(modes::ModesArgs),
+    /// Nonlinear transient at constant speed: orbits, spectrum, instability classification.
+    Simulate(simulate::SimulateArgs),
+    /// Amplitude–speed characteristic: a transient at each speed, in parallel.
+    Sweep(simulate::SweepArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
 }
@@ -29,6 +34,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bearing(args)) => bearing::run(&args),
         Some(Command::Modes(args)) => modes::run(&args),
+        Some(Command::Simulate(args)) => simulate::run_simulate(&args),
+        Some(Command::Sweep(args)) => simulate::run_sweep(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         None => bearing::run(&bearing::BearingArgs::default_bearing()),
     }

@@ -199,6 +199,63 @@ impl Monitor {
         &self.report
     }
 
+    /// Sample counts of the last `revs` completed revolutions, summed (capped by what is stored).
+    fn recent_samples(&self, revs: usize) -> usize {
+        self.rev_lengths
+            .iter()
+            .rev()
+            .take(revs)
+            .sum::<usize>()
+            .min(self.len)
+    }
+
+    /// The orbit `[x, y]` (m) of bearing `bearing` over the last `revs` revolutions, oldest
+    /// first (allocates: for reports and plots).
+    pub fn recent_orbit(&self, bearing: usize, revs: usize) -> Vec<[f64; 2]> {
+        let n = self.recent_samples(revs);
+        let h = &self.bearings[bearing];
+        (0..n)
+            .rev()
+            .map(|back| {
+                let i = (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+                [h.x[i], h.y[i]]
+            })
+            .collect()
+    }
+
+    /// The mid-plane pressure profiles (Pa, PRESSURE_POINTS angles each) of bearing `bearing`
+    /// over the last `revs` revolutions, oldest first (allocates).
+    pub fn recent_pressure(&self, bearing: usize, revs: usize) -> Vec<Vec<f64>> {
+        let n = self.recent_samples(revs);
+        let h = &self.bearings[bearing];
+        (0..n)
+            .rev()
+            .map(|back| {
+                let i = (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+                h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS].to_vec()
+            })
+            .collect()
+    }
+
+    /// The order spectrum of bearing `bearing` over the window, orders 1/16 … 2 (allocates).
+    pub fn full_spectrum(&self, bearing: usize) -> Vec<OrderComponent> {
+        let window = self.recent_samples(SPECTRUM_REVOLUTIONS);
+        let h = &self.bearings[bearing];
+        let idx = |back: usize| (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+        let mut out = vec![OrderComponent::default(); 2 * SPECTRUM_REVOLUTIONS];
+        if window > 0 {
+            order_spectrum(
+                (0..window).map(|k| h.x[idx(window - 1 - k)]),
+                (0..window).map(|k| h.y[idx(window - 1 - k)]),
+                (0..window).map(|k| self.angle[idx(window - 1 - k)]),
+                window,
+                SPECTRUM_REVOLUTIONS,
+                &mut out,
+            );
+        }
+        out
+    }
+
     /// Records the twin's last step; returns the new report when a revolution was completed.
     pub fn record(&mut self, twin: &Twin) -> Option<&RevolutionReport> {
         let out: &StepOutput = twin.output();

@@ -1,0 +1,466 @@
+//! `rotor-twin simulate` and `rotor-twin sweep`: nonlinear transients at constant speed.
+
+use crate::dynamics::Coupling;
+use crate::film::FilmGrid;
+use crate::monitor::RotorState;
+use crate::rotor::{MachineDescription, Rotor};
+use crate::transient::{run_transient, TransientResult, TransientSpec};
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum ModelArg {
+    /// Constant coefficients at the static equilibrium.
+    Linear,
+    /// Reynolds film force at every Newton iteration (the reference).
+    Nonlinear,
+    /// One film solve a step, relaxed coefficients (seed eq. 8).
+    Prehistory,
+}
+
+/// Options shared by `simulate` and `sweep`.
+#[derive(Debug, Clone, Args)]
+pub(crate) struct RunOptions {
+    /// Machine description (YAML); the built-in ORC microturbine if absent.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Revolutions to simulate.
+    #[arg(long, default_value_t = 200)]
+    revs: usize,
+    /// Bearing coupling.
+    #[arg(long, value_enum, default_value_t = ModelArg::Nonlinear)]
+    model: ModelArg,
+    /// Prehistory relaxation factor δ in (0, 1].
+    #[arg(long, default_value_t = 0.5)]
+    delta: f64,
+    /// Time steps per revolution.
+    #[arg(long, default_value_t = 128)]
+    steps_per_rev: usize,
+    /// Film grid NTHxNZ for every finite film bearing (default: the machine file's).
+    #[arg(long, value_parser = FilmGrid::parse)]
+    grid: Option<FilmGrid>,
+}
+
+impl RunOptions {
+    fn coupling(&self) -> anyhow::Result<Coupling> {
+        Ok(match self.model {
+            ModelArg::Linear => Coupling::Linear,
+            ModelArg::Nonlinear => Coupling::Nonlinear,
+            ModelArg::Prehistory => {
+                anyhow::ensure!(
+                    self.delta.is_finite() && self.delta > 0.0 && self.delta <= 1.0,
+                    "invalid --delta {}: the relaxation factor must lie in (0, 1]",
+                    self.delta
+                );
+                Coupling::Prehistory { delta: self.delta }
+            }
+        })
+    }
+
+    fn machine(&self) -> anyhow::Result<(MachineDescription, Rotor)> {
+        let desc = match &self.config {
+            Some(p) => MachineDescription::from_file(p)?,
+            None => MachineDescription::builtin_default(),
+        };
+        let rotor = Rotor::from_description(&desc);
+        Ok((desc, rotor))
+    }
+
+    fn spec(&self, speed_rpm: f64) -> anyhow::Result<TransientSpec> {
+        anyhow::ensure!(
+            speed_rpm.is_finite() && speed_rpm > 0.0,
+            "invalid speed {speed_rpm} rpm: must be finite and above zero"
+        );
+        Ok(TransientSpec {
+            speed_rpm,
+            revolutions: self.revs,
+            coupling: self.coupling()?,
+            steps_per_rev: self.steps_per_rev,
+            grid: self.grid,
+        })
+    }
+}
+
+/// A nonlinear transient at constant speed: orbits, spectrum, classification.
+#[derive(Debug, Clone, Args)]
+pub struct SimulateArgs {
+    /// Speed (rpm).
+    #[arg(long)]
+    speed_rpm: f64,
+    #[command(flatten)]
+    options: RunOptions,
+    /// Write orbit, spectrum and pressure-map SVGs of each bearing into this directory.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One bearing in the `--json` report.
+#[derive(Debug, Serialize)]
+struct BearingSummary {
+    name: String,
+    orbit_pp_x_m: f64,
+    orbit_pp_y_m: f64,
+    max_eccentricity_ratio: f64,
+    one_x_amplitude_m: f64,
+    one_x_phase_deg: f64,
+    subsync_ratio: f64,
+    subsync_amplitude_m: f64,
+    max_pressure_pa: f64,
+    rev_to_rev_orbit_diff: f64,
+    rev_to_rev_pressure_diff: f64,
+    state: RotorState,
+}
+
+/// The `--json` report of `simulate`.
+#[derive(Debug, Serialize)]
+struct SimulateReport {
+    machine: String,
+    speed_rpm: f64,
+    model: ModelArg,
+    delta: Option<f64>,
+    revs: usize,
+    steps_per_rev: usize,
+    state: RotorState,
+    evidence: String,
+    rev_to_rev_orbit_diff: f64,
+    rev_to_rev_pressure_diff: f64,
+    wall_time_s: f64,
+    simulated_time_s: f64,
+    real_time_factor: f64,
+    newton_iterations_per_step: f64,
+    max_substeps: usize,
+    bearings: Vec<BearingSummary>,
+}
+
+fn summarise(
+    desc: &MachineDescription,
+    args: &SimulateArgs,
+    r: &TransientResult,
+) -> SimulateReport {
+    let rep = &r.report;
+    SimulateReport {
+        machine: desc.name.clone(),
+        speed_rpm: args.speed_rpm,
+        model: args.options.model,
+        delta: (args.options.model == ModelArg::Prehistory).then_some(args.options.delta),
+        revs: args.options.revs,
+        steps_per_rev: args.options.steps_per_rev,
+        state: rep.state,
+        evidence: rep.evidence(),
+        rev_to_rev_orbit_diff: rep.rev_to_rev_orbit_diff,
+        rev_to_rev_pressure_diff: rep.rev_to_rev_pressure_diff,
+        wall_time_s: r.wall_time_s,
+        simulated_time_s: r.simulated_s,
+        real_time_factor: r.real_time_factor(),
+        newton_iterations_per_step: r.newton_iterations as f64 / r.steps.max(1) as f64,
+        max_substeps: r.max_substeps,
+        bearings: rep
+            .bearings
+            .iter()
+            .zip(&r.bearing_names)
+            .map(|(b, name)| BearingSummary {
+                name: name.clone(),
+                orbit_pp_x_m: b.orbit_pp_x_m,
+                orbit_pp_y_m: b.orbit_pp_y_m,
+                max_eccentricity_ratio: b.max_eccentricity_ratio,
+                one_x_amplitude_m: b.one_x_amplitude_m,
+                one_x_phase_deg: b.one_x_phase_rad.to_degrees(),
+                subsync_ratio: b.subsync_ratio,
+                subsync_amplitude_m: b.subsync_amplitude_m,
+                max_pressure_pa: b.max_pressure_pa,
+                rev_to_rev_orbit_diff: b.orbit_diff,
+                rev_to_rev_pressure_diff: b.pressure_diff,
+                state: b.state,
+            })
+            .collect(),
+    }
+}
+
+pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
+    let (desc, rotor) = args.options.machine()?;
+    let spec = args.options.spec(args.speed_rpm)?;
+    let result = run_transient(&rotor, &spec).context("transient")?;
+    if let Some(dir) = &args.plot {
+        write_plots(dir, &result)
+            .with_context(|| format!("writing plots into {}", dir.display()))?;
+    }
+    let report = summarise(&desc, args, &result);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "rotor-twin simulate: {} at {:.0} rpm, {:?} coupling{}, {} revolutions × {} steps",
+            report.machine,
+            report.speed_rpm,
+            report.model,
+            report
+                .delta
+                .map_or(String::new(), |d| format!(" (δ = {d})")),
+            report.revs,
+            report.steps_per_rev
+        );
+        println!("  state: {:?} — {}", report.state, report.evidence);
+        println!(
+            "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}",
+            report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff
+        );
+        for b in &report.bearings {
+            println!(
+                "  {:<22} orbit p-p {:6.2} × {:6.2} µm, max ε {:.3}, 1X {:6.2} µm @ {:6.1}°, sub-sync {:6.2} µm @ {:.3}X, p_max {:.3} MPa",
+                b.name,
+                b.orbit_pp_x_m * 1e6,
+                b.orbit_pp_y_m * 1e6,
+                b.max_eccentricity_ratio,
+                b.one_x_amplitude_m * 1e6,
+                b.one_x_phase_deg,
+                b.subsync_amplitude_m * 1e6,
+                b.subsync_ratio,
+                b.max_pressure_pa * 1e-6
+            );
+        }
+        println!(
+            "  {:.3} s simulated in {:.2} s: real-time factor {:.3}; {:.2} Newton iterations a step",
+            report.simulated_time_s, report.wall_time_s, report.real_time_factor, report.newton_iterations_per_step
+        );
+    }
+    Ok(())
+}
+
+fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    for (i, name) in r.bearing_names.iter().enumerate() {
+        crate::plot::orbit_svg(
+            &dir.join(format!("orbit_{name}.svg")),
+            &format!("orbit: {name}"),
+            &r.orbits[i],
+            r.clearances_m[i],
+        )?;
+        crate::plot::spectrum_svg(
+            &dir.join(format!("spectrum_{name}.svg")),
+            &format!("full spectrum: {name}"),
+            &r.spectra[i],
+        )?;
+        crate::plot::pressure_map_svg(
+            &dir.join(format!("pressure_{name}.svg")),
+            &format!("mid-plane pressure: {name}"),
+            &r.pressure_maps[i],
+        )?;
+    }
+    Ok(())
+}
+
+/// Amplitude–speed characteristic: a transient at each speed, in parallel.
+#[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
+pub struct SweepArgs {
+    /// Lowest speed (rpm).
+    #[arg(long)]
+    from_rpm: f64,
+    /// Highest speed (rpm).
+    #[arg(long)]
+    to_rpm: f64,
+    /// Speed step (rpm).
+    #[arg(long)]
+    step_rpm: f64,
+    #[command(flatten)]
+    options: RunOptions,
+    /// Directory for sweep.csv and sweep.svg.
+    #[arg(long, default_value = "sweep")]
+    out: PathBuf,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Serialize)]
+struct SweepPoint {
+    speed_rpm: f64,
+    state: RotorState,
+    max_eccentricity_ratio: f64,
+    subsync_ratio: f64,
+    bearings: Vec<[f64; 3]>,
+}
+
+#[derive(Debug, Serialize)]
+struct SweepReport {
+    machine: String,
+    model: ModelArg,
+    onset_speed_rpm: Option<f64>,
+    points: Vec<SweepPoint>,
+    csv: String,
+    svg: String,
+}
+
+pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
+    for (name, v) in [
+        ("--from-rpm", args.from_rpm),
+        ("--to-rpm", args.to_rpm),
+        ("--step-rpm", args.step_rpm),
+    ] {
+        anyhow::ensure!(
+            v.is_finite() && v > 0.0,
+            "invalid {name} {v}: must be a finite speed above zero"
+        );
+    }
+    anyhow::ensure!(
+        args.to_rpm >= args.from_rpm,
+        "invalid --to-rpm {}: below --from-rpm {}",
+        args.to_rpm,
+        args.from_rpm
+    );
+    let count = ((args.to_rpm - args.from_rpm) / args.step_rpm).round() as usize + 1;
+    anyhow::ensure!(
+        count <= 500,
+        "invalid --step-rpm {}: more than 500 speeds",
+        args.step_rpm
+    );
+    let (desc, rotor) = args.options.machine()?;
+    let speeds: Vec<f64> = (0..count)
+        .map(|k| (args.from_rpm + k as f64 * args.step_rpm).min(args.to_rpm))
+        .collect();
+    let specs = speeds
+        .iter()
+        .map(|&s| args.options.spec(s))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(count);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<std::sync::Mutex<Option<anyhow::Result<TransientResult>>>> =
+        (0..count).map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                if k >= count {
+                    break;
+                }
+                let r = run_transient(&rotor, &specs[k]).map_err(anyhow::Error::from);
+                *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+                let bar = "#".repeat(30 * d / count);
+                eprint!("\rsweep [{bar:<30}] {d}/{count} speeds");
+            });
+        }
+    });
+    eprintln!();
+    let mut points = Vec::new();
+    let mut series: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    for (k, slot) in results.into_iter().enumerate() {
+        let r = slot
+            .into_inner()
+            .unwrap_or_else(|e| e.into_inner())
+            .unwrap_or_else(|| Err(anyhow::anyhow!("not run")))
+            .with_context(|| format!("transient at {:.0} rpm", speeds[k]))?;
+        if series.is_empty() {
+            series = r
+                .bearing_names
+                .iter()
+                .map(|n| (n.clone(), Vec::new(), Vec::new()))
+                .collect();
+        }
+        let rep = &r.report;
+        for (s, b) in series.iter_mut().zip(&rep.bearings) {
+            s.1.push(0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m));
+            s.2.push(b.subsync_amplitude_m);
+        }
+        points.push(SweepPoint {
+            speed_rpm: speeds[k],
+            state: rep.state,
+            max_eccentricity_ratio: rep
+                .bearings
+                .iter()
+                .map(|b| b.max_eccentricity_ratio)
+                .fold(0.0, f64::max),
+            subsync_ratio: rep
+                .bearings
+                .iter()
+                .map(|b| b.subsync_ratio)
+                .fold(0.0, f64::max),
+            bearings: rep
+                .bearings
+                .iter()
+                .map(|b| {
+                    [
+                        0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m),
+                        b.subsync_amplitude_m,
+                        b.max_pressure_pa,
+                    ]
+                })
+                .collect(),
+        });
+    }
+    let onset_speed_rpm = points
+        .iter()
+        .find(|p| p.state != RotorState::Stable)
+        .map(|p| p.speed_rpm);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let csv_path = args.out.join("sweep.csv");
+    let svg_path = args.out.join("sweep.svg");
+    let mut csv = String::from("speed_rpm,state,max_eccentricity_ratio,subsync_ratio");
+    for (name, _, _) in &series {
+        csv.push_str(&format!(
+            ",{name}_amplitude_m,{name}_subsync_amplitude_m,{name}_max_pressure_pa"
+        ));
+    }
+    csv.push('\n');
+    for p in &points {
+        csv.push_str(
+            &format!(
+                "{},{:?},{},{}",
+                p.speed_rpm, p.state, p.max_eccentricity_ratio, p.subsync_ratio
+            )
+            .to_lowercase(),
+        );
+        for b in &p.bearings {
+            csv.push_str(&format!(",{},{},{}", b[0], b[1], b[2]));
+        }
+        csv.push('\n');
+    }
+    std::fs::write(&csv_path, csv).with_context(|| format!("writing {}", csv_path.display()))?;
+    crate::plot::sweep_svg(
+        &svg_path,
+        &format!("amplitude–speed characteristic: {}", desc.name),
+        &speeds,
+        &series,
+    )?;
+    let report = SweepReport {
+        machine: desc.name,
+        model: args.options.model,
+        onset_speed_rpm,
+        points,
+        csv: csv_path.display().to_string(),
+        svg: svg_path.display().to_string(),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "rotor-twin sweep: {} ({:?} coupling)",
+            report.machine, report.model
+        );
+        for p in &report.points {
+            println!(
+                "  {:>8.0} rpm  {:<8}  max ε {:.3}  sub-sync {:.3}X",
+                p.speed_rpm,
+                format!("{:?}", p.state),
+                p.max_eccentricity_ratio,
+                p.subsync_ratio
+            );
+        }
+        match report.onset_speed_rpm {
+            Some(s) => println!("  onset of instability: {s:.0} rpm"),
+            None => println!("  stable over the range"),
+        }
+        println!("  wrote {} and {}", report.csv, report.svg);
+    }
+    Ok(())
+}
