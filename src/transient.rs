@@ -50,12 +50,46 @@ pub struct TransientResult {
     pub newton_iterations: usize,
     /// Most substeps any step needed.
     pub max_substeps: usize,
+    /// The state vectors at the end (q, q̇, q̈ on the twin's reduced DOFs).
+    pub final_state: StateVectors,
 }
+
+/// Displacement, velocity and acceleration on the twin's reduced DOFs.
+pub type StateVectors = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 impl TransientResult {
     /// Simulated time over wall time.
     pub fn real_time_factor(&self) -> f64 {
         self.simulated_s / self.wall_time_s.max(1e-12)
+    }
+
+    /// Growth rate of the non-synchronous motion (1/rev): the least-squares slope of
+    /// ln(rev-to-rev orbit difference) over the last half of the run (at least 10 revolutions).
+    /// Negative: the motion settles; positive: it grows (linearly unstable, or not yet at its
+    /// limit cycle).
+    pub fn growth_per_rev(&self) -> f64 {
+        let n = self.history.len();
+        let take = (n / 2).max(10).min(n);
+        let pts: Vec<(f64, f64)> = self.history[n - take..]
+            .iter()
+            .filter(|r| r.rev_to_rev_orbit_diff > 0.0)
+            .map(|r| (r.revolution as f64, r.rev_to_rev_orbit_diff.ln()))
+            .collect();
+        if pts.len() < 3 {
+            return 0.0;
+        }
+        let m = pts.len() as f64;
+        let (mx, my) = (
+            pts.iter().map(|p| p.0).sum::<f64>() / m,
+            pts.iter().map(|p| p.1).sum::<f64>() / m,
+        );
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        if sxx > 0.0 {
+            sxy / sxx
+        } else {
+            0.0
+        }
     }
 }
 
@@ -74,6 +108,16 @@ pub fn with_grid(rotor: &Rotor, grid: Option<FilmGrid>) -> Rotor {
 
 /// Runs `spec` on `rotor` from its static equilibrium plus the linear synchronous orbit.
 pub fn run_transient(rotor: &Rotor, spec: &TransientSpec) -> Result<TransientResult, TwinError> {
+    run_transient_from(rotor, spec, None)
+}
+
+/// Runs `spec` on `rotor`, starting from `initial` state vectors if given (e.g. the end of an
+/// earlier run of the same machine), else as [`run_transient`].
+pub fn run_transient_from(
+    rotor: &Rotor,
+    spec: &TransientSpec,
+    initial: Option<&StateVectors>,
+) -> Result<TransientResult, TwinError> {
     if !(spec.speed_rpm.is_finite() && spec.speed_rpm > 0.0) {
         return Err(TwinError::InvalidInput {
             name: "speed (rpm)",
@@ -99,6 +143,9 @@ pub fn run_transient(rotor: &Rotor, spec: &TransientSpec) -> Result<TransientRes
     let omega = rpm_to_rad_s(spec.speed_rpm);
     let config = TwinConfig::with_steps_per_rev(spec.coupling, omega, spec.steps_per_rev);
     let mut twin = Twin::new(&rotor, config, omega)?;
+    if let Some((q, qd, qdd)) = initial {
+        twin.set_state_vectors(q, qd, qdd)?;
+    }
     let mut monitor = Monitor::new(&twin, spec.steps_per_rev + 2, ClassifierSettings::default());
     let mut history = Vec::with_capacity(spec.revolutions);
     let input = StepInput {
@@ -118,7 +165,10 @@ pub fn run_transient(rotor: &Rotor, spec: &TransientSpec) -> Result<TransientRes
     }
     let wall_time_s = start.elapsed().as_secs_f64();
     let n = twin.output().bearings.len();
+    let (q, qd, qdd) = twin.state_vectors();
+    let final_state = (q.to_vec(), qd.to_vec(), qdd.to_vec());
     Ok(TransientResult {
+        final_state,
         report: monitor.report().clone(),
         history,
         bearing_names: twin.bearing_names().map(str::to_string).collect(),

@@ -113,6 +113,7 @@ struct BearingSummary {
     subsync_amplitude_m: f64,
     max_pressure_pa: f64,
     rev_to_rev_orbit_diff: f64,
+    rev_to_rev_orbit_path_diff: f64,
     rev_to_rev_pressure_diff: f64,
     state: RotorState,
 }
@@ -130,6 +131,7 @@ struct SimulateReport {
     evidence: String,
     rev_to_rev_orbit_diff: f64,
     rev_to_rev_pressure_diff: f64,
+    growth_per_rev: f64,
     wall_time_s: f64,
     simulated_time_s: f64,
     real_time_factor: f64,
@@ -155,6 +157,7 @@ fn summarise(
         evidence: rep.evidence(),
         rev_to_rev_orbit_diff: rep.rev_to_rev_orbit_diff,
         rev_to_rev_pressure_diff: rep.rev_to_rev_pressure_diff,
+        growth_per_rev: r.growth_per_rev(),
         wall_time_s: r.wall_time_s,
         simulated_time_s: r.simulated_s,
         real_time_factor: r.real_time_factor(),
@@ -175,6 +178,7 @@ fn summarise(
                 subsync_amplitude_m: b.subsync_amplitude_m,
                 max_pressure_pa: b.max_pressure_pa,
                 rev_to_rev_orbit_diff: b.orbit_diff,
+                rev_to_rev_orbit_path_diff: b.orbit_path_diff,
                 rev_to_rev_pressure_diff: b.pressure_diff,
                 state: b.state,
             })
@@ -207,8 +211,8 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         );
         println!("  state: {:?} — {}", report.state, report.evidence);
         println!(
-            "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}",
-            report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff
+            "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}; growth {:+.4}/rev",
+            report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff, report.growth_per_rev
         );
         for b in &report.bearings {
             println!(
@@ -282,6 +286,7 @@ pub struct SweepArgs {
 struct SweepPoint {
     speed_rpm: f64,
     state: RotorState,
+    growth_per_rev: f64,
     max_eccentricity_ratio: f64,
     subsync_ratio: f64,
     bearings: Vec<[f64; 3]>,
@@ -374,6 +379,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         points.push(SweepPoint {
             speed_rpm: speeds[k],
             state: rep.state,
+            growth_per_rev: r.growth_per_rev(),
             max_eccentricity_ratio: rep
                 .bearings
                 .iter()
@@ -405,7 +411,8 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let csv_path = args.out.join("sweep.csv");
     let svg_path = args.out.join("sweep.svg");
-    let mut csv = String::from("speed_rpm,state,max_eccentricity_ratio,subsync_ratio");
+    let mut csv =
+        String::from("speed_rpm,state,growth_per_rev,max_eccentricity_ratio,subsync_ratio");
     for (name, _, _) in &series {
         csv.push_str(&format!(
             ",{name}_amplitude_m,{name}_subsync_amplitude_m,{name}_max_pressure_pa"

@@ -73,8 +73,13 @@ pub struct BearingRevolution {
     pub subsync_forward: bool,
     /// Largest film pressure in the last revolution (Pa).
     pub max_pressure_pa: f64,
-    /// RMS distance between the last two revolutions' orbits, over the clearance.
+    /// RMS distance between the last two revolutions' orbits, sample by sample, over the
+    /// clearance.
     pub orbit_diff: f64,
+    /// RMS distance from each point of the last revolution's orbit to the path traced in the two
+    /// revolutions before it, over the clearance: small when the journal repeats a closed path
+    /// (a limit cycle, even one that takes two revolutions), whatever the timing.
+    pub orbit_path_diff: f64,
     /// Relative L2 difference between the last two revolutions' mid-plane pressure fields.
     pub pressure_diff: f64,
     /// The journal touched the wall in the last revolution.
@@ -358,6 +363,24 @@ impl Monitor {
                 orbit_diff = f64::NAN;
                 pressure_diff = f64::NAN;
             }
+            // path distance: each point of the last revolution to the polyline of the two before
+            let mut path_diff = self.report.bearings[bi].orbit_path_diff;
+            if last > 1 && self.len >= 3 * last {
+                let mut sum = 0.0;
+                for back in 0..last {
+                    let p = idx(back);
+                    let (px, py) = (h.x[p], h.y[p]);
+                    let mut best = f64::MAX;
+                    for seg in last..3 * last - 1 {
+                        let (a, b) = (idx(seg), idx(seg + 1));
+                        best = best.min(point_segment_distance2(
+                            px, py, h.x[a], h.y[a], h.x[b], h.y[b],
+                        ));
+                    }
+                    sum += best;
+                }
+                path_diff = (sum / last as f64).sqrt() / c;
+            }
             // spectrum over the window (oldest first)
             let start = window;
             let xs = (0..window).map(|k| h.x[idx(start - 1 - k)]);
@@ -429,6 +452,7 @@ impl Monitor {
                 subsync_forward: self.spectrum[kbest].forward_m >= self.spectrum[kbest].backward_m,
                 max_pressure_pa: p,
                 // not comparable (speed changed within a revolution): keep the last value
+                orbit_path_diff: path_diff,
                 orbit_diff: if orbit_diff.is_finite() {
                     orbit_diff
                 } else {
@@ -450,4 +474,17 @@ impl Monitor {
         self.report.rev_to_rev_orbit_diff = od;
         self.report.rev_to_rev_pressure_diff = pd;
     }
+}
+
+/// Squared distance from point (px, py) to the segment (ax, ay)–(bx, by).
+fn point_segment_distance2(px: f64, py: f64, ax: f64, ay: f64, bx: f64, by: f64) -> f64 {
+    let (dx, dy) = (bx - ax, by - ay);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((px - ax) * dx + (py - ay) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (cx, cy) = (ax + t * dx - px, ay + t * dy - py);
+    cx * cx + cy * cy
 }

@@ -75,6 +75,43 @@ impl Twin {
         &self.config
     }
 
+    /// The state vectors on the reduced DOFs (all but rigid bearings' journals): displacement
+    /// q (m, rad), velocity q̇ and acceleration q̈.
+    pub fn state_vectors(&self) -> (&[f64], &[f64], &[f64]) {
+        (&self.state.q, &self.state.qd, &self.state.qdd)
+    }
+
+    /// Sets the state vectors (same layout as [`state_vectors`](Self::state_vectors)); time,
+    /// angle and speed stay. Refused if a length differs or a value is not finite.
+    pub fn set_state_vectors(
+        &mut self,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+    ) -> Result<(), TwinError> {
+        let n = self.state.q.len();
+        for (name, v) in [("displacement", q), ("velocity", qd), ("acceleration", qdd)] {
+            if v.len() != n {
+                return Err(TwinError::Setup(format!(
+                    "{name} vector has {} entries, the model {n}",
+                    v.len()
+                )));
+            }
+            if let Some(bad) = v.iter().find(|x| !x.is_finite()) {
+                return Err(TwinError::InvalidInput {
+                    name: "state vector entry",
+                    value: *bad,
+                    rule: "must be finite",
+                });
+            }
+        }
+        self.state.q.copy_from_slice(q);
+        self.state.qd.copy_from_slice(qd);
+        self.state.qdd.copy_from_slice(qdd);
+        self.fill_output(0, 1);
+        Ok(())
+    }
+
     /// The last step's output (the initial state before the first step).
     pub fn output(&self) -> &StepOutput {
         &self.output
