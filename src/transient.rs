@@ -50,6 +50,8 @@ pub struct TransientResult {
     pub newton_iterations: usize,
     /// Most substeps any step needed.
     pub max_substeps: usize,
+    /// Prehistory: substeps that fell back to Newton.
+    pub prehistory_fallbacks: usize,
     /// The state vectors at the end (q, q̇, q̈ on the twin's reduced DOFs).
     pub final_state: StateVectors,
 }
@@ -152,13 +154,14 @@ pub fn run_transient_from(
         speed_rad_s: omega,
         accel_rad_s2: 0.0,
     };
-    let (mut steps, mut iterations, mut max_substeps) = (0, 0, 1);
+    let (mut steps, mut iterations, mut max_substeps, mut fallbacks) = (0, 0, 1, 0);
     let start = Instant::now();
     while history.len() < spec.revolutions {
         let out = twin.step(&input)?;
         steps += 1;
         iterations += out.newton_iterations;
         max_substeps = max_substeps.max(out.substeps);
+        fallbacks += out.prehistory_fallbacks;
         if let Some(r) = monitor.record(&twin) {
             history.push(r.clone());
         }
@@ -168,7 +171,6 @@ pub fn run_transient_from(
     let (q, qd, qdd) = twin.state_vectors();
     let final_state = (q.to_vec(), qd.to_vec(), qdd.to_vec());
     Ok(TransientResult {
-        final_state,
         report: monitor.report().clone(),
         history,
         bearing_names: twin.bearing_names().map(str::to_string).collect(),
@@ -181,5 +183,7 @@ pub fn run_transient_from(
         steps,
         newton_iterations: iterations,
         max_substeps,
+        prehistory_fallbacks: fallbacks,
+        final_state,
     })
 }

@@ -34,6 +34,8 @@ pub struct LinkEvaluation {
     pub stiffness: [[f64; 2]; 2],
     /// −∂F/∂ḋ (N·s/m).
     pub damping: [[f64; 2]; 2],
+    /// The film's own share of `stiffness` (the rest is the wall's) (N/m).
+    pub film_stiffness: [[f64; 2]; 2],
     /// The film solution.
     pub film: FilmResult,
     /// True if the journal was in contact with the wall.
@@ -83,13 +85,15 @@ impl BearingLink {
     }
 
     /// Film (and wall) force, stiffness and damping at relative position `d` (m), velocity `v`
-    /// (m/s) and speed `speed` (rad/s). Allocates nothing.
+    /// (m/s) and speed `speed` (rad/s). Without `with_coefficients` the film's coefficients are
+    /// not computed (left zero; the wall's still are). Allocates nothing.
     pub fn evaluate(
         &mut self,
         d: [f64; 2],
         v: [f64; 2],
         speed: f64,
         contact: &ContactModel,
+        with_coefficients: bool,
     ) -> Result<LinkEvaluation, FilmError> {
         let c = self.clearance_m;
         let e = d[0].hypot(d[1]);
@@ -105,11 +109,16 @@ impl BearingLink {
             velocity_m_s: v,
             speed_rad_s: speed,
         };
-        let (film, coef) = self.film.solve_with_coefficients(&kin)?;
+        let (film, coef) = if with_coefficients {
+            self.film.solve_with_coefficients(&kin)?
+        } else {
+            (self.film.solve(&kin)?, FilmCoefficients::default())
+        };
         let mut out = LinkEvaluation {
             force_n: film.force_n,
             stiffness: coef.stiffness_n_per_m,
             damping: coef.damping_n_s_per_m,
+            film_stiffness: coef.stiffness_n_per_m,
             film,
             contact: in_contact,
         };
@@ -128,6 +137,7 @@ impl BearingLink {
                             .sum::<f64>();
                 }
             }
+            out.film_stiffness = out.stiffness;
             // wall: radial spring beyond the onset, Coulomb friction against the surface sliding
             let penetration = e - onset;
             let normal = contact.wall_stiffness_n_per_m * penetration;
@@ -165,6 +175,7 @@ impl BearingLink {
             force_n: f,
             stiffness: k,
             damping: cc,
+            film_stiffness: k,
             film: self.last.film,
             contact: false,
         };

@@ -7,9 +7,11 @@
 //! - `Linear`: the seed's classical description, constant coefficients at the static equilibrium;
 //! - `Nonlinear`: the film force from the Reynolds solution at every Newton iteration, its
 //!   perturbation coefficients as the Jacobian (the reference);
-//! - `Prehistory { delta }`: seed eq. 8, one film solve per step at the predicted state, the film
-//!   force taken from it and the coefficients, relaxed as c(k+1) = δ c(k) + (1 − δ) c(k−1), carrying
-//!   the implicit correction (the reading the seed summary found consistent).
+//! - `Prehistory { delta }`: seed eq. 8 as the seed summary found it consistent: the film force is
+//!   the Reynolds force at every iteration, while the film coefficients, computed once a step and
+//!   relaxed as c(k+1) = δ c(k) + (1 − δ) c(k−1), serve as the iteration matrix. Iterated to the
+//!   same tolerance as `Nonlinear`; a step whose relaxed iteration does not converge falls back to
+//!   Newton and is counted (`prehistory_fallbacks`).
 
 mod bearing_link;
 mod linear;
@@ -30,7 +32,8 @@ pub enum Coupling {
     Linear,
     /// Film force from the Reynolds equation, Newton-iterated to convergence.
     Nonlinear,
-    /// One film solve per step, coefficients relaxed with factor `delta` (seed eq. 8).
+    /// Reynolds force each iteration, relaxed coefficients (factor `delta`, seed eq. 8) as the
+    /// iteration matrix.
     Prehistory {
         /// Relaxation factor δ in (0, 1]; 1 means no relaxation.
         delta: f64,
@@ -131,6 +134,9 @@ pub struct StepOutput {
     pub newton_iterations: usize,
     /// Substeps the step was split into (1 when it converged at once).
     pub substeps: usize,
+    /// Prehistory coupling: substeps whose relaxed-coefficient iteration did not converge and
+    /// fell back to Newton.
+    pub prehistory_fallbacks: usize,
 }
 
 /// Why a twin could not be built or a step not taken.

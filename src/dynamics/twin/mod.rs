@@ -66,6 +66,10 @@ pub struct Twin {
     jac: Vec<f64>,
     delta: Vec<f64>,
     raw: Vec<Option<FilmCoefficients>>,
+    /// prehistory: the relaxed film coefficients of the current step, per bearing
+    relaxed: Vec<FilmCoefficients>,
+    /// prehistory: substeps of the current step that fell back to Newton
+    fallbacks: usize,
     output: StepOutput,
 }
 
@@ -232,6 +236,7 @@ impl Twin {
         out.speed_rad_s = s.speed_rad_s;
         out.newton_iterations = iterations;
         out.substeps = substeps;
+        out.prehistory_fallbacks = self.fallbacks;
         for (b, link) in out.bearings.iter_mut().zip(&self.links) {
             let pos = |v: &[f64]| -> [f64; 2] {
                 let j = link.journal;

@@ -4,7 +4,7 @@ use super::{State, Twin, HELD};
 use crate::dynamics::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
 use crate::dynamics::linear::{SparseRows, StepFactor};
 use crate::dynamics::{BearingState, Coupling, ProbeState, StepOutput, TwinConfig, TwinError};
-use crate::film::equilibrium_under_load;
+use crate::film::{equilibrium_under_load, FilmCoefficients};
 use crate::rotor::{static_solution, BearingModel, Rotor};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
@@ -116,6 +116,7 @@ impl Twin {
                         force_n: eq.film.force_n,
                         stiffness: eq.coefficients.stiffness_n_per_m,
                         damping: eq.coefficients.damping_n_s_per_m,
+                        film_stiffness: eq.coefficients.stiffness_n_per_m,
                         film: eq.film,
                         contact: false,
                     };
@@ -208,6 +209,8 @@ impl Twin {
             unbalance: rotor.unbalance.clone(),
             external: vec![0.0; n],
             raw: vec![None; links.len()],
+            relaxed: vec![FilmCoefficients::default(); links.len()],
+            fallbacks: 0,
             links,
             b_dofs,
             factors,

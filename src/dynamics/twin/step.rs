@@ -30,6 +30,7 @@ impl Twin {
         self.refactor_if_needed(input.speed_rad_s);
         let start_speed = self.state.speed_rad_s;
         let mut iterations = 0;
+        self.fallbacks = 0;
         for level in 0..3 {
             let substeps = 1usize << level;
             let saved = self.state.clone();
@@ -132,12 +133,27 @@ impl Twin {
         }
 
         let max_iterations = match self.config.coupling {
-            Coupling::Nonlinear => self.config.max_newton_iterations,
-            Coupling::Linear | Coupling::Prehistory { .. } => 1,
+            Coupling::Nonlinear | Coupling::Prehistory { .. } => self.config.max_newton_iterations,
+            Coupling::Linear => 1,
         };
+        // prehistory iterates with its relaxed coefficients; if that does not converge, the
+        // step falls back to Newton (fresh coefficients each iteration) and says so
+        let prehistory = matches!(self.config.coupling, Coupling::Prehistory { .. });
+        let mut fallback = false;
         let mut iterations = 0;
+        let mut total_iterations = 0;
         let mut converged = false;
-        while iterations < max_iterations {
+        while iterations < max_iterations || (prehistory && !fallback) {
+            if iterations == max_iterations {
+                // restart from the predictor with Newton
+                fallback = true;
+                total_iterations += iterations;
+                iterations = 0;
+                for (r, &d) in self.b_dofs.iter().enumerate() {
+                    let s = &self.state;
+                    self.qb[r] = s.q[d] + h * s.qd[d] + 0.5 * h * h * s.qdd[d];
+                }
+            }
             iterations += 1;
             // bearing forces and their derivatives at the current iterate
             self.f_b.fill(0.0);
@@ -155,10 +171,14 @@ impl Twin {
                 let state = &self.state;
                 let d = rel(&|r| qb[r]);
                 let v = rel(&|r| a2 * (qb[r] - state.q[b_dofs[r]]) - state.qd[b_dofs[r]]);
+                // prehistory: the film coefficients are computed once a step (first iteration),
+                // relaxed by seed eq. 8 and kept as the iteration matrix; the force is the
+                // Reynolds force at every iteration
+                let fresh = !prehistory || iterations == 1 || fallback;
                 let mut ev = match self.config.coupling {
                     Coupling::Linear => link.evaluate_linear(d, v),
                     _ => link
-                        .evaluate(d, v, speed, &self.config.contact)
+                        .evaluate(d, v, speed, &self.config.contact, fresh)
                         .map_err(|source| {
                             Some(TwinError::Film {
                                 bearing: link.name.clone(),
@@ -167,21 +187,36 @@ impl Twin {
                             })
                         })?,
                 };
-                if let Coupling::Prehistory { delta } = self.config.coupling {
-                    // seed eq. 8: c(k+1) = δ c(k) + (1 − δ) c(k−1)
-                    let raw = FilmCoefficients {
-                        stiffness_n_per_m: ev.stiffness,
-                        damping_n_s_per_m: ev.damping,
-                    };
-                    self.raw[li] = Some(raw);
-                    if let Some(prev) = link.previous_raw {
-                        for i in 0..2 {
-                            for j in 0..2 {
-                                ev.stiffness[i][j] = delta * raw.stiffness_n_per_m[i][j]
-                                    + (1.0 - delta) * prev.stiffness_n_per_m[i][j];
-                                ev.damping[i][j] = delta * raw.damping_n_s_per_m[i][j]
-                                    + (1.0 - delta) * prev.damping_n_s_per_m[i][j];
+                if let (Coupling::Prehistory { delta }, false) = (self.config.coupling, fallback) {
+                    if fresh {
+                        // c(k+1) = δ c(k) + (1 − δ) c(k−1) on the film coefficients
+                        let raw = FilmCoefficients {
+                            stiffness_n_per_m: ev.film_stiffness,
+                            damping_n_s_per_m: ev.damping,
+                        };
+                        self.raw[li] = Some(raw);
+                        let mut relaxed = raw;
+                        if let Some(prev) = link.previous_raw {
+                            for i in 0..2 {
+                                for j in 0..2 {
+                                    relaxed.stiffness_n_per_m[i][j] = delta
+                                        * raw.stiffness_n_per_m[i][j]
+                                        + (1.0 - delta) * prev.stiffness_n_per_m[i][j];
+                                    relaxed.damping_n_s_per_m[i][j] = delta
+                                        * raw.damping_n_s_per_m[i][j]
+                                        + (1.0 - delta) * prev.damping_n_s_per_m[i][j];
+                                }
                             }
+                        }
+                        self.relaxed[li] = relaxed;
+                    }
+                    // the wall's stiffness (contact) is not a film coefficient: never relaxed
+                    let r = self.relaxed[li];
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            let wall = ev.stiffness[i][j] - ev.film_stiffness[i][j];
+                            ev.stiffness[i][j] = wall + r.stiffness_n_per_m[i][j];
+                            ev.damping[i][j] = r.damping_n_s_per_m[i][j];
                         }
                     }
                 }
@@ -245,7 +280,7 @@ impl Twin {
                 break;
             }
         }
-        if self.config.coupling == Coupling::Nonlinear && !converged {
+        if self.config.coupling != Coupling::Linear && !converged {
             return Err(None);
         }
 
@@ -277,7 +312,8 @@ impl Twin {
                 l.previous_raw = *r;
             }
         }
-        Ok(iterations)
+        self.fallbacks += usize::from(fallback);
+        Ok(iterations + total_iterations)
     }
 
     fn add_unbalance(&mut self, angle: f64, speed: f64, accel: f64) {
