@@ -122,7 +122,12 @@ fn stable_at_8000_whip_at_9000_and_converged_in_step_and_grid() {
     for delta in [0.5, 0.1, 0.02] {
         let p = run_transient(&rotor, &spec(8000.0, 100, Coupling::Prehistory { delta })).unwrap();
         let n = run_transient(&rotor, &spec(8000.0, 100, Coupling::Nonlinear)).unwrap();
-        println!("8000 rpm prehistory δ {delta}: amplitude {:.4} µm vs nonlinear {:.4} µm, fallbacks {}", amplitude(&p) * 1e6, amplitude(&n) * 1e6, p.prehistory_fallbacks);
+        println!(
+            "8000 rpm prehistory δ {delta}: amplitude {:.4} µm vs nonlinear {:.4} µm, fallbacks {}",
+            amplitude(&p) * 1e6,
+            amplitude(&n) * 1e6,
+            p.prehistory_fallbacks
+        );
         assert!((amplitude(&p) - amplitude(&n)).abs() < 1e-3 * amplitude(&n));
     }
     let p = cont(spec(9000.0, 6, Coupling::Prehistory { delta: 0.5 }));
@@ -141,13 +146,16 @@ fn stable_at_8000_whip_at_9000_and_converged_in_step_and_grid() {
 fn transient_onset_agrees_with_the_linear_threshold() {
     let rotor = orc();
     let statics = rotor_twin::rotor::static_solution(&rotor).unwrap();
-    let threshold = rotor_twin::rotor::stability_threshold(&rotor, &statics, 6000.0, 12000.0, 250.0)
-        .unwrap()
-        .unwrap()
-        .speed_rpm;
+    let threshold =
+        rotor_twin::rotor::stability_threshold(&rotor, &statics, 6000.0, 12000.0, 250.0)
+            .unwrap()
+            .unwrap()
+            .speed_rpm;
     let mut onset = None;
     for speed in [8200.0, 8500.0, 8800.0, 9100.0] {
-        let g = run_transient(&rotor, &spec(speed, 80, Coupling::Nonlinear)).unwrap().growth_per_rev();
+        let g = run_transient(&rotor, &spec(speed, 80, Coupling::Nonlinear))
+            .unwrap()
+            .growth_per_rev();
         println!("{speed} rpm: growth {g:+.5}/rev");
         if g > 0.0 && onset.is_none() {
             onset = Some(speed);

@@ -17,15 +17,27 @@ fn omega(rpm: f64) -> f64 {
 fn checkpoint_restore_replays_exactly() {
     let rotor = orc();
     let w = omega(8500.0);
-    let mut twin = Twin::new(&rotor, TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128), w).unwrap();
-    let input = StepInput { speed_rad_s: w, accel_rad_s2: 0.0 };
+    let mut twin = Twin::new(
+        &rotor,
+        TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128),
+        w,
+    )
+    .unwrap();
+    let input = StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    };
     for _ in 0..50 {
         twin.step(&input).unwrap();
     }
     let cp = twin.checkpoint();
-    let first: Vec<_> = (0..100).map(|_| twin.step(&input).unwrap().bearings.clone()).collect();
+    let first: Vec<_> = (0..100)
+        .map(|_| twin.step(&input).unwrap().bearings.clone())
+        .collect();
     twin.restore(&cp);
-    let second: Vec<_> = (0..100).map(|_| twin.step(&input).unwrap().bearings.clone()).collect();
+    let second: Vec<_> = (0..100)
+        .map(|_| twin.step(&input).unwrap().bearings.clone())
+        .collect();
     assert_eq!(first, second);
 }
 
@@ -33,24 +45,57 @@ fn checkpoint_restore_replays_exactly() {
 fn bad_input_is_refused_and_the_state_is_untouched() {
     let rotor = orc();
     let w = omega(8000.0);
-    let mut twin = Twin::new(&rotor, TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128), w).unwrap();
-    twin.step(&StepInput { speed_rad_s: w, accel_rad_s2: 0.0 }).unwrap();
+    let mut twin = Twin::new(
+        &rotor,
+        TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128),
+        w,
+    )
+    .unwrap();
+    twin.step(&StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    })
+    .unwrap();
     let before = twin.state_vectors().0.to_vec();
     let t = twin.time_s();
     for bad in [f64::NAN, f64::INFINITY, -w, 0.0, 100.0 * w] {
-        let e = twin.step(&StepInput { speed_rad_s: bad, accel_rad_s2: 0.0 }).unwrap_err();
-        assert!(matches!(e, TwinError::InvalidInput { name: "speed (rad/s)", .. }), "{e}");
+        let e = twin
+            .step(&StepInput {
+                speed_rad_s: bad,
+                accel_rad_s2: 0.0,
+            })
+            .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                TwinError::InvalidInput {
+                    name: "speed (rad/s)",
+                    ..
+                }
+            ),
+            "{e}"
+        );
     }
-    assert!(twin.step(&StepInput { speed_rad_s: w, accel_rad_s2: f64::NAN }).is_err());
+    assert!(twin
+        .step(&StepInput {
+            speed_rad_s: w,
+            accel_rad_s2: f64::NAN
+        })
+        .is_err());
     assert!(twin.set_unbalance(0, f64::NAN, 0.0).is_err());
     assert!(twin.set_unbalance(0, 5.0, 0.0).is_err());
     assert!(twin.set_unbalance(7, 1e-4, 0.0).is_err());
     assert!(twin.set_external_force(3, [f64::INFINITY, 0.0]).is_err());
     let nan_state = vec![f64::NAN; before.len()];
-    assert!(twin.set_state_vectors(&nan_state, &before, &before).is_err());
+    assert!(twin
+        .set_state_vectors(&nan_state, &before, &before)
+        .is_err());
     assert_eq!(twin.state_vectors().0, &before[..]);
     assert_eq!(twin.time_s(), t);
-    let bad_config = TwinConfig { time_step_s: -1.0, ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128) };
+    let bad_config = TwinConfig {
+        time_step_s: -1.0,
+        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 128)
+    };
     assert!(Twin::new(&rotor, bad_config, w).is_err());
     let bad_delta = TwinConfig::with_steps_per_rev(Coupling::Prehistory { delta: 0.0 }, w, 128);
     assert!(Twin::new(&rotor, bad_delta, w).is_err());
@@ -76,7 +121,12 @@ bearings:
 "#;
     let rotor = Rotor::from_description(&MachineDescription::from_yaml(yaml, "test").unwrap());
     let w = omega(3000.0);
-    let mut twin = Twin::new(&rotor, TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64), w).unwrap();
+    let mut twin = Twin::new(
+        &rotor,
+        TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64),
+        w,
+    )
+    .unwrap();
     let c = 50e-6;
     // push the whole rotor 15 % of the clearance sideways
     let (q, qd, qdd) = twin.state_vectors();
@@ -86,18 +136,30 @@ bearings:
     }
     let (qd, qdd) = (qd.to_vec(), qdd.to_vec());
     twin.set_state_vectors(&q, &qd, &qdd).unwrap();
-    let input = StepInput { speed_rad_s: w, accel_rad_s2: 0.0 };
+    let input = StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    };
     for _ in 0..64 * 150 {
         twin.step(&input).unwrap();
     }
     let loads = static_solution(&rotor).unwrap().bearing_loads_n;
     for (k, b) in rotor.bearings.iter().enumerate() {
-        let BearingModel::Film(f) = &b.model else { unreachable!() };
+        let BearingModel::Film(f) = &b.model else {
+            unreachable!()
+        };
         let mut film = f.solver();
         let eq = equilibrium_under_load(film.as_mut(), 0.01, loads[k], w).unwrap();
         let got = twin.output().bearings[k].position_m;
         let miss = (got[0] - eq.position_m[0]).hypot(got[1] - eq.position_m[1]) / c;
-        println!("{}: twin ({:.3}, {:.3}) µm, film equilibrium ({:.3}, {:.3}) µm, miss {miss:.2e} c", b.name, got[0] * 1e6, got[1] * 1e6, eq.position_m[0] * 1e6, eq.position_m[1] * 1e6);
+        println!(
+            "{}: twin ({:.3}, {:.3}) µm, film equilibrium ({:.3}, {:.3}) µm, miss {miss:.2e} c",
+            b.name,
+            got[0] * 1e6,
+            got[1] * 1e6,
+            eq.position_m[0] * 1e6,
+            eq.position_m[1] * 1e6
+        );
         assert!(miss < 1e-3);
     }
 }

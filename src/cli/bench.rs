@@ -13,6 +13,9 @@ use std::time::{Duration, Instant};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum Workload {
+    /// ORC-9000: the microturbine at 9,000 rpm, 30 elements, 60 × 10 film grids, 128 steps a
+    /// revolution, nonlinear coupling: the cost of one twin step.
+    Orc9000,
     /// One film solve of the seed's bearing (9,000 rpm, 275 N) on a 60 × 10 half-grid.
     Film,
 }
@@ -21,8 +24,12 @@ enum Workload {
 #[derive(Debug, Clone, Args)]
 pub struct BenchArgs {
     /// What to measure.
-    #[arg(value_enum, default_value_t = Workload::Film)]
+    #[arg(value_enum, default_value_t = Workload::Orc9000)]
     workload: Workload,
+    /// ORC-9000: first let the oil whip develop (about 500 revolutions, unmeasured), then measure
+    /// in the whip (the hardest case: large orbits, contact near the wall).
+    #[arg(long)]
+    whip: bool,
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
@@ -52,6 +59,7 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
     );
     let figures = match args.workload {
         Workload::Film => film_cases(args)?,
+        Workload::Orc9000 => return orc_9000(args),
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&figures)?);
@@ -66,6 +74,82 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
                 f.case, f.median_us, f.p99_us, f.samples, f.mean_active_set_passes
             );
         }
+    }
+    Ok(())
+}
+
+/// ORC-9000 figures.
+#[derive(Debug, Serialize)]
+struct TwinFigures {
+    workload: &'static str,
+    phase: &'static str,
+    steps: usize,
+    time_step_us: f64,
+    median_step_us: f64,
+    p99_step_us: f64,
+    mean_step_us: f64,
+    real_time_factor: f64,
+    newton_iterations_per_step: f64,
+}
+
+fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
+    use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig};
+    use crate::rotor::{MachineDescription, Rotor};
+    let rotor = crate::transient::with_grid(
+        &Rotor::from_description(&MachineDescription::builtin_default()),
+        Some(args.grid),
+    );
+    let omega = rpm_to_rad_s(9000.0);
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128);
+    let mut twin = Twin::new(&rotor, config, omega)?;
+    let input = StepInput {
+        speed_rad_s: omega,
+        accel_rad_s2: 0.0,
+    };
+    if args.whip {
+        eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
+        for _ in 0..500 * 128 {
+            twin.step(&input)?;
+        }
+    }
+    let budget = Duration::from_secs_f64(args.seconds);
+    let mut times = Vec::with_capacity(1 << 20);
+    let mut iterations = 0;
+    let start = Instant::now();
+    while start.elapsed() < budget && times.len() < (1 << 20) {
+        let t = Instant::now();
+        let out = twin.step(&input)?;
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+        iterations += out.newton_iterations;
+    }
+    let total_us: f64 = times.iter().sum();
+    let n = times.len();
+    times.sort_by(f64::total_cmp);
+    let pick = |q: f64| times[((n - 1) as f64 * q).round() as usize];
+    let h_us = config.time_step_s * 1e6;
+    let fig = TwinFigures {
+        workload: "ORC-9000",
+        phase: if args.whip {
+            "developed oil whip"
+        } else {
+            "from the synchronous orbit (first seconds)"
+        },
+        steps: n,
+        time_step_us: h_us,
+        median_step_us: pick(0.5),
+        p99_step_us: pick(0.99),
+        mean_step_us: total_us / n as f64,
+        real_time_factor: h_us * n as f64 / total_us,
+        newton_iterations_per_step: iterations as f64 / n as f64,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&fig)?);
+    } else {
+        println!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{}, 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z);
+        println!(
+            "  {} steps: median {:.1} µs, p99 {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
+            fig.steps, fig.median_step_us, fig.p99_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step
+        );
     }
     Ok(())
 }

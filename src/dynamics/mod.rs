@@ -47,7 +47,10 @@ pub struct TwinConfig {
     pub coupling: Coupling,
     /// Time step h (s); e.g. one 128th of a revolution at rated speed.
     pub time_step_s: f64,
-    /// Newton converges when the largest journal correction is below this share of the clearance.
+    /// Newton converges when the error left in the journal positions is below this share of the
+    /// clearance: a correction below √(tol (1 − ε)) (Newton's quadratic convergence leaves
+    /// ~|Δ|²/((1 − ε)c)) while every journal stays below ε = 0.8, below tol otherwise (near the
+    /// wall, in contact) and in prehistory.
     pub newton_tolerance: f64,
     /// Newton iterations allowed before the step is retried with half the time step.
     pub max_newton_iterations: usize,

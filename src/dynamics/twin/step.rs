@@ -275,7 +275,17 @@ impl Twin {
                     self.f_b[i] -= self.d_b[i * nb + j] * self.delta[j];
                 }
             }
-            if largest * scale < self.config.newton_tolerance && scale == 1.0 {
+            // Newton converges quadratically: after a correction Δ the error left is of order
+            // |Δ|²/c, so a correction below √tol leaves less than tol and needs no further film
+            // solve (the force used is the linearised one at the new iterate, f_B − D Δ)
+            let accept = if self.config.coupling == Coupling::Nonlinear
+                && !self.links.iter().any(|l| l.last.contact)
+            {
+                self.config.newton_tolerance.sqrt()
+            } else {
+                self.config.newton_tolerance
+            };
+            if largest * scale < accept && scale == 1.0 {
                 converged = true;
                 break;
             }
