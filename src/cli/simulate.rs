@@ -403,9 +403,10 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
                 .collect(),
         });
     }
+    // onset: the first speed whose non-synchronous motion grows, or that is classified unstable
     let onset_speed_rpm = points
         .iter()
-        .find(|p| p.state != RotorState::Stable)
+        .find(|p| p.state != RotorState::Stable || p.growth_per_rev > 0.0)
         .map(|p| p.speed_rpm);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
@@ -422,8 +423,8 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     for p in &points {
         csv.push_str(
             &format!(
-                "{},{:?},{},{}",
-                p.speed_rpm, p.state, p.max_eccentricity_ratio, p.subsync_ratio
+                "{},{:?},{},{},{}",
+                p.speed_rpm, p.state, p.growth_per_rev, p.max_eccentricity_ratio, p.subsync_ratio
             )
             .to_lowercase(),
         );
@@ -456,9 +457,10 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         );
         for p in &report.points {
             println!(
-                "  {:>8.0} rpm  {:<8}  max ε {:.3}  sub-sync {:.3}X",
+                "  {:>8.0} rpm  {:<8}  growth {:+.4}/rev  max ε {:.3}  sub-sync {:.3}X",
                 p.speed_rpm,
                 format!("{:?}", p.state),
+                p.growth_per_rev,
                 p.max_eccentricity_ratio,
                 p.subsync_ratio
             );
