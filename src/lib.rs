@@ -7,8 +7,10 @@
 pub mod cli;
 pub mod dynamics;
 pub mod film;
+pub mod messages;
 pub mod monitor;
 pub mod plot;
+pub mod record;
 pub mod rotor;
 pub mod transient;
 pub mod units;

@@ -1,0 +1,279 @@
+//! Recording to MCAP in the rosbag2 conventions: a bag directory with `<name>_0.mcap` (profile
+//! `ros2`, CDR messages, `ros2msg` schemas, each channel's `offered_qos_profiles`) and
+//! `metadata.yaml` (rosbag2 version 9). Flushed on demand (the node does it at least every second)
+//! so that a killed process loses at most the last chunk; [`Recorder::finish`] writes the summary
+//! and the metadata.
+
+use crate::messages::RosMessage;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// QoS a topic is offered with, as rosbag2 records it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TopicQos {
+    /// Depth of a keep-last history.
+    pub depth: u32,
+    /// Reliable (else best effort).
+    pub reliable: bool,
+    /// Transient local (else volatile): late joiners get the last samples.
+    pub transient_local: bool,
+}
+
+impl TopicQos {
+    /// Reliable, volatile, keep last `depth`.
+    pub const fn reliable(depth: u32) -> Self {
+        Self {
+            depth,
+            reliable: true,
+            transient_local: false,
+        }
+    }
+
+    /// Reliable, transient local, keep last `depth` (latched).
+    pub const fn latched(depth: u32) -> Self {
+        Self {
+            depth,
+            reliable: true,
+            transient_local: true,
+        }
+    }
+
+    /// Best effort, volatile, keep last `depth` (sensor data).
+    pub const fn sensor(depth: u32) -> Self {
+        Self {
+            depth,
+            reliable: false,
+            transient_local: false,
+        }
+    }
+
+    /// rosbag2's YAML list for this QoS (one profile).
+    pub fn rosbag2_yaml(&self) -> String {
+        let zero = "{sec: 0, nsec: 0}";
+        format!(
+            "- history: keep_last\n  depth: {}\n  reliability: {}\n  durability: {}\n  deadline: {zero}\n  lifespan: {zero}\n  liveliness: automatic\n  liveliness_lease_duration: {zero}\n  avoid_ros_namespace_conventions: false\n",
+            self.depth,
+            if self.reliable { "reliable" } else { "best_effort" },
+            if self.transient_local { "transient_local" } else { "volatile" },
+        )
+    }
+}
+
+/// A topic being recorded.
+#[derive(Debug, Clone)]
+struct TopicEntry {
+    name: String,
+    type_name: String,
+    qos: TopicQos,
+    channel: u16,
+    count: u64,
+}
+
+/// Why recording failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// File-system trouble, with the path.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path concerned.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The MCAP writer failed.
+    #[error("MCAP writer: {0}")]
+    Mcap(#[from] mcap::McapError),
+    /// A message could not be encoded.
+    #[error("encoding a {type_name} for {topic}: {why}")]
+    Encode {
+        /// Topic.
+        topic: String,
+        /// Type.
+        type_name: String,
+        /// Why.
+        why: String,
+    },
+    /// A topic was written before it was added.
+    #[error("topic {0} was not added to the recording")]
+    UnknownTopic(String),
+}
+
+/// Writes one bag directory.
+pub struct Recorder {
+    dir: PathBuf,
+    file_name: String,
+    writer: mcap::Writer<BufWriter<File>>,
+    topics: Vec<TopicEntry>,
+    sequence: u32,
+    first_ns: Option<u64>,
+    last_ns: u64,
+    last_flush: Instant,
+}
+
+impl Recorder {
+    /// Creates bag directory `dir` (which must not exist yet, as with `ros2 bag record -o`).
+    pub fn create(dir: &Path) -> Result<Self, RecordError> {
+        let io = |source| RecordError::Io {
+            path: dir.to_path_buf(),
+            source,
+        };
+        if dir.exists() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "bag directory already exists",
+            )));
+        }
+        std::fs::create_dir_all(dir).map_err(io)?;
+        let stem = dir
+            .file_name()
+            .map_or("rotor_twin".into(), |s| s.to_string_lossy().into_owned());
+        let file_name = format!("{stem}_0.mcap");
+        let path = dir.join(&file_name);
+        let file = File::create(&path).map_err(|source| RecordError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let writer = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library("rotor-twin")
+            .create(BufWriter::new(file))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            file_name,
+            writer,
+            topics: Vec::new(),
+            sequence: 0,
+            first_ns: None,
+            last_ns: 0,
+            last_flush: Instant::now(),
+        })
+    }
+
+    /// Adds topic `name` of type `T` offered with `qos`; returns its handle. Adding the same name
+    /// twice returns the first handle.
+    pub fn add_topic<T: RosMessage>(
+        &mut self,
+        name: &str,
+        qos: TopicQos,
+    ) -> Result<usize, RecordError> {
+        if let Some(i) = self.topics.iter().position(|t| t.name == name) {
+            return Ok(i);
+        }
+        let schema = self
+            .writer
+            .add_schema(T::TYPE_NAME, "ros2msg", T::schema().as_bytes())?;
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), qos.rosbag2_yaml())]);
+        let channel = self.writer.add_channel(schema, name, "cdr", &metadata)?;
+        self.topics.push(TopicEntry {
+            name: name.into(),
+            type_name: T::TYPE_NAME.into(),
+            qos,
+            channel,
+            count: 0,
+        });
+        Ok(self.topics.len() - 1)
+    }
+
+    /// Records `message` on topic handle `topic`, received at `log_time_ns` and sent at
+    /// `publish_time_ns` (ns since the epoch).
+    pub fn write<T: Serialize>(
+        &mut self,
+        topic: usize,
+        message: &T,
+        log_time_ns: u64,
+        publish_time_ns: u64,
+    ) -> Result<(), RecordError> {
+        let entry = self
+            .topics
+            .get(topic)
+            .ok_or_else(|| RecordError::UnknownTopic(format!("#{topic}")))?;
+        let bytes = crate::messages::to_cdr(message).map_err(|why| RecordError::Encode {
+            topic: entry.name.clone(),
+            type_name: entry.type_name.clone(),
+            why,
+        })?;
+        self.write_cdr(topic, &bytes, log_time_ns, publish_time_ns)
+    }
+
+    /// Records an already encoded CDR payload (with its encapsulation header).
+    pub fn write_cdr(
+        &mut self,
+        topic: usize,
+        cdr: &[u8],
+        log_time_ns: u64,
+        publish_time_ns: u64,
+    ) -> Result<(), RecordError> {
+        let entry = self
+            .topics
+            .get_mut(topic)
+            .ok_or_else(|| RecordError::UnknownTopic(format!("#{topic}")))?;
+        self.sequence = self.sequence.wrapping_add(1);
+        self.writer.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: entry.channel,
+                sequence: self.sequence,
+                log_time: log_time_ns,
+                publish_time: publish_time_ns,
+            },
+            cdr,
+        )?;
+        entry.count += 1;
+        self.first_ns = Some(self.first_ns.map_or(log_time_ns, |f| f.min(log_time_ns)));
+        self.last_ns = self.last_ns.max(log_time_ns);
+        Ok(())
+    }
+
+    /// Closes the current chunk if `every` has passed since the last flush, so that a killed
+    /// process loses at most that much.
+    pub fn flush_if_due(&mut self, every: Duration) -> Result<(), RecordError> {
+        if self.last_flush.elapsed() >= every {
+            self.writer.flush()?;
+            self.last_flush = Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Messages recorded per topic so far.
+    pub fn counts(&self) -> Vec<(String, u64)> {
+        self.topics
+            .iter()
+            .map(|t| (t.name.clone(), t.count))
+            .collect()
+    }
+
+    /// Writes the summary section and `metadata.yaml`. Returns the bag directory.
+    pub fn finish(mut self) -> Result<PathBuf, RecordError> {
+        self.writer.finish()?;
+        let metadata = self.metadata_yaml();
+        let path = self.dir.join("metadata.yaml");
+        std::fs::write(&path, metadata).map_err(|source| RecordError::Io { path, source })?;
+        Ok(self.dir)
+    }
+
+    fn metadata_yaml(&self) -> String {
+        let start = self.first_ns.unwrap_or(0);
+        let duration = self.last_ns.saturating_sub(start);
+        let total: u64 = self.topics.iter().map(|t| t.count).sum();
+        let mut topics = String::new();
+        for t in &self.topics {
+            let qos: String = t
+                .qos
+                .rosbag2_yaml()
+                .lines()
+                .map(|l| format!("        {l}\n"))
+                .collect();
+            topics.push_str(&format!(
+                "  - message_count: {}\n    topic_metadata:\n      name: {}\n      offered_qos_profiles:\n{qos}      serialization_format: cdr\n      type: {}\n      type_description_hash: ''\n",
+                t.count, t.name, t.type_name
+            ));
+        }
+        format!(
+            "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n  - {file}\n  files:\n  - path: {file}\n    starting_time:\n      nanoseconds_since_epoch: {start}\n    duration:\n      nanoseconds: {duration}\n    message_count: {total}\n  custom_data: {{}}\n  ros_distro: jazzy\n",
+            file = self.file_name
+        )
+    }
+}
