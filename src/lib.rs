@@ -11,6 +11,7 @@ pub mod messages;
 pub mod monitor;
 pub mod plot;
 pub mod record;
+pub mod ros;
 pub mod rotor;
 pub mod transient;
 pub mod units;

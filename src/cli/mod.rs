@@ -3,6 +3,7 @@
 mod bearing;
 mod bench;
 mod modes;
+mod node;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +26,8 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     /// Amplitude–speed characteristic: a transient at each speed, in parallel.
     Sweep(simulate::SweepArgs),
+    /// The live ROS 2 node: the twin beside a plant or rig, recorded to MCAP.
+    Node(node::NodeArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
 }
@@ -36,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Modes(args)) => modes::run(&args),
         Some(Command::Simulate(args)) => simulate::run_simulate(&args),
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
+        Some(Command::Node(args)) => node::run(args),
         Some(Command::Bench(args)) => bench::run(&args),
         None => bearing::run(&bearing::BearingArgs::default_bearing()),
     }

@@ -59,4 +59,13 @@ else:
             types[conn.topic] = conn.msgtype
     out["rosbags"] = {"counts": counts, "types": types}
 
-print(json.dumps(out))
+def finite(v):
+    """JSON has no NaN or infinity: a recorded bad input is shown as text."""
+    if isinstance(v, float) and (v != v or v in (float("inf"), float("-inf"))):
+        return str(v)
+    if isinstance(v, dict):
+        return {k: finite(x) for k, x in v.items()}
+    return v
+
+
+print(json.dumps(finite(out)))

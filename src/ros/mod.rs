@@ -1,0 +1,457 @@
+//! The live node: ROS 2 in and out through ros2-client (RustDDS), the twin on its own thread at
+//! real-time pace, every input and output recorded to MCAP. Only this module opens DDS.
+//!
+//! Topics (names remappable with `-r from:=to`; QoS stated per topic):
+//! - in  `/rotor_twin/speed` rotor_twin_msgs/RotorSpeed, or std_msgs/Float64 with `speed_type:=float64`
+//!   (unit `speed_unit`), reliable, keep last 100;
+//! - in  `/rotor_twin/unbalance` rotor_twin_msgs/Unbalance, reliable, keep last 100;
+//! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
+//!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
+//!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
+//!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz.
+
+mod inputs;
+mod model;
+mod params;
+
+pub use inputs::{check_probe, check_unbalance, SpeedGate};
+pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit};
+
+use crate::messages::{self, RosMessage};
+use crate::record::{Recorder, TopicQos};
+use crate::rotor::{MachineDescription, Rotor};
+use anyhow::Context as _;
+use futures::StreamExt;
+use model::{now_ns, Inputs, Outgoing};
+use ros2_client::{
+    Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, ParameterValue,
+};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Everything `rotor-twin node` needs.
+#[derive(Debug, Clone)]
+pub struct NodeSetup {
+    /// Machine description file; the built-in microturbine if None.
+    pub config: Option<PathBuf>,
+    /// Bag directory to record into.
+    pub record: Option<PathBuf>,
+    /// Arguments after `--ros-args`.
+    pub ros_args: Vec<String>,
+}
+
+const SPEED: &str = "/rotor_twin/speed";
+const UNBALANCE: &str = "/rotor_twin/unbalance";
+const JOURNAL: &str = "/rotor_twin/journal_state";
+const FILM: &str = "/rotor_twin/film_state";
+const ORBIT: &str = "/rotor_twin/orbit";
+const WARNING: &str = "/rotor_twin/warning";
+const DIAGNOSTICS: &str = "/diagnostics";
+
+fn qos_profile(q: TopicQos) -> ros2_client::QosProfile {
+    use ros2_client::qos::{Durability, History, Reliability, WhenFull};
+    let base = ros2_client::QosProfile::publisher_default();
+    ros2_client::QosProfile {
+        reliability: if q.reliable {
+            Reliability::Reliable {
+                when_full: WhenFull::Fail,
+            }
+        } else {
+            Reliability::BestEffort
+        },
+        durability: if q.transient_local {
+            Durability::TransientLocal
+        } else {
+            Durability::Volatile
+        },
+        history: History::KeepLast {
+            depth: q.depth as usize,
+        },
+        ..base
+    }
+}
+
+/// A topic name after remapping, as a ros2-client Name.
+fn topic_name(
+    remaps: &std::collections::BTreeMap<String, String>,
+    default: &str,
+) -> anyhow::Result<Name> {
+    let name = remaps.get(default).map_or(default, String::as_str);
+    Name::parse(name).map_err(|e| anyhow::anyhow!("topic name '{name}': {e:?}"))
+}
+
+fn type_name<T: RosMessage>() -> MessageTypeName {
+    let mut parts = T::TYPE_NAME.split('/');
+    let pkg = parts.next().unwrap_or_default();
+    let ty = parts.next_back().unwrap_or_default();
+    MessageTypeName::new(pkg, ty)
+}
+
+/// A record request for the recorder thread.
+enum ToRecord {
+    Out(Outgoing, i64),
+    Speed(messages::RotorSpeed, i64),
+    Speed64(messages::Float64, i64),
+    Unbalance(messages::Unbalance, i64),
+}
+
+/// Runs the node until SIGINT or SIGTERM.
+pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
+    let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
+    let mut params = NodeParams::default();
+    for (k, v) in &ros.params {
+        params.set(k, v).map_err(anyhow::Error::msg)?;
+    }
+    anyhow::ensure!(
+        !params.use_sim_time,
+        "use_sim_time:=true is not supported yet: the node follows the wall clock"
+    );
+    let desc = match &setup.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    let rotor = Rotor::from_description(&desc);
+    let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
+        Ok(v) if !v.trim().is_empty() => v
+            .trim()
+            .parse()
+            .with_context(|| format!("ROS_DOMAIN_ID '{v}' is not a domain number"))?,
+        _ => 0,
+    };
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()?;
+    runtime.block_on(run_async(setup, ros, params, rotor, domain))
+}
+
+async fn run_async(
+    setup: NodeSetup,
+    ros: RosArgs,
+    params: NodeParams,
+    rotor: Rotor,
+    domain: u16,
+) -> anyhow::Result<()> {
+    let context = Context::with_options(ContextOptions::new().domain_id(domain))
+        .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))?;
+    let mut options = NodeOptions::new().enable_rosout(false);
+    for (name, value) in [
+        ("model", ParameterValue::String(params.model.clone())),
+        ("delta", ParameterValue::Double(params.delta)),
+        (
+            "steps_per_rev",
+            ParameterValue::Integer(params.steps_per_rev as i64),
+        ),
+        (
+            "state_rate_hz",
+            ParameterValue::Double(params.state_rate_hz),
+        ),
+        (
+            "pressure_map_rate_hz",
+            ParameterValue::Double(params.pressure_map_rate_hz),
+        ),
+        (
+            "input_timeout_s",
+            ParameterValue::Double(params.input_timeout_s),
+        ),
+        (
+            "min_speed_rpm",
+            ParameterValue::Double(params.min_speed_rpm),
+        ),
+        (
+            "speed_type",
+            ParameterValue::String(params.speed_type.clone()),
+        ),
+        ("use_sim_time", ParameterValue::Boolean(params.use_sim_time)),
+    ] {
+        options = options.declare_parameter(name, value);
+    }
+    let mut node = context
+        .new_node(
+            NodeName::new("/", "rotor_twin").map_err(|e| anyhow::anyhow!("{e:?}"))?,
+            options,
+        )
+        .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
+    let input_qos = TopicQos::reliable(100);
+    let state_qos = TopicQos::reliable(10);
+    let warning_qos = TopicQos::latched(1);
+
+    macro_rules! publisher {
+        ($ty:ty, $name:expr, $qos:expr) => {{
+            let topic = node
+                .create_topic(
+                    &topic_name(&ros.remaps, $name)?,
+                    type_name::<$ty>(),
+                    &qos_profile($qos),
+                )
+                .map_err(|e| anyhow::anyhow!("topic {}: {e:?}", $name))?;
+            node.create_publisher::<$ty>(&topic, None)
+                .map_err(|e| anyhow::anyhow!("publisher {}: {e:?}", $name))?
+        }};
+    }
+    let pub_journal = publisher!(messages::JournalState, JOURNAL, state_qos);
+    let pub_film = publisher!(messages::FilmState, FILM, state_qos);
+    let pub_orbit = publisher!(messages::Orbit, ORBIT, state_qos);
+    let pub_warning = publisher!(messages::InstabilityWarning, WARNING, warning_qos);
+    let pub_diag = publisher!(messages::DiagnosticArray, DIAGNOSTICS, state_qos);
+
+    // recording
+    let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
+    let stop = Arc::new(AtomicBool::new(false));
+    let recorder_thread = match &setup.record {
+        Some(dir) => {
+            let stop = stop.clone();
+            let mut rec = Recorder::create(dir)?;
+            let h_speed = if params.speed_type == "float64" {
+                rec.add_topic::<messages::Float64>(SPEED, input_qos)?
+            } else {
+                rec.add_topic::<messages::RotorSpeed>(SPEED, input_qos)?
+            };
+            let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE, input_qos)?;
+            let h_journal = rec.add_topic::<messages::JournalState>(JOURNAL, state_qos)?;
+            let h_film = rec.add_topic::<messages::FilmState>(FILM, state_qos)?;
+            let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, state_qos)?;
+            let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, warning_qos)?;
+            let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, state_qos)?;
+            Some(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
+                loop {
+                    match rec_rx.recv_timeout(Duration::from_millis(200)) {
+                        Ok(item) => {
+                            let t = |ns: &i64| *ns as u64;
+                            match &item {
+                                ToRecord::Speed(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
+                                ToRecord::Speed64(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
+                                ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
+                                ToRecord::Out(o, ns) => match o {
+                                    Outgoing::Journal(m) => {
+                                        rec.write(h_journal, m, t(ns), t(ns))?
+                                    }
+                                    Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,
+                                    Outgoing::Orbit(m) => rec.write(h_orbit, m, t(ns), t(ns))?,
+                                    Outgoing::Warning(m) => {
+                                        rec.write(h_warning, m, t(ns), t(ns))?
+                                    }
+                                    Outgoing::Diagnostics(m) => {
+                                        rec.write(h_diag, m, t(ns), t(ns))?
+                                    }
+                                },
+                            }
+                        }
+                        // after shutdown, the first quiet moment ends the recording
+                        Err(mpsc::RecvTimeoutError::Timeout) if stop.load(Ordering::Relaxed) => {
+                            break
+                        }
+                        Err(mpsc::RecvTimeoutError::Timeout) => {}
+                        Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                    }
+                    rec.flush_if_due(Duration::from_secs(1))?;
+                }
+                Ok(rec.finish()?)
+            }))
+        }
+        None => {
+            drop(rec_rx);
+            None
+        }
+    };
+    let recording = setup.record.is_some();
+
+    // the model thread and the publishing thread
+    let inputs = Arc::new(Mutex::new(Inputs::default()));
+    let (out_tx, out_rx) = mpsc::sync_channel::<Outgoing>(4096);
+    let model_thread = {
+        let (inputs, stop) = (inputs.clone(), stop.clone());
+        let params = params.clone();
+        std::thread::Builder::new()
+            .name("rotor_twin model".into())
+            .spawn(move || model::run(rotor.clone(), params, inputs, out_tx, stop))?
+    };
+    let rec_out = rec_tx.clone();
+    let publish_thread = std::thread::Builder::new()
+        .name("rotor_twin publish".into())
+        .spawn(move || {
+            for item in out_rx {
+                let t = now_ns();
+                let _sent = match &item {
+                    // a full send window drops the sample (never block the model)
+                    Outgoing::Journal(m) => pub_journal.publish(m.clone()).is_ok(),
+                    Outgoing::Film(m) => pub_film.publish(m.clone()).is_ok(),
+                    Outgoing::Orbit(m) => pub_orbit.publish(m.clone()).is_ok(),
+                    Outgoing::Warning(m) => pub_warning.publish(m.clone()).is_ok(),
+                    Outgoing::Diagnostics(m) => pub_diag.publish(m.clone()).is_ok(),
+                };
+                if recording {
+                    let _ = rec_out.try_send(ToRecord::Out(item, t));
+                }
+            }
+        })?;
+
+    // subscriptions
+    let max_speed = 10.0
+        * crate::units::rpm_to_rad_s(MachineDescription::builtin_default().rated_speed_rpm)
+            .max(1.0);
+    let gate = Arc::new(Mutex::new(SpeedGate::new(
+        max_speed,
+        params.input_timeout_s,
+    )));
+    let reject = |inputs: &Arc<Mutex<Inputs>>, why: String| {
+        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
+        g.rejected += 1;
+        g.last_rejection = why;
+    };
+    let speed_topic = topic_name(&ros.remaps, SPEED)?;
+    if params.speed_type == "float64" {
+        let topic = node
+            .create_topic(
+                &speed_topic,
+                type_name::<messages::Float64>(),
+                &qos_profile(input_qos),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::Float64>(&topic, Some(qos_profile(input_qos)))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let (inputs, gate, rec, unit) = (
+            inputs.clone(),
+            gate.clone(),
+            rec_tx.clone(),
+            params.speed_unit,
+        );
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                let now = now_ns();
+                if recording {
+                    let _ = rec.try_send(ToRecord::Speed64(m, now));
+                }
+                let checked = gate.lock().unwrap_or_else(|e| e.into_inner()).check(
+                    unit.to_rad_s(m.data),
+                    0.0,
+                    0,
+                    now,
+                );
+                match checked {
+                    Ok((w, a)) => {
+                        inputs.lock().unwrap_or_else(|e| e.into_inner()).speed =
+                            Some((w, a, Instant::now()))
+                    }
+                    Err(why) => reject(&inputs, why),
+                }
+            }
+        });
+    } else {
+        let topic = node
+            .create_topic(
+                &speed_topic,
+                type_name::<messages::RotorSpeed>(),
+                &qos_profile(input_qos),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::RotorSpeed>(&topic, Some(qos_profile(input_qos)))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let (inputs, gate, rec) = (inputs.clone(), gate.clone(), rec_tx.clone());
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                let now = now_ns();
+                let checked = gate.lock().unwrap_or_else(|e| e.into_inner()).check(
+                    m.speed,
+                    m.acceleration,
+                    m.header.stamp.as_nanos(),
+                    now,
+                );
+                if recording {
+                    let _ = rec.try_send(ToRecord::Speed(m, now));
+                }
+                match checked {
+                    Ok((w, a)) => {
+                        inputs.lock().unwrap_or_else(|e| e.into_inner()).speed =
+                            Some((w, a, Instant::now()))
+                    }
+                    Err(why) => reject(&inputs, why),
+                }
+            }
+        });
+    }
+    {
+        let topic = node
+            .create_topic(
+                &topic_name(&ros.remaps, UNBALANCE)?,
+                type_name::<messages::Unbalance>(),
+                &qos_profile(input_qos),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::Unbalance>(&topic, Some(qos_profile(input_qos)))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let (inputs, rec) = (inputs.clone(), rec_tx.clone());
+        let planes = desc_planes(&setup)?;
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                if recording {
+                    let _ = rec.try_send(ToRecord::Unbalance(m.clone(), now_ns()));
+                }
+                match check_unbalance(m.plane, m.magnitude, m.phase, planes) {
+                    Ok(u) => inputs
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .unbalance
+                        .push(u),
+                    Err(why) => reject(&inputs, why),
+                }
+            }
+        });
+    }
+    drop(rec_tx);
+    let spinner = node
+        .spinner()
+        .map_err(|e| anyhow::anyhow!("spinner: {e:?}"))?;
+    tokio::spawn(async move {
+        let _ = spinner.spin().await;
+    });
+    eprintln!(
+        "rotor_twin: node up on ROS domain {domain}; waiting for {}",
+        speed_topic_label(&ros)
+    );
+
+    // until SIGINT or SIGTERM
+    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {},
+        _ = term.recv() => {},
+    }
+    eprintln!("rotor_twin: shutting down");
+    stop.store(true, Ordering::Relaxed);
+    let _ = model_thread.join();
+    let _ = publish_thread.join();
+    drop(node);
+    if let Some(t) = recorder_thread {
+        // the subscription tasks hold senders: end the runtime's tasks by leaving; the recorder
+        // stops when every sender is gone or after its last flush
+        match t.join() {
+            Ok(Ok(dir)) => eprintln!("rotor_twin: recording finished in {}", dir.display()),
+            Ok(Err(e)) => eprintln!("rotor_twin: recording failed: {e:#}"),
+            Err(_) => eprintln!("rotor_twin: recorder thread panicked"),
+        }
+    }
+    Ok(())
+}
+
+fn speed_topic_label(ros: &RosArgs) -> String {
+    ros.remaps
+        .get(SPEED)
+        .cloned()
+        .unwrap_or_else(|| SPEED.to_string())
+}
+
+fn desc_planes(setup: &NodeSetup) -> anyhow::Result<usize> {
+    let desc = match &setup.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    Ok(desc.unbalance.len())
+}

@@ -1,0 +1,286 @@
+//! Node parameters and the ROS 2 command-line conventions (`--ros-args -p name:=value
+//! --params-file F.yaml -r from:=to`), which ros2-client leaves to the node.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Unit of a bare speed value (std_msgs/Float64 on a plant bus).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedUnit {
+    /// Revolutions per minute.
+    Rpm,
+    /// Radians per second.
+    RadPerS,
+    /// Revolutions per second.
+    Hz,
+}
+
+impl SpeedUnit {
+    /// Converts a value in this unit to rad/s.
+    pub fn to_rad_s(self, v: f64) -> f64 {
+        match self {
+            SpeedUnit::Rpm => v * std::f64::consts::PI / 30.0,
+            SpeedUnit::RadPerS => v,
+            SpeedUnit::Hz => v * std::f64::consts::TAU,
+        }
+    }
+}
+
+/// The node's parameters (ROS 2 parameters; set with `-p name:=value` or a params file).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeParams {
+    /// `model`: linear | nonlinear | prehistory.
+    pub model: String,
+    /// `delta`: prehistory relaxation factor δ in (0, 1].
+    pub delta: f64,
+    /// `steps_per_rev`: time steps per revolution at rated speed.
+    pub steps_per_rev: usize,
+    /// `state_rate_hz`: rate of journal and film states (Hz), decimated from the step rate.
+    pub state_rate_hz: f64,
+    /// `pressure_map_rate_hz`: rate of the pressure profile in the film state (Hz).
+    pub pressure_map_rate_hz: f64,
+    /// `input_timeout_s`: a speed older than this is stale (s).
+    pub input_timeout_s: f64,
+    /// `min_speed_rpm`: below this speed the model pauses (rpm).
+    pub min_speed_rpm: f64,
+    /// `speed_type`: rotor_speed (rotor_twin_msgs/RotorSpeed) | float64 (std_msgs/Float64).
+    pub speed_type: String,
+    /// `speed_unit`: rpm | rad_s | hz, for `speed_type` float64.
+    pub speed_unit: SpeedUnit,
+    /// `use_sim_time`: follow `/clock` (rosgraph_msgs/Clock) instead of the wall clock.
+    pub use_sim_time: bool,
+    /// `warning_amplitude_ratio`: orbit amplitude over clearance that raises a warning.
+    pub warning_amplitude_ratio: f64,
+}
+
+impl Default for NodeParams {
+    fn default() -> Self {
+        Self {
+            model: "nonlinear".into(),
+            delta: 0.5,
+            steps_per_rev: 128,
+            state_rate_hz: 200.0,
+            pressure_map_rate_hz: 2.0,
+            input_timeout_s: 1.0,
+            min_speed_rpm: 1000.0,
+            speed_type: "rotor_speed".into(),
+            speed_unit: SpeedUnit::Rpm,
+            use_sim_time: false,
+            warning_amplitude_ratio: 0.5,
+        }
+    }
+}
+
+impl NodeParams {
+    /// Sets one parameter from its text value; the error names the parameter, the value and
+    /// the rule.
+    pub fn set(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let num = |v: &str| -> Result<f64, String> {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("parameter {name}: '{v}' is not a number"))
+        };
+        let positive = |v: f64, rule: &str| -> Result<f64, String> {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("parameter {name}: {v} {rule}"))
+            }
+        };
+        match name {
+            "model" => match value {
+                "linear" | "nonlinear" | "prehistory" => self.model = value.into(),
+                _ => {
+                    return Err(format!(
+                        "parameter model: '{value}' must be linear, nonlinear or prehistory"
+                    ))
+                }
+            },
+            "delta" => {
+                let d = num(value)?;
+                if !(d > 0.0 && d <= 1.0) {
+                    return Err(format!("parameter delta: {d} must lie in (0, 1]"));
+                }
+                self.delta = d;
+            }
+            "steps_per_rev" => {
+                let s: usize = value.trim().parse().map_err(|_| {
+                    format!("parameter steps_per_rev: '{value}' is not a whole number")
+                })?;
+                if !(16..=4096).contains(&s) {
+                    return Err(format!("parameter steps_per_rev: {s} must be 16 to 4096"));
+                }
+                self.steps_per_rev = s;
+            }
+            "state_rate_hz" => {
+                self.state_rate_hz = positive(num(value)?, "must be a rate above zero")?
+            }
+            "pressure_map_rate_hz" => {
+                self.pressure_map_rate_hz = positive(num(value)?, "must be a rate above zero")?
+            }
+            "input_timeout_s" => {
+                self.input_timeout_s = positive(num(value)?, "must be a time above zero")?
+            }
+            "min_speed_rpm" => {
+                self.min_speed_rpm = positive(num(value)?, "must be a speed above zero")?
+            }
+            "warning_amplitude_ratio" => {
+                self.warning_amplitude_ratio = positive(num(value)?, "must be above zero")?
+            }
+            "speed_type" => match value {
+                "rotor_speed" | "float64" => self.speed_type = value.into(),
+                _ => {
+                    return Err(format!(
+                        "parameter speed_type: '{value}' must be rotor_speed or float64"
+                    ))
+                }
+            },
+            "speed_unit" => {
+                self.speed_unit = match value {
+                    "rpm" => SpeedUnit::Rpm,
+                    "rad_s" => SpeedUnit::RadPerS,
+                    "hz" => SpeedUnit::Hz,
+                    _ => {
+                        return Err(format!(
+                            "parameter speed_unit: '{value}' must be rpm, rad_s or hz"
+                        ))
+                    }
+                }
+            }
+            "use_sim_time" => {
+                self.use_sim_time = match value {
+                    "true" | "True" | "1" => true,
+                    "false" | "False" | "0" => false,
+                    _ => {
+                        return Err(format!(
+                            "parameter use_sim_time: '{value}' must be true or false"
+                        ))
+                    }
+                }
+            }
+            _ => return Err(format!("unknown parameter '{name}'")),
+        }
+        Ok(())
+    }
+}
+
+/// What `--ros-args` said.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RosArgs {
+    /// Parameters in order of appearance (files first, then -p).
+    pub params: Vec<(String, String)>,
+    /// Topic remappings from → to.
+    pub remaps: BTreeMap<String, String>,
+}
+
+/// Parses the arguments after `--ros-args` (up to an optional `--`).
+pub fn parse_ros_args(args: &[String]) -> Result<RosArgs, String> {
+    let mut out = RosArgs::default();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--" => break,
+            "-p" | "--param" => {
+                let kv = it.next().ok_or("-p needs name:=value")?;
+                let (k, v) = kv
+                    .split_once(":=")
+                    .ok_or_else(|| format!("-p {kv}: expected name:=value"))?;
+                out.params.push((k.to_string(), v.to_string()));
+            }
+            "-r" | "--remap" => {
+                let kv = it.next().ok_or("-r needs from:=to")?;
+                let (k, v) = kv
+                    .split_once(":=")
+                    .ok_or_else(|| format!("-r {kv}: expected from:=to"))?;
+                out.remaps.insert(k.to_string(), v.to_string());
+            }
+            "--params-file" => {
+                let f = it.next().ok_or("--params-file needs a file")?;
+                out.params.extend(read_params_file(Path::new(f))?);
+            }
+            other => {
+                return Err(format!(
+                    "unsupported ROS argument '{other}' (supported: -p, -r, --params-file)"
+                ))
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a ROS 2 params file: `<node or /**>: ros__parameters: {name: value}`.
+fn read_params_file(path: &Path) -> Result<Vec<(String, String)>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let doc: serde_yaml_ng::Value =
+        serde_yaml_ng::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = Vec::new();
+    let Some(map) = doc.as_mapping() else {
+        return Err(format!(
+            "{}: expected a mapping of node names",
+            path.display()
+        ));
+    };
+    for (node, body) in map {
+        let node = node.as_str().unwrap_or("");
+        if !matches!(node, "rotor_twin" | "/rotor_twin" | "/**") {
+            continue;
+        }
+        let params = body
+            .get("ros__parameters")
+            .and_then(|p| p.as_mapping())
+            .ok_or_else(|| format!("{}: {node} has no ros__parameters", path.display()))?;
+        for (k, v) in params {
+            let key = k
+                .as_str()
+                .ok_or_else(|| format!("{}: a parameter name is not text", path.display()))?;
+            let value = match v {
+                serde_yaml_ng::Value::String(s) => s.clone(),
+                serde_yaml_ng::Value::Number(n) => n.to_string(),
+                serde_yaml_ng::Value::Bool(b) => b.to_string(),
+                other => {
+                    return Err(format!(
+                        "{}: parameter {key}: unsupported value {other:?}",
+                        path.display()
+                    ))
+                }
+            };
+            out.push((key.to_string(), value));
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ros_args_and_parameters() {
+        let args: Vec<String> = [
+            "-p",
+            "model:=linear",
+            "-r",
+            "/rotor_twin/speed:=/plant/speed",
+            "-p",
+            "speed_unit:=hz",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let r = parse_ros_args(&args).unwrap();
+        let mut p = NodeParams::default();
+        for (k, v) in &r.params {
+            p.set(k, v).unwrap();
+        }
+        assert_eq!(p.model, "linear");
+        assert_eq!(p.speed_unit, SpeedUnit::Hz);
+        assert_eq!(r.remaps["/rotor_twin/speed"], "/plant/speed");
+        assert!(p.set("delta", "0").unwrap_err().contains("delta"));
+        assert!(p
+            .set("steps_per_rev", "3")
+            .unwrap_err()
+            .contains("steps_per_rev"));
+        assert!(p.set("bogus", "1").unwrap_err().contains("bogus"));
+        assert!((SpeedUnit::Rpm.to_rad_s(9000.0) - 942.477_796).abs() < 1e-5);
+    }
+}

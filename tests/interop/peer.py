@@ -1,0 +1,116 @@
+"""An independent DDS peer (Cyclone DDS) speaking the ROS 2 conventions to the rotor-twin node.
+
+Usage: peer.py SECONDS SPEED_RAD_S [--domain N] [--bad] [--warnings-only]
+  --bad: first send NaN, infinite, negative and absurd speeds (the node must refuse them)
+  --warnings-only: only listen for the latched warning (a late subscriber)
+Publishes rotor_twin_msgs/RotorSpeed on /rotor_twin/speed at 100 Hz and listens to the node's
+journal states, orbits and warnings; prints what it received as JSON. Run it only inside a private
+network namespace (unshare -n), as the node.
+"""
+import json
+import sys
+import time
+from dataclasses import dataclass
+
+from cyclonedds.core import Qos, Policy
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.types import float64, int32, uint32, uint8, uint64, sequence
+import cyclonedds.idl.annotations as annotate
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+
+@dataclass
+@annotate.final
+class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: int32
+    nanosec: uint32
+
+
+@dataclass
+@annotate.final
+class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Time
+    frame_id: str
+
+
+@dataclass
+@annotate.final
+class RotorSpeed(IdlStruct, typename="rotor_twin_msgs::msg::dds_::RotorSpeed_"):
+    header: Header
+    speed: float64
+    acceleration: float64
+
+
+@dataclass
+@annotate.final
+class JournalState(IdlStruct, typename="rotor_twin_msgs::msg::dds_::JournalState_"):
+    header: Header
+    bearing: str
+    x: float64
+    y: float64
+    vx: float64
+    vy: float64
+    eccentricity_ratio: float64
+    attitude: float64
+    speed: float64
+    contact: bool
+
+
+@dataclass
+@annotate.final
+class InstabilityWarning(IdlStruct, typename="rotor_twin_msgs::msg::dds_::InstabilityWarning_"):
+    header: Header
+    level: uint8
+    kind: str
+    bearing: str
+    whirl_ratio: float64
+    amplitude_over_clearance: float64
+    evidence: str
+
+
+def main():
+    seconds = float(sys.argv[1])
+    speed = float(sys.argv[2])
+    domain = int(sys.argv[sys.argv.index("--domain") + 1]) if "--domain" in sys.argv else 0
+    dp = DomainParticipant(domain)
+    reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100),
+                   Policy.DataRepresentation(use_cdrv0_representation=True))
+    latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1),
+                  Policy.Durability.TransientLocal, Policy.DataRepresentation(use_cdrv0_representation=True))
+    w = DataWriter(dp, Topic(dp, "rt/rotor_twin/speed", RotorSpeed), qos=reliable)
+    journal = DataReader(dp, Topic(dp, "rt/rotor_twin/journal_state", JournalState), qos=reliable)
+    warnings = DataReader(dp, Topic(dp, "rt/rotor_twin/warning", InstabilityWarning), qos=latched)
+    out = {"journal": 0, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
+    start = time.time()
+    last = None
+    bad = [float("nan"), float("inf"), -100.0, 1e9] if "--bad" in sys.argv else []
+    listen_only = "--warnings-only" in sys.argv
+    while time.time() - start < seconds:
+        now = time.time_ns()
+        value = bad.pop(0) if bad else speed
+        if not listen_only:
+            w.write(RotorSpeed(Header(Time(now // 1_000_000_000, now % 1_000_000_000), ""), value, 0.0))
+        for s in journal.take(N=1000):
+            out["journal"] += 1
+            vals = [s.x, s.y, s.vx, s.vy, s.eccentricity_ratio, s.attitude, s.speed]
+            out["nonfinite"] += sum(1 for v in vals if v != v or v in (float("inf"), float("-inf")))
+            if len(out["speeds"]) < 5 or s.speed not in out["speeds"]:
+                out["speeds"].append(s.speed)
+            if out["first_journal_after_s"] is None:
+                out["first_journal_after_s"] = time.time() - start
+            last = s
+        for s in warnings.take(N=100):
+            out["warnings"].append({"level": s.level, "kind": s.kind, "bearing": s.bearing, "evidence": s.evidence})
+        time.sleep(0.01)
+    if last is not None:
+        out["last_journal"] = {"bearing": last.bearing, "eccentricity_ratio": last.eccentricity_ratio,
+                               "speed": last.speed, "x": last.x, "y": last.y}
+    print(json.dumps(out))
+
+
+if __name__ == "__main__":
+    main()

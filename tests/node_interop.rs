@@ -1,0 +1,113 @@
+//! The live node against an independent DDS peer (Cyclone DDS from PyPI), in a private network
+//! namespace with loopback only (`unshare -n`): the twin reacts to the speed it is sent, refuses
+//! bad speeds and says so, raises instability warnings that a late subscriber still gets, never
+//! publishes a non-finite number, and leaves a recording that independent readers open after
+//! SIGINT.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+#[test]
+fn node_talks_to_an_independent_peer_and_records() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let setup = Command::new("bash")
+        .arg(root.join("tests/interop/setup-venv.sh"))
+        .output()
+        .expect("setup-venv.sh");
+    assert!(
+        setup.status.success(),
+        "{}",
+        String::from_utf8_lossy(&setup.stderr)
+    );
+    let py = root.join("tests/.venv/bin/python");
+    let out = std::env::temp_dir().join(format!("rotor-twin-node-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let status = Command::new("unshare")
+        .arg("-n")
+        .arg("bash")
+        .arg(root.join("tests/interop/node_scenario.sh"))
+        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
+        .arg(&py)
+        .arg(&out)
+        .status()
+        .expect("unshare (needs root: every DDS test runs in a private network namespace)");
+    assert!(status.success());
+    let read = |name: &str| -> Value {
+        let text = std::fs::read_to_string(out.join(name)).unwrap_or_default();
+        serde_json::from_str(&text).unwrap_or_else(|e| {
+            panic!(
+                "{name}: {e}: '{text}'\nnode: {}",
+                std::fs::read_to_string(out.join("node.err")).unwrap_or_default()
+            )
+        })
+    };
+    let peer = read("peer.json");
+    println!(
+        "peer: {} journal states, first after {} s",
+        peer["journal"], peer["first_journal_after_s"]
+    );
+    assert!(peer["journal"].as_u64().unwrap() > 100, "{peer}");
+    assert_eq!(peer["nonfinite"], 0);
+    // the twin runs at the speed it was sent
+    assert!(
+        peer["speeds"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| (s.as_f64().unwrap() - 963.42).abs() < 1e-9),
+        "{peer}"
+    );
+    let kinds: Vec<&str> = peer["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["kind"].as_str().unwrap())
+        .collect();
+    assert!(kinds.contains(&"bad_input"), "{kinds:?}");
+    assert!(
+        kinds.iter().any(|k| *k == "whirl" || *k == "whip"),
+        "{kinds:?}"
+    );
+    let late = read("late.json");
+    assert!(
+        !late["warnings"].as_array().unwrap().is_empty(),
+        "the late subscriber got no latched warning: {late}"
+    );
+    let node_err = std::fs::read_to_string(out.join("node.err")).unwrap();
+    assert!(node_err.contains("recording finished"), "{node_err}");
+    assert!(node_err.contains("node exit 0"), "{node_err}");
+    // the recording opens in rosbags and mcap-ros2-support with every topic
+    let bag = Command::new(&py)
+        .arg(root.join("tests/interop/read_bag.py"))
+        .arg(out.join("bag"))
+        .output()
+        .unwrap();
+    assert!(
+        bag.status.success(),
+        "{}",
+        String::from_utf8_lossy(&bag.stderr)
+    );
+    let v: Value = serde_json::from_slice(&bag.stdout).unwrap();
+    for reader in ["rosbags", "mcap_ros2"] {
+        let c = &v[reader]["counts"];
+        for topic in [
+            "/rotor_twin/speed",
+            "/rotor_twin/journal_state",
+            "/rotor_twin/film_state",
+            "/rotor_twin/orbit",
+            "/rotor_twin/warning",
+            "/diagnostics",
+        ] {
+            assert!(
+                c[topic].as_u64().unwrap_or(0) > 0,
+                "{reader}: no {topic} in the recording: {v}"
+            );
+        }
+    }
+    assert_eq!(
+        v["rosbags"]["types"]["/rotor_twin/journal_state"],
+        "rotor_twin_msgs/msg/JournalState"
+    );
+    std::fs::remove_dir_all(&out).ok();
+}
