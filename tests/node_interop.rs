@@ -1,7 +1,8 @@
 //! The live node against an independent DDS peer (Cyclone DDS from PyPI), in a private network
 //! namespace with loopback only (`unshare -n`): the twin reacts to the speed it is sent, refuses
 //! bad speeds and says so, raises instability warnings that a late subscriber still gets, never
-//! publishes a non-finite number, and leaves a recording that independent readers open after
+//! publishes a non-finite number, answers measured probe displacements with residuals, and leaves
+//! a recording that independent readers open after
 //! SIGINT.
 
 use serde_json::Value;
@@ -69,6 +70,9 @@ fn node_talks_to_an_independent_peer_and_records() {
         kinds.iter().any(|k| *k == "whirl" || *k == "whip"),
         "{kinds:?}"
     );
+    // measured probe displacements come back as predicted − measured residuals
+    assert!(peer["residuals"].as_u64().unwrap() > 10, "{peer}");
+    assert_eq!(peer["residual_ok"], true);
     let late = read("late.json");
     assert!(
         !late["warnings"].as_array().unwrap().is_empty(),

@@ -5,6 +5,8 @@
 //! - in  `/rotor_twin/speed` rotor_twin_msgs/RotorSpeed, or std_msgs/Float64 with `speed_type:=float64`
 //!   (unit `speed_unit`), reliable, keep last 100;
 //! - in  `/rotor_twin/unbalance` rotor_twin_msgs/Unbalance, reliable, keep last 100;
+//! - in  `/rotor_twin/probe` rotor_twin_msgs/ProbeDisplacement (m), reliable, keep last 100;
+//!   out `/rotor_twin/residual` OrbitResidual: predicted minus measured at that station;
 //! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
@@ -44,6 +46,8 @@ pub struct NodeSetup {
 
 const SPEED: &str = "/rotor_twin/speed";
 const UNBALANCE: &str = "/rotor_twin/unbalance";
+const PROBE: &str = "/rotor_twin/probe";
+const RESIDUAL: &str = "/rotor_twin/residual";
 const JOURNAL: &str = "/rotor_twin/journal_state";
 const FILM: &str = "/rotor_twin/film_state";
 const ORBIT: &str = "/rotor_twin/orbit";
@@ -95,6 +99,7 @@ enum ToRecord {
     Speed(messages::RotorSpeed, i64),
     Speed64(messages::Float64, i64),
     Unbalance(messages::Unbalance, i64),
+    Probe(messages::ProbeDisplacement, i64),
 }
 
 /// Runs the node until SIGINT or SIGTERM.
@@ -196,6 +201,7 @@ async fn run_async(
     let pub_orbit = publisher!(messages::Orbit, ORBIT, state_qos);
     let pub_warning = publisher!(messages::InstabilityWarning, WARNING, warning_qos);
     let pub_diag = publisher!(messages::DiagnosticArray, DIAGNOSTICS, state_qos);
+    let pub_residual = publisher!(messages::OrbitResidual, RESIDUAL, state_qos);
 
     // recording
     let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
@@ -215,6 +221,8 @@ async fn run_async(
             let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, state_qos)?;
             let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, warning_qos)?;
             let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, state_qos)?;
+            let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input_qos)?;
+            let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, state_qos)?;
             Some(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
                 loop {
                     match rec_rx.recv_timeout(Duration::from_millis(200)) {
@@ -224,6 +232,7 @@ async fn run_async(
                                 ToRecord::Speed(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
                                 ToRecord::Speed64(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
                                 ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
+                                ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
                                 ToRecord::Out(o, ns) => match o {
                                     Outgoing::Journal(m) => {
                                         rec.write(h_journal, m, t(ns), t(ns))?
@@ -235,6 +244,9 @@ async fn run_async(
                                     }
                                     Outgoing::Diagnostics(m) => {
                                         rec.write(h_diag, m, t(ns), t(ns))?
+                                    }
+                                    Outgoing::Residual(m) => {
+                                        rec.write(h_residual, m, t(ns), t(ns))?
                                     }
                                 },
                             }
@@ -281,6 +293,7 @@ async fn run_async(
                     Outgoing::Orbit(m) => pub_orbit.publish(m.clone()).is_ok(),
                     Outgoing::Warning(m) => pub_warning.publish(m.clone()).is_ok(),
                     Outgoing::Diagnostics(m) => pub_diag.publish(m.clone()).is_ok(),
+                    Outgoing::Residual(m) => pub_residual.publish(m.clone()).is_ok(),
                 };
                 if recording {
                     let _ = rec_out.try_send(ToRecord::Out(item, t));
@@ -406,6 +419,56 @@ async fn run_async(
             }
         });
     }
+    {
+        let topic = node
+            .create_topic(
+                &topic_name(&ros.remaps, PROBE)?,
+                type_name::<messages::ProbeDisplacement>(),
+                &qos_profile(input_qos),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::ProbeDisplacement>(
+                &topic,
+                Some(qos_profile(input_qos)),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let (inputs, rec) = (inputs.clone(), rec_tx.clone());
+        let stations = desc_stations(&setup)?;
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                let now = now_ns();
+                if recording {
+                    let _ = rec.try_send(ToRecord::Probe(m.clone(), now));
+                }
+                let station = stations.iter().position(|s| *s == m.station);
+                match (station, check_probe(m.x, m.y)) {
+                    (Some(k), Ok((x, y))) => {
+                        let stamp = if m.header.stamp.as_nanos() != 0 {
+                            m.header.stamp.as_nanos()
+                        } else {
+                            now
+                        };
+                        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
+                        // keep the queue bounded: a burst keeps its newest samples
+                        if g.probes.len() >= 1000 {
+                            g.probes.remove(0);
+                        }
+                        g.probes.push((k, x, y, stamp));
+                    }
+                    (None, _) => reject(
+                        &inputs,
+                        format!(
+                            "probe station '{}' is not in the machine description",
+                            m.station
+                        ),
+                    ),
+                    (_, Err(why)) => reject(&inputs, why),
+                }
+            }
+        });
+    }
     drop(rec_tx);
     let spinner = node
         .spinner()
@@ -446,6 +509,14 @@ fn speed_topic_label(ros: &RosArgs) -> String {
         .get(SPEED)
         .cloned()
         .unwrap_or_else(|| SPEED.to_string())
+}
+
+fn desc_stations(setup: &NodeSetup) -> anyhow::Result<Vec<String>> {
+    let desc = match &setup.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    Ok(desc.probes.iter().map(|p| p.name.clone()).collect())
 }
 
 fn desc_planes(setup: &NodeSetup) -> anyhow::Result<usize> {

@@ -19,6 +19,8 @@ pub struct Inputs {
     pub speed: Option<(f64, f64, Instant)>,
     /// Unbalance changes not yet applied: (plane, m·e kg·m, phase rad).
     pub unbalance: Vec<(usize, f64, f64)>,
+    /// Measured probe displacements not yet compared: (station index, x m, y m, stamp ns).
+    pub probes: Vec<(usize, f64, f64, i64)>,
     /// Rejected inputs since the last report, with the last reason.
     pub rejected: u64,
     /// The last rejection's reason.
@@ -38,6 +40,8 @@ pub enum Outgoing {
     Warning(InstabilityWarning),
     /// Diagnostics.
     Diagnostics(DiagnosticArray),
+    /// Predicted minus measured displacement at a probe station.
+    Residual(OrbitResidual),
 }
 
 /// Wall-clock time (ns since the epoch).
@@ -110,12 +114,14 @@ pub fn run(
     let mut last_stale_warning = Instant::now() - Duration::from_secs(3600);
     let mut last_behind_warning = Instant::now() - Duration::from_secs(3600);
     let epoch_ns = now_ns();
+    let station_names: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     while !stop.load(Ordering::Relaxed) {
-        let (speed, unbalance, age, rejected, last_rejection) = {
+        let (speed, unbalance, probes, age, rejected, last_rejection) = {
             let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
             let r = (
                 g.speed,
                 std::mem::take(&mut g.unbalance),
+                std::mem::take(&mut g.probes),
                 g.speed.map(|s| s.2.elapsed()),
                 g.rejected,
                 g.last_rejection.clone(),
@@ -241,6 +247,27 @@ pub fn run(
             }
             Ok(()) => {
                 let o = t.output();
+                // measured against predicted at each probe station (the latest prediction)
+                for (station, mx, my, stamp_ns) in probes {
+                    if let (Some(p), Some(name)) =
+                        (o.probes.get(station), station_names.get(station))
+                    {
+                        let [px, py] = p.displacement_m;
+                        send(
+                            Outgoing::Residual(OrbitResidual {
+                                header: header(stamp_ns, name),
+                                station: name.clone(),
+                                predicted_x: px,
+                                predicted_y: py,
+                                measured_x: mx,
+                                measured_y: my,
+                                residual_x: px - mx,
+                                residual_y: py - my,
+                            }),
+                            &mut dropped,
+                        );
+                    }
+                }
                 if step_index % decimation == 0 {
                     for (k, b) in o.bearings.iter().enumerate() {
                         send(

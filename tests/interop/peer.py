@@ -47,6 +47,28 @@ class RotorSpeed(IdlStruct, typename="rotor_twin_msgs::msg::dds_::RotorSpeed_"):
 
 @dataclass
 @annotate.final
+class ProbeDisplacement(IdlStruct, typename="rotor_twin_msgs::msg::dds_::ProbeDisplacement_"):
+    header: Header
+    station: str
+    x: float64
+    y: float64
+
+
+@dataclass
+@annotate.final
+class OrbitResidual(IdlStruct, typename="rotor_twin_msgs::msg::dds_::OrbitResidual_"):
+    header: Header
+    station: str
+    predicted_x: float64
+    predicted_y: float64
+    measured_x: float64
+    measured_y: float64
+    residual_x: float64
+    residual_y: float64
+
+
+@dataclass
+@annotate.final
 class JournalState(IdlStruct, typename="rotor_twin_msgs::msg::dds_::JournalState_"):
     header: Header
     bearing: str
@@ -84,7 +106,9 @@ def main():
     w = DataWriter(dp, Topic(dp, "rt/rotor_twin/speed", RotorSpeed), qos=reliable)
     journal = DataReader(dp, Topic(dp, "rt/rotor_twin/journal_state", JournalState), qos=reliable)
     warnings = DataReader(dp, Topic(dp, "rt/rotor_twin/warning", InstabilityWarning), qos=latched)
-    out = {"journal": 0, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
+    probe = DataWriter(dp, Topic(dp, "rt/rotor_twin/probe", ProbeDisplacement), qos=reliable)
+    residuals = DataReader(dp, Topic(dp, "rt/rotor_twin/residual", OrbitResidual), qos=reliable)
+    out = {"residuals": 0, "residual_ok": True, "journal": 0, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
     start = time.time()
     last = None
     bad = [float("nan"), float("inf"), -100.0, 1e9] if "--bad" in sys.argv else []
@@ -93,7 +117,14 @@ def main():
         now = time.time_ns()
         value = bad.pop(0) if bad else speed
         if not listen_only:
-            w.write(RotorSpeed(Header(Time(now // 1_000_000_000, now % 1_000_000_000), ""), value, 0.0))
+            stamp = Header(Time(now // 1_000_000_000, now % 1_000_000_000), "")
+            w.write(RotorSpeed(stamp, value, 0.0))
+            probe.write(ProbeDisplacement(stamp, "probe_outboard", 1.0e-5, -2.0e-5))
+        for s in residuals.take(N=1000):
+            out["residuals"] += 1
+            if s.station != "probe_outboard" or abs(s.measured_x - 1.0e-5) > 1e-15 or \
+                    abs(s.residual_x - (s.predicted_x - s.measured_x)) > 1e-15:
+                out["residual_ok"] = False
         for s in journal.take(N=1000):
             out["journal"] += 1
             vals = [s.x, s.y, s.vx, s.vy, s.eccentricity_ratio, s.attitude, s.speed]
