@@ -73,6 +73,22 @@ fn node_talks_to_an_independent_peer_and_records() {
     // measured probe displacements come back as predicted − measured residuals
     assert!(peer["residuals"].as_u64().unwrap() > 10, "{peer}");
     assert_eq!(peer["residual_ok"], true);
+    // both probe routes: rotor_twin_msgs/ProbeDisplacement and a plant's geometry_msgs/PointStamped
+    let stations = peer["stations"].as_array().unwrap();
+    assert!(
+        stations.iter().any(|s| s == "probe_outboard")
+            && stations.iter().any(|s| s == "probe_pulley_end"),
+        "{peer}"
+    );
+    // the stability margin: the linear threshold of `rotor-twin modes` (8,635 rpm = 904.3 rad/s)
+    let m = &peer["margin"];
+    assert_eq!(m["threshold_found"], true, "{peer}");
+    let threshold = m["threshold_speed"].as_f64().unwrap();
+    assert!((threshold - 904.3).abs() < 0.01 * 904.3, "{m}");
+    assert!(
+        (m["margin"].as_f64().unwrap() - (threshold - 963.42)).abs() < 1e-6,
+        "{m}"
+    );
     let late = read("late.json");
     assert!(
         !late["warnings"].as_array().unwrap().is_empty(),

@@ -48,6 +48,7 @@ const SPEED: &str = "/rotor_twin/speed";
 const UNBALANCE: &str = "/rotor_twin/unbalance";
 const PROBE: &str = "/rotor_twin/probe";
 const RESIDUAL: &str = "/rotor_twin/residual";
+const MARGIN: &str = "/rotor_twin/stability_margin";
 const JOURNAL: &str = "/rotor_twin/journal_state";
 const FILM: &str = "/rotor_twin/film_state";
 const ORBIT: &str = "/rotor_twin/orbit";
@@ -202,6 +203,7 @@ async fn run_async(
     let pub_warning = publisher!(messages::InstabilityWarning, WARNING, warning_qos);
     let pub_diag = publisher!(messages::DiagnosticArray, DIAGNOSTICS, state_qos);
     let pub_residual = publisher!(messages::OrbitResidual, RESIDUAL, state_qos);
+    let pub_margin = publisher!(messages::StabilityMargin, MARGIN, TopicQos::latched(1));
 
     // recording
     let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
@@ -223,6 +225,8 @@ async fn run_async(
             let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, state_qos)?;
             let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input_qos)?;
             let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, state_qos)?;
+            let h_margin =
+                rec.add_topic::<messages::StabilityMargin>(MARGIN, TopicQos::latched(1))?;
             Some(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
                 loop {
                     match rec_rx.recv_timeout(Duration::from_millis(200)) {
@@ -248,6 +252,7 @@ async fn run_async(
                                     Outgoing::Residual(m) => {
                                         rec.write(h_residual, m, t(ns), t(ns))?
                                     }
+                                    Outgoing::Margin(m) => rec.write(h_margin, m, t(ns), t(ns))?,
                                 },
                             }
                         }
@@ -294,6 +299,7 @@ async fn run_async(
                     Outgoing::Warning(m) => pub_warning.publish(m.clone()).is_ok(),
                     Outgoing::Diagnostics(m) => pub_diag.publish(m.clone()).is_ok(),
                     Outgoing::Residual(m) => pub_residual.publish(m.clone()).is_ok(),
+                    Outgoing::Margin(m) => pub_margin.publish(m.clone()).is_ok(),
                 };
                 if recording {
                     let _ = rec_out.try_send(ToRecord::Out(item, t));
@@ -465,6 +471,47 @@ async fn run_async(
                         ),
                     ),
                     (_, Err(why)) => reject(&inputs, why),
+                }
+            }
+        });
+    }
+    // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
+    let stations = desc_stations(&setup)?;
+    for (station, topic_text) in &params.probe_point_topics {
+        let k = stations
+            .iter()
+            .position(|s| s == station)
+            .ok_or_else(|| anyhow::anyhow!("parameter probe_point_topics: station '{station}' is not in the machine description"))?;
+        let name = Name::parse(topic_text)
+            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+        let topic = node
+            .create_topic(
+                &name,
+                type_name::<messages::PointStamped>(),
+                &qos_profile(input_qos),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::PointStamped>(&topic, Some(qos_profile(input_qos)))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let inputs = inputs.clone();
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                match check_probe(m.point.x, m.point.y) {
+                    Ok((x, y)) => {
+                        let stamp = if m.header.stamp.as_nanos() != 0 {
+                            m.header.stamp.as_nanos()
+                        } else {
+                            now_ns()
+                        };
+                        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
+                        if g.probes.len() >= 1000 {
+                            g.probes.remove(0);
+                        }
+                        g.probes.push((k, x, y, stamp));
+                    }
+                    Err(why) => reject(&inputs, why),
                 }
             }
         });

@@ -42,6 +42,8 @@ pub enum Outgoing {
     Diagnostics(DiagnosticArray),
     /// Predicted minus measured displacement at a probe station.
     Residual(OrbitResidual),
+    /// Distance from the linear stability threshold.
+    Margin(StabilityMargin),
 }
 
 /// Wall-clock time (ns since the epoch).
@@ -114,6 +116,28 @@ pub fn run(
     let mut last_stale_warning = Instant::now() - Duration::from_secs(3600);
     let mut last_behind_warning = Instant::now() - Duration::from_secs(3600);
     let epoch_ns = now_ns();
+    // the linear threshold depends on the static loads, not on the present speed: compute it once,
+    // on a helper thread, and report the margin to it every second
+    let threshold: Arc<Mutex<Option<Option<(f64, f64)>>>> = Arc::new(Mutex::new(None));
+    {
+        let (rotor, threshold) = (rotor.clone(), threshold.clone());
+        std::thread::spawn(move || {
+            let rated_rpm = rotor.rated_speed_rad_s * 30.0 / std::f64::consts::PI;
+            let found = crate::rotor::static_solution(&rotor).ok().and_then(|st| {
+                crate::rotor::stability_threshold(
+                    &rotor,
+                    &st,
+                    (0.1 * rated_rpm).max(100.0),
+                    2.0 * rated_rpm,
+                    rated_rpm / 20.0,
+                )
+                .ok()
+            });
+            let value = found
+                .map(|t| t.map(|t| (t.speed_rpm * std::f64::consts::PI / 30.0, t.whirl_ratio)));
+            *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value.unwrap_or(None));
+        });
+    }
     let station_names: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     while !stop.load(Ordering::Relaxed) {
         let (speed, unbalance, probes, age, rejected, last_rejection) = {
@@ -389,6 +413,27 @@ pub fn run(
             );
         }
         if last_report.elapsed() >= Duration::from_secs(1) {
+            if let Some(found) = *threshold.lock().unwrap_or_else(|e| e.into_inner()) {
+                let (threshold_found, threshold_speed, whirl_ratio) = match found {
+                    Some((s, r)) => (true, s, r),
+                    None => (false, 0.0, 0.0),
+                };
+                send(
+                    Outgoing::Margin(StabilityMargin {
+                        header: header(now_ns(), ""),
+                        speed: w,
+                        threshold_found,
+                        threshold_speed,
+                        margin: if threshold_found {
+                            threshold_speed - w
+                        } else {
+                            0.0
+                        },
+                        whirl_ratio,
+                    }),
+                    &mut dropped,
+                );
+            }
             let wall = last_report.elapsed().as_secs_f64();
             let rtf = steps_since as f64 * h / wall;
             let values = vec![

@@ -51,6 +51,8 @@ pub struct NodeParams {
     pub use_sim_time: bool,
     /// `warning_amplitude_ratio`: orbit amplitude over clearance that raises a warning.
     pub warning_amplitude_ratio: f64,
+    /// `probe_point_topics`: probe pairs as geometry_msgs/PointStamped, `station=topic,…`.
+    pub probe_point_topics: Vec<(String, String)>,
 }
 
 impl Default for NodeParams {
@@ -67,6 +69,7 @@ impl Default for NodeParams {
             speed_unit: SpeedUnit::Rpm,
             use_sim_time: false,
             warning_amplitude_ratio: 0.5,
+            probe_point_topics: Vec::new(),
         }
     }
 }
@@ -126,6 +129,21 @@ impl NodeParams {
             }
             "warning_amplitude_ratio" => {
                 self.warning_amplitude_ratio = positive(num(value)?, "must be above zero")?
+            }
+            "probe_point_topics" => {
+                let mut pairs = Vec::new();
+                for item in value.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+                    let (station, topic) = item.split_once('=').ok_or_else(|| {
+                        format!("parameter probe_point_topics: '{item}' must be station=topic")
+                    })?;
+                    if !topic.starts_with('/') {
+                        return Err(format!(
+                            "parameter probe_point_topics: topic '{topic}' must be absolute (/…)"
+                        ));
+                    }
+                    pairs.push((station.trim().to_string(), topic.trim().to_string()));
+                }
+                self.probe_point_topics = pairs;
             }
             "speed_type" => match value {
                 "rotor_speed" | "float64" => self.speed_type = value.into(),
@@ -281,6 +299,16 @@ mod tests {
             .unwrap_err()
             .contains("steps_per_rev"));
         assert!(p.set("bogus", "1").unwrap_err().contains("bogus"));
+        p.set(
+            "probe_point_topics",
+            "probe_outboard=/plant/probe_a, probe_pulley_end=/plant/probe_b",
+        )
+        .unwrap();
+        assert_eq!(
+            p.probe_point_topics[1],
+            ("probe_pulley_end".to_string(), "/plant/probe_b".to_string())
+        );
+        assert!(p.set("probe_point_topics", "x:/a").is_err());
         assert!((SpeedUnit::Rpm.to_rad_s(9000.0) - 942.477_796).abs() < 1e-5);
     }
 }

@@ -69,6 +69,32 @@ class OrbitResidual(IdlStruct, typename="rotor_twin_msgs::msg::dds_::OrbitResidu
 
 @dataclass
 @annotate.final
+class StabilityMargin(IdlStruct, typename="rotor_twin_msgs::msg::dds_::StabilityMargin_"):
+    header: Header
+    speed: float64
+    threshold_found: bool
+    threshold_speed: float64
+    margin: float64
+    whirl_ratio: float64
+
+
+@dataclass
+@annotate.final
+class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+@annotate.final
+class PointStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PointStamped_"):
+    header: Header
+    point: Point
+
+
+@dataclass
+@annotate.final
 class JournalState(IdlStruct, typename="rotor_twin_msgs::msg::dds_::JournalState_"):
     header: Header
     bearing: str
@@ -108,7 +134,9 @@ def main():
     warnings = DataReader(dp, Topic(dp, "rt/rotor_twin/warning", InstabilityWarning), qos=latched)
     probe = DataWriter(dp, Topic(dp, "rt/rotor_twin/probe", ProbeDisplacement), qos=reliable)
     residuals = DataReader(dp, Topic(dp, "rt/rotor_twin/residual", OrbitResidual), qos=reliable)
-    out = {"residuals": 0, "residual_ok": True, "journal": 0, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
+    margins = DataReader(dp, Topic(dp, "rt/rotor_twin/stability_margin", StabilityMargin), qos=latched)
+    plant_probe = DataWriter(dp, Topic(dp, "rt/plant/probe_b", PointStamped), qos=reliable)
+    out = {"residuals": 0, "residual_ok": True, "journal": 0, "stations": [], "margin": None, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
     start = time.time()
     last = None
     bad = [float("nan"), float("inf"), -100.0, 1e9] if "--bad" in sys.argv else []
@@ -120,11 +148,16 @@ def main():
             stamp = Header(Time(now // 1_000_000_000, now % 1_000_000_000), "")
             w.write(RotorSpeed(stamp, value, 0.0))
             probe.write(ProbeDisplacement(stamp, "probe_outboard", 1.0e-5, -2.0e-5))
+            plant_probe.write(PointStamped(stamp, Point(1.0e-5, -2.0e-5, 0.0)))
         for s in residuals.take(N=1000):
             out["residuals"] += 1
-            if s.station != "probe_outboard" or abs(s.measured_x - 1.0e-5) > 1e-15 or \
-                    abs(s.residual_x - (s.predicted_x - s.measured_x)) > 1e-15:
+            if s.station not in out["stations"]:
+                out["stations"].append(s.station)
+            if abs(s.measured_x - 1.0e-5) > 1e-15 or abs(s.residual_x - (s.predicted_x - s.measured_x)) > 1e-15:
                 out["residual_ok"] = False
+        for s in margins.take(N=10):
+            out["margin"] = {"speed": s.speed, "threshold_found": s.threshold_found,
+                             "threshold_speed": s.threshold_speed, "margin": s.margin, "whirl_ratio": s.whirl_ratio}
         for s in journal.take(N=1000):
             out["journal"] += 1
             vals = [s.x, s.y, s.vx, s.vy, s.eccentricity_ratio, s.attitude, s.speed]
