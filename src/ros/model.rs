@@ -46,6 +46,10 @@ pub enum Outgoing {
     Margin(StabilityMargin),
 }
 
+/// The linear threshold once computed: Some(Some((speed rad/s, whirl ratio))), Some(None) if
+/// stable over the range, None while computing.
+type ThresholdSlot = Option<Option<(f64, f64)>>;
+
 /// Wall-clock time (ns since the epoch).
 pub fn now_ns() -> i64 {
     SystemTime::now()
@@ -118,7 +122,7 @@ pub fn run(
     let epoch_ns = now_ns();
     // the linear threshold depends on the static loads, not on the present speed: compute it once,
     // on a helper thread, and report the margin to it every second
-    let threshold: Arc<Mutex<Option<Option<(f64, f64)>>>> = Arc::new(Mutex::new(None));
+    let threshold: Arc<Mutex<ThresholdSlot>> = Arc::new(Mutex::new(None));
     {
         let (rotor, threshold) = (rotor.clone(), threshold.clone());
         std::thread::spawn(move || {
