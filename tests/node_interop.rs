@@ -1,4 +1,5 @@
-//! The live node against an independent DDS peer (Cyclone DDS from PyPI), in a private network
+//! The live node against an independent DDS peer (a burst of 10,000 speed messages with NaNs and a
+//! stale stamp among them included) (Cyclone DDS from PyPI), in a private network
 //! namespace with loopback only (`unshare -n`): the twin reacts to the speed it is sent, refuses
 //! bad speeds and says so, raises instability warnings that a late subscriber still gets, never
 //! publishes a non-finite number, answers measured probe displacements with residuals, and leaves
@@ -128,6 +129,27 @@ fn node_talks_to_an_independent_peer_and_records() {
     assert_eq!(
         v["rosbags"]["types"]["/rotor_twin/journal_state"],
         "rotor_twin_msgs/msg/JournalState"
+    );
+    // the burst of 10,000 speeds (100 of them NaN, one 10 s stale) is recorded whole: nothing lost
+    let recorded = v["rosbags"]["counts"]["/rotor_twin/speed"]
+        .as_u64()
+        .unwrap();
+    println!("speed messages recorded: {recorded} (burst of 10,000 plus the steady stream)");
+    assert_eq!(
+        recorded,
+        peer["sent"].as_u64().unwrap(),
+        "every message the peer sent is recorded"
+    );
+    let evidence: Vec<&str> = peer["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["kind"] == "bad_input")
+        .map(|w| w["evidence"].as_str().unwrap())
+        .collect();
+    assert!(
+        evidence.iter().any(|e| e.contains("rejected")),
+        "{evidence:?}"
     );
     std::fs::remove_dir_all(&out).ok();
 }

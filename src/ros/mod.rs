@@ -181,6 +181,9 @@ async fn run_async(
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
     let input_qos = TopicQos::reliable(100);
+    // subscriptions keep a deep history: RustDDS drops unread samples beyond it silently, and a
+    // burst of 10,000 messages must not lose any
+    let reader_qos = qos_profile(TopicQos::reliable(20_000));
     let state_qos = TopicQos::reliable(10);
     let warning_qos = TopicQos::latched(1);
 
@@ -330,7 +333,7 @@ async fn run_async(
             )
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let sub = node
-            .create_subscription::<messages::Float64>(&topic, Some(qos_profile(input_qos)))
+            .create_subscription::<messages::Float64>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, gate, rec, unit) = (
             inputs.clone(),
@@ -369,7 +372,7 @@ async fn run_async(
             )
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let sub = node
-            .create_subscription::<messages::RotorSpeed>(&topic, Some(qos_profile(input_qos)))
+            .create_subscription::<messages::RotorSpeed>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, gate, rec) = (inputs.clone(), gate.clone(), rec_tx.clone());
         tokio::spawn(async move {
@@ -404,7 +407,7 @@ async fn run_async(
             )
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let sub = node
-            .create_subscription::<messages::Unbalance>(&topic, Some(qos_profile(input_qos)))
+            .create_subscription::<messages::Unbalance>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, rec) = (inputs.clone(), rec_tx.clone());
         let planes = desc_planes(&setup)?;
@@ -434,10 +437,7 @@ async fn run_async(
             )
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let sub = node
-            .create_subscription::<messages::ProbeDisplacement>(
-                &topic,
-                Some(qos_profile(input_qos)),
-            )
+            .create_subscription::<messages::ProbeDisplacement>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, rec) = (inputs.clone(), rec_tx.clone());
         let stations = desc_stations(&setup)?;
@@ -492,7 +492,7 @@ async fn run_async(
             )
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let sub = node
-            .create_subscription::<messages::PointStamped>(&topic, Some(qos_profile(input_qos)))
+            .create_subscription::<messages::PointStamped>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let inputs = inputs.clone();
         tokio::spawn(async move {

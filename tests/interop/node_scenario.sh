@@ -10,7 +10,7 @@ rm -rf "$out/bag"
 node=$!
 sleep 1
 # 9,200 rpm = 963.4 rad/s, above the linear threshold: the linear model whirls and grows
-timeout 40 "$py" "$here/peer.py" 7 963.42 --bad > "$out/peer.json" 2> "$out/peer.err"
+timeout 60 "$py" "$here/peer.py" 7 963.42 --bad --burst 10000 > "$out/peer.json" 2> "$out/peer.err"
 # a late subscriber: only the latched warning
 timeout 20 "$py" "$here/peer.py" 2 963.42 --warnings-only > "$out/late.json" 2> "$out/late.err"
 kill -INT "$node"

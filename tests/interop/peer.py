@@ -136,17 +136,33 @@ def main():
     residuals = DataReader(dp, Topic(dp, "rt/rotor_twin/residual", OrbitResidual), qos=reliable)
     margins = DataReader(dp, Topic(dp, "rt/rotor_twin/stability_margin", StabilityMargin), qos=latched)
     plant_probe = DataWriter(dp, Topic(dp, "rt/plant/probe_b", PointStamped), qos=reliable)
-    out = {"residuals": 0, "residual_ok": True, "journal": 0, "stations": [], "margin": None, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
+    out = {"sent": 0, "residuals": 0, "residual_ok": True, "journal": 0, "stations": [], "margin": None, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
     start = time.time()
     last = None
     bad = [float("nan"), float("inf"), -100.0, 1e9] if "--bad" in sys.argv else []
     listen_only = "--warnings-only" in sys.argv
+    if "--burst" in sys.argv:
+        # wait until the node answers, then a burst: every 100th value NaN, one stamp 10 s stale
+        deadline = time.time() + 10
+        while time.time() < deadline and not journal.read(N=1):
+            now = time.time_ns()
+            w.write(RotorSpeed(Header(Time(now // 1_000_000_000, now % 1_000_000_000), ""), speed, 0.0))
+            out["sent"] += 1
+            time.sleep(0.02)
+        n = int(sys.argv[sys.argv.index("--burst") + 1])
+        for i in range(n):
+            now = time.time_ns() - (10_000_000_000 if i == n // 2 else 0)
+            v = float("nan") if i % 100 == 0 else speed + 1e-6 * (i % 2)
+            w.write(RotorSpeed(Header(Time(now // 1_000_000_000, now % 1_000_000_000), ""), v, 0.0))
+            out["sent"] += 1
+        out["burst_sent"] = n
     while time.time() - start < seconds:
         now = time.time_ns()
         value = bad.pop(0) if bad else speed
         if not listen_only:
             stamp = Header(Time(now // 1_000_000_000, now % 1_000_000_000), "")
             w.write(RotorSpeed(stamp, value, 0.0))
+            out["sent"] += 1
             probe.write(ProbeDisplacement(stamp, "probe_outboard", 1.0e-5, -2.0e-5))
             plant_probe.write(PointStamped(stamp, Point(1.0e-5, -2.0e-5, 0.0)))
         for s in residuals.take(N=1000):
