@@ -153,3 +153,38 @@ fn node_talks_to_an_independent_peer_and_records() {
     );
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// With use_sim_time the model follows `/clock` (rosgraph_msgs/Clock), not the wall clock: a peer
+/// runs the simulation clock at half real time from 1,000 s for 6 s, and the node's journal states
+/// are stamped from 1,000 s on and span half the wall time, 3 s (±20 %: start-up and the peer's
+/// 10 ms loop), where the wall clock would have given 6 s.
+#[test]
+fn node_follows_simulation_time() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let setup = Command::new("bash")
+        .arg(root.join("tests/interop/setup-venv.sh"))
+        .output()
+        .expect("setup-venv.sh");
+    assert!(setup.status.success());
+    let py = root.join("tests/.venv/bin/python");
+    let out = std::env::temp_dir().join(format!("rotor-twin-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let status = Command::new("unshare")
+        .args(["-n", "bash"])
+        .arg(root.join("tests/interop/sim_time_scenario.sh"))
+        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
+        .arg(&py)
+        .arg(&out)
+        .status()
+        .expect("unshare");
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("peer.json")).unwrap_or_default();
+    let peer: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: '{text}'"));
+    let stamps = peer["stamps"].as_array().unwrap();
+    let (first, last) = (stamps[0].as_f64().unwrap(), stamps[1].as_f64().unwrap());
+    println!("sim time: journal stamps {first:.3} … {last:.3} s over 6 s of wall time at rate 0.5");
+    assert!((1000.0..1001.0).contains(&first), "{first}");
+    let span = last - first;
+    assert!((span - 3.0).abs() < 0.6, "span {span} s");
+    std::fs::remove_dir_all(&out).ok();
+}

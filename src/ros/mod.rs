@@ -10,7 +10,9 @@
 //! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
-//!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz.
+//!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz;
+//! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
+//!   outputs are stamped in simulation time.
 
 mod inputs;
 mod model;
@@ -110,10 +112,6 @@ pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     for (k, v) in &ros.params {
         params.set(k, v).map_err(anyhow::Error::msg)?;
     }
-    anyhow::ensure!(
-        !params.use_sim_time,
-        "use_sim_time:=true is not supported yet: the node follows the wall clock"
-    );
     let desc = match &setup.config {
         Some(p) => MachineDescription::from_file(p)?,
         None => MachineDescription::builtin_default(),
@@ -375,15 +373,23 @@ async fn run_async(
             .create_subscription::<messages::RotorSpeed>(&topic, Some(reader_qos.clone()))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, gate, rec) = (inputs.clone(), gate.clone(), rec_tx.clone());
+        let sim_time = params.use_sim_time;
         tokio::spawn(async move {
             let mut stream = Box::pin(sub.async_stream());
             while let Some(Ok((m, _info))) = stream.next().await {
                 let now = now_ns();
+                // stamps are judged against the clock the node follows
+                let clock_now = if sim_time {
+                    let sim = inputs.lock().unwrap_or_else(|e| e.into_inner()).sim_time_ns;
+                    sim.unwrap_or(m.header.stamp.as_nanos())
+                } else {
+                    now
+                };
                 let checked = gate.lock().unwrap_or_else(|e| e.into_inner()).check(
                     m.speed,
                     m.acceleration,
                     m.header.stamp.as_nanos(),
-                    now,
+                    clock_now,
                 );
                 if recording {
                     let _ = rec.try_send(ToRecord::Speed(m, now));
@@ -512,6 +518,35 @@ async fn run_async(
                         g.probes.push((k, x, y, stamp));
                     }
                     Err(why) => reject(&inputs, why),
+                }
+            }
+        });
+    }
+    if params.use_sim_time {
+        // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
+        let topic = node
+            .create_topic(
+                &topic_name(&ros.remaps, "/clock")?,
+                type_name::<messages::Clock>(),
+                &qos_profile(TopicQos::sensor(1)),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let sub = node
+            .create_subscription::<messages::Clock>(&topic, Some(qos_profile(TopicQos::sensor(10))))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let inputs = inputs.clone();
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(Ok((m, _info))) = stream.next().await {
+                let ns = m.clock.as_nanos();
+                let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
+                // simulation time never runs backwards
+                if g.sim_time_ns.is_none_or(|t| ns >= t) {
+                    g.sim_time_ns = Some(ns);
+                } else {
+                    g.rejected += 1;
+                    g.last_rejection =
+                        format!("/clock went backwards to {:.6} s", ns as f64 * 1e-9);
                 }
             }
         });

@@ -25,6 +25,8 @@ pub struct Inputs {
     pub rejected: u64,
     /// The last rejection's reason.
     pub last_rejection: String,
+    /// With use_sim_time: the latest `/clock` time (ns).
+    pub sim_time_ns: Option<i64>,
 }
 
 /// A message for the bus and the recording.
@@ -112,6 +114,7 @@ pub fn run(
         .collect();
     let mut step_index = 0u64;
     let mut wall_start = Instant::now();
+    let mut sim_start_ns: Option<i64> = None;
     let mut model_start_s = 0.0;
     let mut last_report = Instant::now();
     let (mut steps_since, mut overruns, mut worst_step_us) = (0u64, 0u64, 0.0f64);
@@ -119,7 +122,7 @@ pub fn run(
     let mut last_state_warning = Instant::now();
     let mut last_stale_warning = Instant::now() - Duration::from_secs(3600);
     let mut last_behind_warning = Instant::now() - Duration::from_secs(3600);
-    let epoch_ns = now_ns();
+    let mut epoch_ns = now_ns();
     // the linear threshold depends on the static loads, not on the present speed: compute it once,
     // on a helper thread, and report the margin to it every second
     let threshold: Arc<Mutex<ThresholdSlot>> = Arc::new(Mutex::new(None));
@@ -207,6 +210,8 @@ pub fn run(
                         Monitor::new(&t, 2 * params.steps_per_rev, ClassifierSettings::default());
                     twin = Some((t, m));
                     wall_start = Instant::now();
+                    sim_start_ns = None;
+                    epoch_ns = now_ns();
                     model_start_s = 0.0;
                 }
                 Err(e) => {
@@ -231,9 +236,25 @@ pub fn run(
         for (plane, m, p) in unbalance {
             let _ = t.set_unbalance(plane, m, p);
         }
-        // real-time pacing: step k is due at wall time k·h after the start
+        // pacing: step k is due at k·h after the start, on the wall clock or on /clock
         let model_elapsed = t.time_s() - model_start_s;
-        let ahead = model_elapsed - wall_start.elapsed().as_secs_f64();
+        let clock_elapsed = if params.use_sim_time {
+            let sim_now = inputs.lock().unwrap_or_else(|e| e.into_inner()).sim_time_ns;
+            match (sim_now, sim_start_ns) {
+                (Some(now), Some(start)) => (now - start) as f64 * 1e-9,
+                (Some(now), None) => {
+                    sim_start_ns = Some(now);
+                    0.0
+                }
+                _ => {
+                    std::thread::sleep(Duration::from_millis(1));
+                    continue;
+                }
+            }
+        } else {
+            wall_start.elapsed().as_secs_f64()
+        };
+        let ahead = model_elapsed - clock_elapsed;
         if ahead > 0.0 {
             if ahead > 0.002 {
                 std::thread::sleep(Duration::from_secs_f64(ahead - 0.001));
@@ -257,7 +278,8 @@ pub fn run(
             overruns += 1;
         }
         step_index += 1;
-        let stamp = epoch_ns + (t.time_s() * 1e9) as i64;
+        // stamps: the clock the model follows, at the model's time
+        let stamp = sim_start_ns.unwrap_or(epoch_ns) + ((t.time_s() - model_start_s) * 1e9) as i64;
         match result {
             Err(e) => {
                 send(

@@ -1,6 +1,7 @@
 """An independent DDS peer (Cyclone DDS) speaking the ROS 2 conventions to the rotor-twin node.
 
-Usage: peer.py SECONDS SPEED_RAD_S [--domain N] [--bad] [--warnings-only]
+Usage: peer.py SECONDS SPEED_RAD_S [--domain N] [--bad] [--warnings-only] [--sim-clock RATE]
+  --sim-clock RATE: publish /clock from 1000 s at RATE × real time, stamp speeds with it
   --bad: first send NaN, infinite, negative and absurd speeds (the node must refuse them)
   --warnings-only: only listen for the latched warning (a late subscriber)
 Publishes rotor_twin_msgs/RotorSpeed on /rotor_twin/speed at 100 Hz and listens to the node's
@@ -95,6 +96,12 @@ class PointStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PointStamped_"
 
 @dataclass
 @annotate.final
+class Clock(IdlStruct, typename="rosgraph_msgs::msg::dds_::Clock_"):
+    clock: Time
+
+
+@dataclass
+@annotate.final
 class JournalState(IdlStruct, typename="rotor_twin_msgs::msg::dds_::JournalState_"):
     header: Header
     bearing: str
@@ -156,8 +163,14 @@ def main():
             w.write(RotorSpeed(Header(Time(now // 1_000_000_000, now % 1_000_000_000), ""), v, 0.0))
             out["sent"] += 1
         out["burst_sent"] = n
+    sim_rate = float(sys.argv[sys.argv.index("--sim-clock") + 1]) if "--sim-clock" in sys.argv else None
+    clock = DataWriter(dp, Topic(dp, "rt/clock", Clock), qos=reliable) if sim_rate else None
+    out["stamps"] = []
     while time.time() - start < seconds:
         now = time.time_ns()
+        if sim_rate:
+            now = 1000 * 1_000_000_000 + int(sim_rate * (time.time() - start) * 1e9)
+            clock.write(Clock(Time(now // 1_000_000_000, now % 1_000_000_000)))
         value = bad.pop(0) if bad else speed
         if not listen_only:
             stamp = Header(Time(now // 1_000_000_000, now % 1_000_000_000), "")
@@ -176,6 +189,10 @@ def main():
                              "threshold_speed": s.threshold_speed, "margin": s.margin, "whirl_ratio": s.whirl_ratio}
         for s in journal.take(N=1000):
             out["journal"] += 1
+            stamp = s.header.stamp.sec + 1e-9 * s.header.stamp.nanosec
+            if not out["stamps"]:
+                out["stamps"] = [stamp, stamp]
+            out["stamps"][1] = stamp
             vals = [s.x, s.y, s.vx, s.vy, s.eccentricity_ratio, s.attitude, s.speed]
             out["nonfinite"] += sum(1 for v in vals if v != v or v in (float("inf"), float("-inf")))
             if len(out["speeds"]) < 5 or s.speed not in out["speeds"]:
