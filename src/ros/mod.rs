@@ -19,7 +19,7 @@ mod model;
 mod params;
 
 pub use inputs::{check_probe, check_unbalance, SpeedGate};
-pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit};
+pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit, RUNTIME_PARAMETERS};
 
 use crate::messages::{self, RosMessage};
 use crate::record::{Recorder, TopicQos};
@@ -140,7 +140,42 @@ async fn run_async(
 ) -> anyhow::Result<()> {
     let context = Context::with_options(ContextOptions::new().domain_id(domain))
         .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))?;
-    let mut options = NodeOptions::new().enable_rosout(false);
+    // parameters that may change at run time are shared with the model thread
+    let live_params = Arc::new(Mutex::new(params.clone()));
+    let params_version = Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let text_of = |v: &ParameterValue| -> Option<String> {
+        match v {
+            ParameterValue::Double(d) => Some(d.to_string()),
+            ParameterValue::Integer(i) => Some(i.to_string()),
+            ParameterValue::Boolean(b) => Some(b.to_string()),
+            ParameterValue::String(s) => Some(s.clone()),
+            _ => None,
+        }
+    };
+    let validator_params = live_params.clone();
+    let action_params = live_params.clone();
+    let action_version = params_version.clone();
+    let mut options = NodeOptions::new()
+        .enable_rosout(false)
+        .parameter_validator(Box::new(move |name, value| {
+            let text =
+                text_of(value).ok_or_else(|| format!("parameter {name}: unsupported type"))?;
+            let mut trial = validator_params
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .clone();
+            trial.set_at_runtime(name, &text)
+        }))
+        .parameter_set_action(Box::new(move |name, value| {
+            let text =
+                text_of(value).ok_or_else(|| format!("parameter {name}: unsupported type"))?;
+            action_params
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .set_at_runtime(name, &text)?;
+            action_version.fetch_add(1, Ordering::SeqCst);
+            Ok(())
+        }));
     for (name, value) in [
         ("model", ParameterValue::String(params.model.clone())),
         ("delta", ParameterValue::Double(params.delta)),
@@ -169,6 +204,10 @@ async fn run_async(
             ParameterValue::String(params.speed_type.clone()),
         ),
         ("use_sim_time", ParameterValue::Boolean(params.use_sim_time)),
+        (
+            "warning_amplitude_ratio",
+            ParameterValue::Double(params.warning_amplitude_ratio),
+        ),
     ] {
         options = options.declare_parameter(name, value);
     }
@@ -282,9 +321,10 @@ async fn run_async(
     let model_thread = {
         let (inputs, stop) = (inputs.clone(), stop.clone());
         let params = params.clone();
+        let live = (live_params.clone(), params_version.clone());
         std::thread::Builder::new()
             .name("rotor_twin model".into())
-            .spawn(move || model::run(rotor.clone(), params, inputs, out_tx, stop))?
+            .spawn(move || model::run(rotor.clone(), params, live, inputs, out_tx, stop))?
     };
     let rec_out = rec_tx.clone();
     let publish_thread = std::thread::Builder::new()
@@ -374,6 +414,7 @@ async fn run_async(
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let (inputs, gate, rec) = (inputs.clone(), gate.clone(), rec_tx.clone());
         let sim_time = params.use_sim_time;
+        let live = live_params.clone();
         tokio::spawn(async move {
             let mut stream = Box::pin(sub.async_stream());
             while let Some(Ok((m, _info))) = stream.next().await {
@@ -385,12 +426,19 @@ async fn run_async(
                 } else {
                     now
                 };
-                let checked = gate.lock().unwrap_or_else(|e| e.into_inner()).check(
+                let timeout_s = live
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .input_timeout_s;
+                let mut g = gate.lock().unwrap_or_else(|e| e.into_inner());
+                g.timeout_ns = (timeout_s * 1e9) as i64;
+                let checked = g.check(
                     m.speed,
                     m.acceleration,
                     m.header.stamp.as_nanos(),
                     clock_now,
                 );
+                drop(g);
                 if recording {
                     let _ = rec.try_send(ToRecord::Speed(m, now));
                 }

@@ -81,7 +81,8 @@ fn warning(ns: i64, level: u8, kind: &str, bearing: &str, evidence: String) -> O
 /// dropped and counted (the model never waits for the bus).
 pub fn run(
     rotor: Rotor,
-    params: NodeParams,
+    mut params: NodeParams,
+    live: (Arc<Mutex<NodeParams>>, Arc<std::sync::atomic::AtomicU64>),
     inputs: Arc<Mutex<Inputs>>,
     out: SyncSender<Outgoing>,
     stop: Arc<AtomicBool>,
@@ -96,9 +97,10 @@ pub fn run(
     let rated = rotor.rated_speed_rad_s;
     let config = TwinConfig::with_steps_per_rev(coupling, rated, params.steps_per_rev);
     let h = config.time_step_s;
-    let min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
-    let decimation = ((1.0 / params.state_rate_hz) / h).round().max(1.0) as u64;
-    let map_decimation = ((1.0 / params.pressure_map_rate_hz) / h).round().max(1.0) as u64;
+    let mut min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
+    let mut decimation = ((1.0 / params.state_rate_hz) / h).round().max(1.0) as u64;
+    let mut map_decimation = ((1.0 / params.pressure_map_rate_hz) / h).round().max(1.0) as u64;
+    let mut seen_version = 0u64;
     let mut dropped = 0u64;
     let send = |m: Outgoing, dropped: &mut u64| {
         if out.try_send(m).is_err() {
@@ -147,6 +149,20 @@ pub fn run(
     }
     let station_names: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     while !stop.load(Ordering::Relaxed) {
+        // parameters changed at run time (rates, thresholds, timeouts)
+        let version = live.1.load(Ordering::Relaxed);
+        if version != seen_version {
+            seen_version = version;
+            let p = live.0.lock().unwrap_or_else(|e| e.into_inner()).clone();
+            params.state_rate_hz = p.state_rate_hz;
+            params.pressure_map_rate_hz = p.pressure_map_rate_hz;
+            params.input_timeout_s = p.input_timeout_s;
+            params.min_speed_rpm = p.min_speed_rpm;
+            params.warning_amplitude_ratio = p.warning_amplitude_ratio;
+            min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
+            decimation = ((1.0 / params.state_rate_hz) / h).round().max(1.0) as u64;
+            map_decimation = ((1.0 / params.pressure_map_rate_hz) / h).round().max(1.0) as u64;
+        }
         let (speed, unbalance, probes, age, rejected, last_rejection) = {
             let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
             let r = (

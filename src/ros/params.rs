@@ -182,6 +182,33 @@ impl NodeParams {
     }
 }
 
+/// Parameters that may change while the node runs (`ros2 param set`); the others shape the model
+/// or its subscriptions and are set at start only.
+pub const RUNTIME_PARAMETERS: &[&str] = &[
+    "state_rate_hz",
+    "pressure_map_rate_hz",
+    "input_timeout_s",
+    "min_speed_rpm",
+    "warning_amplitude_ratio",
+];
+
+impl NodeParams {
+    /// A change at run time: refused for start-only parameters and for bad values (the message
+    /// names the parameter and the rule), else applied.
+    pub fn set_at_runtime(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let mut next = self.clone();
+        next.set(name, value)?;
+        // a start-only parameter may be "set" to the value it has (as at declaration)
+        if !RUNTIME_PARAMETERS.contains(&name) && next != *self {
+            return Err(format!(
+                "parameter {name} can only be set at start (restart the node with -p {name}:=…)"
+            ));
+        }
+        *self = next;
+        Ok(())
+    }
+}
+
 /// What `--ros-args` said.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RosArgs {
@@ -309,6 +336,19 @@ mod tests {
             ("probe_pulley_end".to_string(), "/plant/probe_b".to_string())
         );
         assert!(p.set("probe_point_topics", "x:/a").is_err());
+        // at run time: rates and thresholds yes, the model no
+        p.set_at_runtime("state_rate_hz", "50").unwrap();
+        assert_eq!(p.state_rate_hz, 50.0);
+        assert!(p
+            .set_at_runtime("model", "nonlinear")
+            .unwrap_err()
+            .contains("only be set at start"));
+        assert!(
+            p.set_at_runtime("model", "linear").is_ok(),
+            "its own value is accepted"
+        );
+        assert!(p.set_at_runtime("state_rate_hz", "-1").is_err());
+        assert_eq!(p.state_rate_hz, 50.0, "a refused change leaves the value");
         assert!((SpeedUnit::Rpm.to_rad_s(9000.0) - 942.477_796).abs() < 1e-5);
     }
 }
