@@ -1,22 +1,12 @@
 //! The `rotor-twin bearing` command-line contract: flags, JSON keys, errors.
 
-use serde_json::Value;
-use std::process::Command;
+mod common;
+use common::run_cli;
 
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
-        .args(args)
-        .output()
-        .expect("run rotor-twin");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use serde_json::Value;
 
 fn json(args: &[&str]) -> Value {
-    let (ok, out, err) = run(args);
+    let (ok, out, err) = run_cli(args);
     assert!(ok, "rotor-twin {args:?} failed: {err}");
     serde_json::from_str(&out).unwrap_or_else(|e| panic!("not JSON ({e}): {out}"))
 }
@@ -100,7 +90,7 @@ fn models_grooves_and_eccentricity_mode() {
 
 #[test]
 fn default_run_prints_a_table() {
-    let (ok, out, _) = run(&[]);
+    let (ok, out, _) = run_cli(&[]);
     assert!(ok);
     assert!(out.contains("eccentricity ratio") && out.contains("stiffness k (N/m)"));
 }
@@ -119,7 +109,7 @@ fn bad_flags_are_named() {
         (vec!["bearing", "--load-n", "-5"], "load"),
         (vec!["bearing", "--viscosity-pa-s", "inf"], "viscosity"),
     ] {
-        let (ok, out, err) = run(&args);
+        let (ok, out, err) = run_cli(&args);
         assert!(!ok, "{args:?} should fail");
         assert!(
             err.contains(word),

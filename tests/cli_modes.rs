@@ -1,19 +1,9 @@
 //! The `rotor-twin modes` command-line contract: JSON keys, plot file, errors.
 
-use serde_json::Value;
-use std::process::Command;
+mod common;
+use common::run_cli;
 
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
-        .args(args)
-        .output()
-        .expect("run rotor-twin");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use serde_json::Value;
 
 /// The built-in microturbine: the contracted keys, a Campbell diagram, and the linear threshold in
 /// the window the seed reports (stable at 8,000 rpm, whip at 9,000: the shaft body diameter was
@@ -21,7 +11,7 @@ fn run(args: &[&str]) -> (bool, String, String) {
 #[test]
 fn modes_json_and_plot_for_the_builtin_machine() {
     let svg = std::env::temp_dir().join(format!("rotor-twin-campbell-{}.svg", std::process::id()));
-    let (ok, out, err) = run(&[
+    let (ok, out, err) = run_cli(&[
         "modes",
         "--json",
         "--from-rpm",
@@ -86,7 +76,7 @@ fn bad_modes_input_is_named() {
             "/nonexistent.yaml",
         ),
     ] {
-        let (ok, _, err) = run(&args);
+        let (ok, _, err) = run_cli(&args);
         assert!(!ok, "{args:?} should fail");
         assert!(err.contains(word), "{args:?}: '{err}' does not name {word}");
     }

@@ -1,19 +1,9 @@
 //! The `simulate` and `sweep` command-line contracts: JSON keys, plot files, CSV, errors.
 
-use serde_json::Value;
-use std::process::Command;
+mod common;
+use common::run_cli;
 
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
-        .args(args)
-        .output()
-        .expect("run rotor-twin");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use serde_json::Value;
 
 fn scratch(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("rotor-twin-{name}-{}", std::process::id()))
@@ -22,7 +12,7 @@ fn scratch(name: &str) -> std::path::PathBuf {
 #[test]
 fn simulate_json_and_plots() {
     let dir = scratch("plots");
-    let (ok, out, err) = run(&[
+    let (ok, out, err) = run_cli(&[
         "simulate",
         "--speed-rpm",
         "8000",
@@ -72,7 +62,7 @@ fn simulate_json_and_plots() {
 #[test]
 fn sweep_writes_csv_and_svg() {
     let dir = scratch("sweep");
-    let (ok, out, err) = run(&[
+    let (ok, out, err) = run_cli(&[
         "sweep",
         "--from-rpm",
         "6000",
@@ -141,7 +131,7 @@ fn bad_simulation_input_is_named() {
             "--to-rpm",
         ),
     ] {
-        let (ok, out, err) = run(&args);
+        let (ok, out, err) = run_cli(&args);
         assert!(!ok, "{args:?} should fail");
         assert!(err.contains(word), "{args:?}: '{err}' does not name {word}");
         assert!(!out.contains("NaN"));

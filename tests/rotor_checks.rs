@@ -1,6 +1,8 @@
 //! Rotor-level checks: statics against equilibrium, the eigenvalue stability threshold against
 //! Lund's closed-form rigid-rotor criterion, and the shipped machine descriptions.
 
+mod common;
+use common::short_bearing_coefficients;
 use rotor_twin::rotor::{
     stability_threshold, static_solution, MachineDescription, Rotor, DEFAULT_MACHINE_YAML,
 };
@@ -79,34 +81,6 @@ fn microturbine_matches_the_published_figures() {
     assert!(!DEFAULT_MACHINE_YAML.is_empty());
 }
 
-/// Closed-form dimensionless short-bearing coefficients (Friswell et al. 2010, ch. 5;
-/// closed_forms.md), x along the load.
-fn short_kb(e: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
-    let pi2 = PI * PI;
-    let q = 1.0 - e * e;
-    let s = q.sqrt();
-    let h0 = 1.0 / (pi2 * q + 16.0 * e * e).powf(1.5);
-    let k = [
-        [
-            4.0 * h0 * (pi2 * (1.0 + 2.0 * e * e) + 32.0 * e * e * (1.0 + e * e) / q),
-            h0 * PI * (pi2 * q * (1.0 + 2.0 * e * e) + 32.0 * e * e * (1.0 + e * e)) / (e * s),
-        ],
-        [
-            -h0 * PI * (pi2 * q * q - 16.0 * e.powi(4)) / (e * s),
-            4.0 * h0 * (pi2 * (2.0 - e * e) + 16.0 * e * e),
-        ],
-    ];
-    let bxy = 8.0 * h0 * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e);
-    let b = [
-        [2.0 * PI * h0 * (pi2 * q * q + 48.0 * e * e) / (e * s), bxy],
-        [
-            bxy,
-            2.0 * PI * h0 * s * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e) / e,
-        ],
-    ];
-    (k, b)
-}
-
 /// A rigid symmetric rotor on two identical short bearings: the eigenvalue threshold equals
 /// Lund's closed-form criterion (closed_forms.md) within 1 %:
 /// K_eq = (K_xx B_yy + K_yy B_xx − K_xy B_yx − K_yx B_xy)/(B_xx + B_yy),
@@ -153,7 +127,7 @@ bearings:
                 hi = mid
             }
         }
-        let (k, b) = short_kb(0.5 * (lo + hi));
+        let (k, b) = short_bearing_coefficients(0.5 * (lo + hi));
         let k_eq = (k[0][0] * b[1][1] + k[1][1] * b[0][0] - k[0][1] * b[1][0] - k[1][0] * b[0][1])
             / (b[0][0] + b[1][1]);
         let g2 = ((k[0][0] - k_eq) * (k[1][1] - k_eq) - k[0][1] * k[1][0])

@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use rotor_twin::film::{BearingGeometry, Lubricant};
+use std::f64::consts::PI;
 use std::path::PathBuf;
+use std::process::Command;
 
 /// Rows of a reference CSV under tests/reference/ (copied from ../shared/reference/), `#`
 /// comment lines skipped, header used to name the columns.
@@ -51,4 +53,45 @@ pub const OMEGA_9000_RPM: f64 = 9000.0 * std::f64::consts::PI / 30.0;
 /// Relative difference |a − b| / |b|.
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs()
+}
+
+/// Closed-form dimensionless short-bearing K and B, x along the load, y ahead (Friswell et al.
+/// 2010, ch. 5; ../shared/reference/closed_forms.md): the reference formulas of several tests.
+pub fn short_bearing_coefficients(e: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+    let pi2 = PI * PI;
+    let q = 1.0 - e * e;
+    let s = q.sqrt();
+    let h0 = 1.0 / (pi2 * q + 16.0 * e * e).powf(1.5);
+    let k = [
+        [
+            4.0 * h0 * (pi2 * (1.0 + 2.0 * e * e) + 32.0 * e * e * (1.0 + e * e) / q),
+            h0 * PI * (pi2 * q * (1.0 + 2.0 * e * e) + 32.0 * e * e * (1.0 + e * e)) / (e * s),
+        ],
+        [
+            -h0 * PI * (pi2 * q * q - 16.0 * e.powi(4)) / (e * s),
+            4.0 * h0 * (pi2 * (2.0 - e * e) + 16.0 * e * e),
+        ],
+    ];
+    let bxy = 8.0 * h0 * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e);
+    let b = [
+        [2.0 * PI * h0 * (pi2 * q * q + 48.0 * e * e) / (e * s), bxy],
+        [
+            bxy,
+            2.0 * PI * h0 * s * (pi2 * (1.0 + 2.0 * e * e) - 16.0 * e * e) / e,
+        ],
+    ];
+    (k, b)
+}
+
+/// Runs the rotor-twin binary: (success, stdout, stderr).
+pub fn run_cli(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+        .args(args)
+        .output()
+        .expect("run rotor-twin");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
