@@ -272,11 +272,9 @@ pub fn run(
         };
         let ahead = model_elapsed - clock_elapsed;
         if ahead > 0.0 {
-            if ahead > 0.002 {
-                std::thread::sleep(Duration::from_secs_f64(ahead - 0.001));
-            } else {
-                std::thread::yield_now();
-            }
+            // ahead of the clock: sleep in short slices (spinning here starves the bus threads
+            // of CPU and delays the next input), and look at the inputs again
+            std::thread::sleep(Duration::from_secs_f64(ahead.min(0.0005)));
             continue;
         }
         let lag = -ahead;
