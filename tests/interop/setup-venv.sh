@@ -4,9 +4,15 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 venv="$here/.venv"
+# tests call this concurrently: one at a time builds the venv, the others wait
+exec 9>"$here/.venv.lock"
+flock 9
 if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
-"$venv/bin/pip" install --quiet --disable-pip-version-check \
-  "cyclonedds==11.0.1" "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
+if [ ! -f "$venv/.complete" ]; then
+  "$venv/bin/pip" install --quiet --disable-pip-version-check \
+    "cyclonedds==11.0.1" "rosbags>=0.10" "mcap>=1.2" "mcap-ros2-support>=0.5"
+  touch "$venv/.complete"
+fi
 echo "$venv"
