@@ -505,17 +505,11 @@ async fn run_async(
                 let station = stations.iter().position(|s| *s == m.station);
                 match (station, check_probe(m.x, m.y)) {
                     (Some(k), Ok((x, y))) => {
-                        let stamp = if m.header.stamp.as_nanos() != 0 {
-                            m.header.stamp.as_nanos()
-                        } else {
-                            now
-                        };
-                        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
-                        // keep the queue bounded: a burst keeps its newest samples
-                        if g.probes.len() >= 1000 {
-                            g.probes.remove(0);
-                        }
-                        g.probes.push((k, x, y, stamp));
+                        let stamp = m.header.stamp.as_nanos();
+                        inputs
+                            .lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .push_probe(k, x, y, stamp, now);
                     }
                     (None, _) => reject(
                         &inputs,
@@ -554,16 +548,14 @@ async fn run_async(
             while let Some(Ok((m, _info))) = stream.next().await {
                 match check_probe(m.point.x, m.point.y) {
                     Ok((x, y)) => {
-                        let stamp = if m.header.stamp.as_nanos() != 0 {
-                            m.header.stamp.as_nanos()
-                        } else {
-                            now_ns()
-                        };
-                        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
-                        if g.probes.len() >= 1000 {
-                            g.probes.remove(0);
-                        }
-                        g.probes.push((k, x, y, stamp));
+                        let stamp = m.header.stamp.as_nanos();
+                        inputs.lock().unwrap_or_else(|e| e.into_inner()).push_probe(
+                            k,
+                            x,
+                            y,
+                            stamp,
+                            now_ns(),
+                        );
                     }
                     Err(why) => reject(&inputs, why),
                 }

@@ -29,6 +29,18 @@ pub struct Inputs {
     pub sim_time_ns: Option<i64>,
 }
 
+impl Inputs {
+    /// Queues a checked probe displacement (m) of station `station`, stamped `stamp_ns` (0:
+    /// unstamped, then `now_ns`). The queue is bounded: a burst keeps its newest 1,000 samples.
+    pub fn push_probe(&mut self, station: usize, x: f64, y: f64, stamp_ns: i64, now_ns: i64) {
+        if self.probes.len() >= 1000 {
+            self.probes.remove(0);
+        }
+        let stamp = if stamp_ns != 0 { stamp_ns } else { now_ns };
+        self.probes.push((station, x, y, stamp));
+    }
+}
+
 /// A message for the bus and the recording.
 #[derive(Debug, Clone)]
 pub enum Outgoing {
