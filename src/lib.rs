@@ -4,6 +4,7 @@
 //! considering the prehistory of dynamic phenomena*, Sci. Rep. 15:43354 (2025) ("the seed").
 //! SI units everywhere inside; names carry the unit where it is not SI.
 
+pub mod bag;
 pub mod cli;
 pub mod dynamics;
 pub mod film;
@@ -11,7 +12,9 @@ pub mod messages;
 pub mod monitor;
 pub mod plot;
 pub mod record;
+pub mod replay;
 pub mod ros;
 pub mod rotor;
+pub mod session;
 pub mod transient;
 pub mod units;

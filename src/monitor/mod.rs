@@ -3,7 +3,7 @@
 //! component, forward/backward), and a classification with its evidence. Fed one step at a time;
 //! storage is reserved at construction and nothing is allocated per step.
 
-mod spectrum;
+pub mod spectrum;
 
 pub use spectrum::{order_spectrum, OrderComponent};
 

@@ -178,6 +178,33 @@ impl Recorder {
         Ok(self.topics.len() - 1)
     }
 
+    /// Adds topic `name` with a schema given as is (to copy a topic from another bag): ROS type
+    /// `type_name`, schema `encoding` and `schema` text. Returns its handle; adding the same name
+    /// twice returns the first handle.
+    pub fn add_topic_raw(
+        &mut self,
+        name: &str,
+        type_name: &str,
+        encoding: &str,
+        schema: &[u8],
+        qos: TopicQos,
+    ) -> Result<usize, RecordError> {
+        if let Some(i) = self.topics.iter().position(|t| t.name == name) {
+            return Ok(i);
+        }
+        let schema = self.writer.add_schema(type_name, encoding, schema)?;
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), qos.rosbag2_yaml())]);
+        let channel = self.writer.add_channel(schema, name, "cdr", &metadata)?;
+        self.topics.push(TopicEntry {
+            name: name.into(),
+            type_name: type_name.into(),
+            qos,
+            channel,
+            count: 0,
+        });
+        Ok(self.topics.len() - 1)
+    }
+
     /// Records `message` on topic handle `topic`, received at `log_time_ns` and sent at
     /// `publish_time_ns` (ns since the epoch).
     pub fn write<T: Serialize>(

@@ -1,0 +1,280 @@
+//! Predicted against measured orbits at one probe station, streamed: the samples are gathered
+//! in blocks of [`BLOCK_REVS`] revolutions of the shaft (amplitude against speed, onset of
+//! instability) and the last [`SUMMARY_REVS`] revolutions are kept for the summary. Both orbits
+//! are sampled at the same instants, so they are aligned by shaft angle by construction; the
+//! shaft angle is the twin's, integrated from the bag's speed.
+
+use crate::monitor::spectrum::{order_spectrum, OrderComponent};
+use crate::monitor::ClassifierSettings;
+use serde::Serialize;
+use std::collections::VecDeque;
+use std::f64::consts::TAU;
+
+/// Revolutions per block of the amplitude–speed series and of the onset detector.
+pub const BLOCK_REVS: usize = 8;
+/// Revolutions of the summary window at the end of the bag.
+pub const SUMMARY_REVS: usize = 32;
+
+/// One probe sample with the prediction at the same instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Sample {
+    /// Bag time since the bag's first message (s).
+    pub time_s: f64,
+    /// Shaft angle (rad).
+    pub angle_rad: f64,
+    /// Speed (rad/s).
+    pub speed_rad_s: f64,
+    /// Measured displacement `[x, y]` (m).
+    pub measured_m: [f64; 2],
+    /// Predicted displacement `[x, y]` (m).
+    pub predicted_m: [f64; 2],
+}
+
+/// The features of one orbit over a window.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct OrbitFeatures {
+    /// 1X semi-major axis (m).
+    pub one_x_amplitude_m: f64,
+    /// Phase of the forward 1X component against the shaft angle (degrees).
+    pub one_x_phase_deg: f64,
+    /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−2)/R.
+    pub subsync_amplitude_m: f64,
+    /// Its order, refined between bins (Gaussian interpolation); None unless it counts by the
+    /// monitor's rule (≥ 2 % of the clearance and ≥ half the 1X amplitude).
+    pub subsync_ratio: Option<f64>,
+    /// Mean position `[x, y]` (m).
+    pub mean_m: [f64; 2],
+}
+
+/// Predicted and measured over one window.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct WindowComparison {
+    /// Window start and end, bag time (s).
+    pub start_s: f64,
+    /// Window end, bag time (s).
+    pub end_s: f64,
+    /// Mean speed over the window (rpm).
+    pub speed_rpm: f64,
+    /// Revolutions in the window.
+    pub revolutions: usize,
+    /// The measured orbit.
+    pub measured: OrbitFeatures,
+    /// The predicted orbit.
+    pub predicted: OrbitFeatures,
+    /// RMS distance between the two orbits with their means removed (m): the shape difference.
+    pub orbit_rms_distance_m: f64,
+    /// Distance between the two mean positions (m).
+    pub mean_position_distance_m: f64,
+}
+
+/// The streaming comparison at one station.
+#[derive(Debug, Clone)]
+pub struct StationComparison {
+    /// Station name.
+    pub station: String,
+    clearance_m: f64,
+    settings: ClassifierSettings,
+    block: Vec<Sample>,
+    recent: VecDeque<Sample>,
+    /// Completed blocks.
+    pub blocks: Vec<WindowComparison>,
+    /// Samples compared.
+    pub samples: usize,
+}
+
+impl StationComparison {
+    /// A comparison at `station`; sub-synchronous motion counts relative to `clearance_m`.
+    pub fn new(station: &str, clearance_m: f64) -> Self {
+        Self {
+            station: station.into(),
+            clearance_m,
+            settings: ClassifierSettings::default(),
+            block: Vec::new(),
+            recent: VecDeque::new(),
+            blocks: Vec::new(),
+            samples: 0,
+        }
+    }
+
+    /// Adds a sample (in time order).
+    pub fn push(&mut self, s: Sample) {
+        self.samples += 1;
+        if let Some(first) = self.block.first() {
+            if s.angle_rad - first.angle_rad >= BLOCK_REVS as f64 * TAU || s.time_s < first.time_s {
+                let block = std::mem::take(&mut self.block);
+                if let Some(w) = self.compare(&block, BLOCK_REVS) {
+                    self.blocks.push(w);
+                }
+            }
+        }
+        self.block.push(s);
+        self.recent.push_back(s);
+        while self
+            .recent
+            .front()
+            .is_some_and(|f| s.angle_rad - f.angle_rad > SUMMARY_REVS as f64 * TAU)
+        {
+            self.recent.pop_front();
+        }
+    }
+
+    /// The comparison over the last [`SUMMARY_REVS`] revolutions (or as many whole ones as
+    /// there are, at least 2); None with fewer.
+    pub fn summary(&self) -> Option<WindowComparison> {
+        let recent: Vec<Sample> = self.recent.iter().copied().collect();
+        let (first, last) = (recent.first()?, recent.last()?);
+        let revs = (((last.angle_rad - first.angle_rad) / TAU).floor() as usize).min(SUMMARY_REVS);
+        if revs < 2 {
+            return None;
+        }
+        let start = recent
+            .iter()
+            .position(|s| last.angle_rad - s.angle_rad <= revs as f64 * TAU)
+            .unwrap_or(0);
+        self.compare(&recent[start..], revs)
+    }
+
+    /// The first block whose orbit (measured, or predicted with `predicted`) shows a
+    /// sub-synchronous component that counts: its end time (s) and speed (rpm).
+    pub fn onset(&self, predicted: bool) -> Option<(f64, f64)> {
+        self.blocks
+            .iter()
+            .find(|b| {
+                if predicted {
+                    b.predicted.subsync_ratio.is_some()
+                } else {
+                    b.measured.subsync_ratio.is_some()
+                }
+            })
+            .map(|b| (b.end_s, b.speed_rpm))
+    }
+
+    /// The order spectra (measured, predicted) of the summary window, orders 1/R … 2.
+    pub fn summary_spectra(&self) -> Option<(Vec<OrderComponent>, Vec<OrderComponent>)> {
+        let w = self.summary()?;
+        let samples: Vec<Sample> = self
+            .recent
+            .iter()
+            .filter(|s| s.time_s >= w.start_s)
+            .copied()
+            .collect();
+        let revs = w.revolutions;
+        Some((
+            spectrum(&samples, revs, |s| s.measured_m),
+            spectrum(&samples, revs, |s| s.predicted_m),
+        ))
+    }
+
+    /// The samples of the last `revs` revolutions (for plots).
+    pub fn recent_samples(&self, revs: usize) -> Vec<Sample> {
+        let Some(last) = self.recent.back() else {
+            return Vec::new();
+        };
+        self.recent
+            .iter()
+            .filter(|s| last.angle_rad - s.angle_rad <= revs as f64 * TAU)
+            .copied()
+            .collect()
+    }
+
+    fn compare(&self, samples: &[Sample], revs: usize) -> Option<WindowComparison> {
+        if samples.len() < 8 * revs.max(1) {
+            return None;
+        }
+        let measured = self.features(samples, revs, |s| s.measured_m);
+        let predicted = self.features(samples, revs, |s| s.predicted_m);
+        let (mm, pm) = (measured.mean_m, predicted.mean_m);
+        let n = samples.len() as f64;
+        let shape = samples
+            .iter()
+            .map(|s| {
+                let dx = (s.predicted_m[0] - pm[0]) - (s.measured_m[0] - mm[0]);
+                let dy = (s.predicted_m[1] - pm[1]) - (s.measured_m[1] - mm[1]);
+                dx * dx + dy * dy
+            })
+            .sum::<f64>()
+            / n;
+        Some(WindowComparison {
+            start_s: samples[0].time_s,
+            end_s: samples[samples.len() - 1].time_s,
+            speed_rpm: samples.iter().map(|s| s.speed_rad_s).sum::<f64>() / n * 30.0
+                / std::f64::consts::PI,
+            revolutions: revs,
+            measured,
+            predicted,
+            orbit_rms_distance_m: shape.sqrt(),
+            mean_position_distance_m: (pm[0] - mm[0]).hypot(pm[1] - mm[1]),
+        })
+    }
+
+    fn features(
+        &self,
+        samples: &[Sample],
+        revs: usize,
+        pick: impl Fn(&Sample) -> [f64; 2],
+    ) -> OrbitFeatures {
+        let spec = spectrum(samples, revs, &pick);
+        let n = samples.len() as f64;
+        let mean = [
+            samples.iter().map(|s| pick(s)[0]).sum::<f64>() / n,
+            samples.iter().map(|s| pick(s)[1]).sum::<f64>() / n,
+        ];
+        let one_x = spec[revs - 1];
+        // the Hann window leaks 1X into the bin next to it: sub-synchronous bins are 2 … R−2
+        let (mut kbest, mut abest) = (0, 0.0);
+        for k in 2..revs.saturating_sub(1) {
+            let a = spec[k - 1].semi_major_m();
+            if a > abest {
+                (kbest, abest) = (k, a);
+            }
+        }
+        let counts = abest > self.settings.subsync_min_clearance_share * self.clearance_m
+            && abest > self.settings.subsync_min_one_x_share * one_x.semi_major_m();
+        let ratio = counts.then(|| {
+            let mag = |k: usize| spec[k - 1].semi_major_m().max(1e-30).ln();
+            let (a, b, c) = (mag(kbest - 1), mag(kbest), mag(kbest + 1));
+            let den = a - 2.0 * b + c;
+            let shift = if den.abs() > 1e-12 {
+                (0.5 * (a - c) / den).clamp(-0.5, 0.5)
+            } else {
+                0.0
+            };
+            (kbest as f64 + shift) / revs as f64
+        });
+        OrbitFeatures {
+            one_x_amplitude_m: one_x.semi_major_m(),
+            one_x_phase_deg: one_x.forward_phase_rad.to_degrees(),
+            subsync_amplitude_m: abest,
+            subsync_ratio: ratio,
+            mean_m: mean,
+        }
+    }
+}
+
+/// The order spectrum at orders k/`revs`, k = 1 … 2·revs (at most 64 bins).
+fn spectrum(
+    samples: &[Sample],
+    revs: usize,
+    pick: impl Fn(&Sample) -> [f64; 2],
+) -> Vec<OrderComponent> {
+    let mut out = vec![OrderComponent::default(); (2 * revs).clamp(1, 64)];
+    order_spectrum(
+        samples.iter().map(|s| pick(s)[0]),
+        samples.iter().map(|s| pick(s)[1]),
+        samples.iter().map(|s| s.angle_rad),
+        samples.len(),
+        revs,
+        &mut out,
+    );
+    out
+}
+
+/// `a − b` in degrees wrapped into (−180, 180].
+pub fn phase_difference_deg(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(360.0);
+    if d > 180.0 {
+        d - 360.0
+    } else {
+        d
+    }
+}

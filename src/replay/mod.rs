@@ -1,0 +1,496 @@
+//! Replay: a recorded bag through the twin, in bag time. The bag's topics are mapped to the
+//! twin's inputs (after remapping), the twin is stepped up to each message's receive time, and
+//! every input and prediction goes to an output bag; measured probe orbits are compared with the
+//! predicted ones (see [`compare`]). The same [`Session`] the live node runs does the modelling,
+//! so a replay predicts what the node would have published, and two replays of one bag are
+//! identical.
+
+pub mod compare;
+mod report;
+
+pub use report::{OnsetReport, ReplayReport, StateChange, StationReport};
+
+use crate::bag::{Bag, BagMessage};
+use crate::dynamics::{Coupling, StepInput, TwinConfig};
+use crate::messages::{self, from_cdr, InstabilityWarning, RosMessage};
+use crate::record::{Recorder, TopicQos};
+use crate::ros::{check_probe, check_unbalance, SpeedGate, SpeedUnit};
+use crate::rotor::Rotor;
+use crate::session::{margin, warning, Outgoing, Session, SessionSettings};
+use compare::{Sample, StationComparison};
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// The twin's input topics (before remapping, the names the node uses).
+pub const SPEED_TOPIC: &str = "/rotor_twin/speed";
+/// Unbalance topic.
+pub const UNBALANCE_TOPIC: &str = "/rotor_twin/unbalance";
+/// Probe displacement topic (rotor_twin_msgs/ProbeDisplacement).
+pub const PROBE_TOPIC: &str = "/rotor_twin/probe";
+
+/// How to replay.
+#[derive(Debug, Clone)]
+pub struct ReplayOptions {
+    /// Bearing coupling of the twin.
+    pub coupling: Coupling,
+    /// Time steps per revolution at rated speed.
+    pub steps_per_rev: usize,
+    /// Output rates and thresholds.
+    pub session: SessionSettings,
+    /// Below this speed (rad/s) the twin pauses.
+    pub min_speed_rad_s: f64,
+    /// Topic remappings `from → to`, applied to the bag's topic names.
+    pub remaps: Vec<(String, String)>,
+    /// Unit of a std_msgs/Float64 speed.
+    pub speed_unit: SpeedUnit,
+    /// geometry_msgs/PointStamped probe topics (after remapping) → probe station name.
+    pub probe_points: Vec<(String, String)>,
+    /// Bag time per wall time (None: as fast as the model runs).
+    pub rate: Option<f64>,
+    /// Replay only the first this many seconds of the bag.
+    pub duration_s: Option<f64>,
+    /// Where to write the output bag (None: no output bag).
+    pub out_bag: Option<PathBuf>,
+}
+
+impl Default for ReplayOptions {
+    fn default() -> Self {
+        Self {
+            coupling: Coupling::Nonlinear,
+            steps_per_rev: 128,
+            session: SessionSettings::default(),
+            min_speed_rad_s: 100.0 * std::f64::consts::PI / 30.0,
+            remaps: Vec::new(),
+            speed_unit: SpeedUnit::Rpm,
+            probe_points: Vec::new(),
+            rate: None,
+            duration_s: None,
+            out_bag: None,
+        }
+    }
+}
+
+/// Why a replay cannot run.
+#[derive(Debug, Error)]
+pub enum ReplayError {
+    /// A required topic is not in the bag.
+    #[error("the bag has no topic {topic} ({why}); its topics: {present}")]
+    MissingTopic {
+        /// The topic (after remapping).
+        topic: String,
+        /// Why it is needed.
+        why: String,
+        /// The topics the bag has.
+        present: String,
+    },
+    /// A mapped topic has a type the replay cannot use.
+    #[error("topic {topic} has type '{found}'; expected {expected}")]
+    WrongType {
+        /// The topic.
+        topic: String,
+        /// Its type in the bag.
+        found: String,
+        /// What would do.
+        expected: String,
+    },
+    /// An option names a probe station the machine does not have.
+    #[error("probe station '{0}' is not in the machine description (its stations: {1})")]
+    UnknownStation(String, String),
+    /// The output bag could not be written.
+    #[error("output bag: {0}")]
+    Record(#[from] crate::record::RecordError),
+}
+
+/// What a bag topic feeds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role {
+    SpeedRotor,
+    SpeedFloat,
+    Unbalance,
+    Probe,
+    ProbePoint(usize),
+    Other,
+}
+
+/// Replays `bag` through a twin of `rotor`. `progress` is called now and then with the share of
+/// the bag done (0–1). Returns the report (with `wall_time_s` measured here).
+pub fn replay(
+    bag: &Bag,
+    rotor: &Rotor,
+    options: &ReplayOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<ReplayReport, ReplayError> {
+    let wall = std::time::Instant::now();
+    let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
+    let roles = map_topics(bag, options, &stations)?;
+    let config = TwinConfig::with_steps_per_rev(
+        options.coupling,
+        rotor.rated_speed_rad_s,
+        options.steps_per_rev,
+    );
+    let clearance = rotor
+        .bearings
+        .iter()
+        .filter_map(|b| match &b.model {
+            crate::rotor::BearingModel::Film(f) => Some(f.geometry.radial_clearance_m),
+            _ => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    let mut comparisons: Vec<StationComparison> = stations
+        .iter()
+        .map(|s| StationComparison::new(s, clearance))
+        .collect();
+    let mut out = match &options.out_bag {
+        Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
+        None => None,
+    };
+    let threshold = crate::session::linear_threshold(rotor);
+    let Some((t0, t_last)) = bag.time_span_ns() else {
+        return Ok(ReplayReport::empty(bag, wall.elapsed().as_secs_f64()));
+    };
+    let t_end = match options.duration_s {
+        Some(d) => t_last.min(t0 + (d * 1e9) as u64),
+        None => t_last,
+    };
+    let mut report = ReplayReport::empty(bag, 0.0);
+    report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
+    let mut gate = SpeedGate::new(10.0 * rotor.rated_speed_rad_s, f64::INFINITY);
+    let mut speed: Option<(f64, f64)> = None;
+    // the latest accepted unbalance per plane (m·e kg·m, phase rad), applied to every (re)start
+    let mut unbalance: Vec<Option<(f64, f64)>> = vec![None; rotor.unbalance.len()];
+    let mut session: Option<Session> = None;
+    let mut next_margin_ns = t0;
+    let mut emitted: Vec<Outgoing> = Vec::new();
+    let mut last_progress = std::time::Instant::now();
+    for (index, m) in bag.messages.iter().enumerate() {
+        if m.log_time_ns > t_end {
+            break;
+        }
+        let t_ns = m.log_time_ns as i64;
+        // the twin up to this message's time
+        if let (Some(s), Some((w, a))) = (session.as_mut(), speed) {
+            let input = StepInput {
+                speed_rad_s: w,
+                accel_rad_s2: a,
+            };
+            while s.stamp_ns() < t_ns {
+                if let Err(e) = s.step(&input, &mut |o| emitted.push(o)) {
+                    emitted.push(warning(
+                        s.stamp_ns(),
+                        InstabilityWarning::ERROR,
+                        "model_failure",
+                        "",
+                        format!("step failed: {e}; the twin restarts at the next speed message"),
+                    ));
+                    session = None;
+                    break;
+                }
+            }
+        }
+        report.messages_in += 1;
+        let role = roles[m.topic];
+        let rejected = match role {
+            Role::SpeedRotor | Role::SpeedFloat => {
+                let decoded = if role == Role::SpeedRotor {
+                    from_cdr::<messages::RotorSpeed>(bag.payload(m))
+                        .map(|v| (v.speed, v.acceleration))
+                } else {
+                    from_cdr::<messages::Float64>(bag.payload(m))
+                        .map(|v| (options.speed_unit.to_rad_s(v.data), 0.0))
+                };
+                match decoded.and_then(|(w, a)| gate.check(w, a, 0, t_ns)) {
+                    Ok((w, a)) => {
+                        speed = Some((w, a));
+                        if w < options.min_speed_rad_s {
+                            session = None;
+                        } else if session.is_none() {
+                            match Session::new(rotor, config, w, options.session, t_ns) {
+                                Ok(mut s) => {
+                                    for (plane, u) in unbalance.iter().enumerate() {
+                                        if let Some((me, phase)) = *u {
+                                            let _ = s.twin_mut().set_unbalance(plane, me, phase);
+                                        }
+                                    }
+                                    session = Some(s);
+                                }
+                                Err(e) => emitted.push(warning(
+                                    t_ns,
+                                    InstabilityWarning::ERROR,
+                                    "bad_input",
+                                    "",
+                                    format!("cannot start the twin at {w:.1} rad/s: {e}"),
+                                )),
+                            }
+                        }
+                        None
+                    }
+                    Err(why) => Some(why),
+                }
+            }
+            Role::Unbalance => match from_cdr::<messages::Unbalance>(bag.payload(m))
+                .and_then(|u| check_unbalance(u.plane, u.magnitude, u.phase, rotor.unbalance.len()))
+            {
+                Ok((plane, me, phase)) => {
+                    unbalance[plane] = Some((me, phase));
+                    if let Some(s) = session.as_mut() {
+                        let _ = s.twin_mut().set_unbalance(plane, me, phase);
+                    }
+                    None
+                }
+                Err(why) => Some(why),
+            },
+            Role::Probe | Role::ProbePoint(_) => {
+                let decoded = match role {
+                    Role::ProbePoint(k) => from_cdr::<messages::PointStamped>(bag.payload(m))
+                        .map(|p| (k, p.point.x, p.point.y)),
+                    _ => from_cdr::<messages::ProbeDisplacement>(bag.payload(m)).and_then(|p| {
+                        stations
+                            .iter()
+                            .position(|s| *s == p.station)
+                            .map(|k| (k, p.x, p.y))
+                            .ok_or_else(|| {
+                                format!("probe station '{}' is not in the machine", p.station)
+                            })
+                    }),
+                };
+                match decoded.and_then(|(k, x, y)| check_probe(x, y).map(|(x, y)| (k, x, y))) {
+                    Ok((k, x, y)) => {
+                        if let Some(s) = session.as_ref() {
+                            if let Some(r) = s.residual(k, [x, y], t_ns) {
+                                let time_s = (t_ns - s.epoch_ns()) as f64 * 1e-9;
+                                let (_, angle) = s.predicted_probe(k, time_s).unwrap_or_default();
+                                comparisons[k].push(Sample {
+                                    time_s: (t_ns - t0 as i64) as f64 * 1e-9,
+                                    angle_rad: angle,
+                                    speed_rad_s: s.twin().output().speed_rad_s,
+                                    measured_m: [x, y],
+                                    predicted_m: [r.predicted_x, r.predicted_y],
+                                });
+                                emitted.push(Outgoing::Residual(r));
+                            }
+                        }
+                        None
+                    }
+                    Err(why) => Some(why),
+                }
+            }
+            Role::Other => None,
+        };
+        if let Some(why) = rejected {
+            report.note_rejection(&bag.topics[m.topic].name, &why);
+            emitted.push(warning(
+                t_ns,
+                InstabilityWarning::WARN,
+                "bad_input",
+                "",
+                format!("{}: {why}", bag.topics[m.topic].name),
+            ));
+        }
+        if let (Some((w, _)), true) = (speed, t_ns >= next_margin_ns as i64) {
+            emitted.push(Outgoing::Margin(margin(t_ns, w, threshold)));
+            next_margin_ns = t_ns as u64 + 1_000_000_000;
+        }
+        // the report and the output bag
+        for o in emitted.drain(..) {
+            report.note_output(&o, t0, &session);
+            if let Some(out) = out.as_mut() {
+                out.write_outgoing(&o)?;
+            }
+        }
+        if let Some(out) = out.as_mut() {
+            out.write_input(bag, m)?;
+        }
+        if let Some(rate) = options.rate {
+            let due = (m.log_time_ns - t0) as f64 * 1e-9 / rate;
+            let ahead = due - wall.elapsed().as_secs_f64();
+            if ahead > 0.0 {
+                std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
+            }
+        }
+        if last_progress.elapsed().as_millis() >= 200 {
+            last_progress = std::time::Instant::now();
+            progress((m.log_time_ns - t0) as f64 / (t_end - t0).max(1) as f64);
+            let _ = index;
+        }
+    }
+    progress(1.0);
+    report.finish(&comparisons, wall.elapsed().as_secs_f64());
+    if let Some(out) = out {
+        report.messages_out = out.finish()?;
+    }
+    Ok(report)
+}
+
+/// The role of each bag topic, checking that the speed topic is there and the types fit.
+fn map_topics(
+    bag: &Bag,
+    options: &ReplayOptions,
+    stations: &[String],
+) -> Result<Vec<Role>, ReplayError> {
+    let remap = |name: &str| -> String {
+        options
+            .remaps
+            .iter()
+            .find(|(from, _)| from == name)
+            .map_or(name.to_string(), |(_, to)| to.clone())
+    };
+    for (station, _) in options.probe_points.iter().map(|(t, s)| (s, t)) {
+        if !stations.contains(station) {
+            return Err(ReplayError::UnknownStation(
+                station.clone(),
+                stations.join(", "),
+            ));
+        }
+    }
+    let mut roles = Vec::with_capacity(bag.topics.len());
+    for t in &bag.topics {
+        let name = remap(&t.name);
+        let wrong = |expected: &str| ReplayError::WrongType {
+            topic: t.name.clone(),
+            found: t.type_name.clone(),
+            expected: expected.into(),
+        };
+        let role = if name == SPEED_TOPIC {
+            match t.type_name.as_str() {
+                messages::RotorSpeed::TYPE_NAME => Role::SpeedRotor,
+                messages::Float64::TYPE_NAME => Role::SpeedFloat,
+                _ => {
+                    return Err(wrong(
+                        "rotor_twin_msgs/msg/RotorSpeed or std_msgs/msg/Float64",
+                    ))
+                }
+            }
+        } else if name == UNBALANCE_TOPIC {
+            if t.type_name != messages::Unbalance::TYPE_NAME {
+                return Err(wrong(messages::Unbalance::TYPE_NAME));
+            }
+            Role::Unbalance
+        } else if name == PROBE_TOPIC {
+            if t.type_name != messages::ProbeDisplacement::TYPE_NAME {
+                return Err(wrong(messages::ProbeDisplacement::TYPE_NAME));
+            }
+            Role::Probe
+        } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| *tp == name) {
+            if t.type_name != messages::PointStamped::TYPE_NAME {
+                return Err(wrong(messages::PointStamped::TYPE_NAME));
+            }
+            Role::ProbePoint(stations.iter().position(|s| s == station).unwrap_or(0))
+        } else {
+            Role::Other
+        };
+        if role != Role::Other && t.message_encoding != "cdr" {
+            return Err(wrong("a CDR-encoded message"));
+        }
+        roles.push(role);
+    }
+    if !roles
+        .iter()
+        .any(|r| matches!(r, Role::SpeedRotor | Role::SpeedFloat))
+    {
+        let present = bag
+            .topics
+            .iter()
+            .map(|t| format!("{} [{}]", t.name, t.type_name))
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(ReplayError::MissingTopic {
+            topic: SPEED_TOPIC.into(),
+            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed".into(),
+            present: if present.is_empty() {
+                "none".into()
+            } else {
+                present
+            },
+        });
+    }
+    Ok(roles)
+}
+
+/// The output bag: the inputs used (under the twin's topic names) and every prediction.
+struct OutputBag {
+    rec: Recorder,
+    inputs: Vec<Option<usize>>,
+    journal: usize,
+    film: usize,
+    orbit: usize,
+    warning: usize,
+    residual: usize,
+    margin: usize,
+}
+
+impl OutputBag {
+    fn create(
+        dir: &std::path::Path,
+        bag: &Bag,
+        roles: &[Role],
+        options: &ReplayOptions,
+    ) -> Result<Self, ReplayError> {
+        let mut rec = Recorder::create(dir)?;
+        let mut inputs = Vec::with_capacity(roles.len());
+        for (t, role) in bag.topics.iter().zip(roles) {
+            let name = options
+                .remaps
+                .iter()
+                .find(|(from, _)| *from == t.name)
+                .map_or(t.name.as_str(), |(_, to)| to.as_str());
+            inputs.push(if *role == Role::Other {
+                None
+            } else {
+                Some(rec.add_topic_raw(
+                    name,
+                    &t.type_name,
+                    &t.schema_encoding,
+                    &t.schema,
+                    TopicQos::reliable(100),
+                )?)
+            });
+        }
+        let state = TopicQos::reliable(10);
+        Ok(Self {
+            journal: rec.add_topic::<messages::JournalState>("/rotor_twin/journal_state", state)?,
+            film: rec.add_topic::<messages::FilmState>("/rotor_twin/film_state", state)?,
+            orbit: rec.add_topic::<messages::Orbit>("/rotor_twin/orbit", state)?,
+            warning: rec.add_topic::<messages::InstabilityWarning>(
+                "/rotor_twin/warning",
+                TopicQos::latched(10),
+            )?,
+            residual: rec.add_topic::<messages::OrbitResidual>("/rotor_twin/residual", state)?,
+            margin: rec.add_topic::<messages::StabilityMargin>(
+                "/rotor_twin/stability_margin",
+                TopicQos::latched(1),
+            )?,
+            rec,
+            inputs,
+        })
+    }
+
+    fn write_input(&mut self, bag: &Bag, m: &BagMessage) -> Result<(), ReplayError> {
+        if let Some(h) = self.inputs[m.topic] {
+            self.rec
+                .write_cdr(h, bag.payload(m), m.log_time_ns, m.publish_time_ns)?;
+        }
+        Ok(())
+    }
+
+    fn write_outgoing(&mut self, o: &Outgoing) -> Result<(), ReplayError> {
+        let t = |h: &messages::Header| h.stamp.as_nanos().max(0) as u64;
+        match o {
+            Outgoing::Journal(m) => self.rec.write(self.journal, m, t(&m.header), t(&m.header)),
+            Outgoing::Film(m) => self.rec.write(self.film, m, t(&m.header), t(&m.header)),
+            Outgoing::Orbit(m) => self.rec.write(self.orbit, m, t(&m.header), t(&m.header)),
+            Outgoing::Warning(m) => self.rec.write(self.warning, m, t(&m.header), t(&m.header)),
+            Outgoing::Residual(m) => self.rec.write(self.residual, m, t(&m.header), t(&m.header)),
+            Outgoing::Margin(m) => self.rec.write(self.margin, m, t(&m.header), t(&m.header)),
+            // the replay has no diagnostics of its own
+            Outgoing::Diagnostics(_) => Ok(()),
+        }?;
+        Ok(())
+    }
+
+    /// Closes the bag; returns the number of messages written.
+    fn finish(self) -> Result<u64, ReplayError> {
+        let total = self.rec.counts().iter().map(|(_, c)| c).sum();
+        self.rec.finish()?;
+        Ok(total)
+    }
+}

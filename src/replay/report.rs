@@ -1,0 +1,287 @@
+//! The replay's report: what was read, what came out, predicted against measured per probe
+//! station, and when the instability set in. Serialized as the `--json` report.
+
+use super::compare::{phase_difference_deg, StationComparison, WindowComparison};
+use crate::bag::Bag;
+use crate::session::{Outgoing, Session};
+use serde::Serialize;
+
+/// Predicted against measured at one probe station, over the summary window (the last 32
+/// revolutions of the bag, or as many as there are).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct StationReport {
+    /// Probe station name.
+    pub station: String,
+    /// Measured samples compared.
+    pub samples: usize,
+    /// The summary window (bag time, s) and its mean speed (rpm).
+    pub window_start_s: Option<f64>,
+    /// End of the summary window (s).
+    pub window_end_s: Option<f64>,
+    /// Mean speed over the window (rpm).
+    pub window_speed_rpm: Option<f64>,
+    /// Measured 1X semi-major axis (m).
+    pub one_x_amplitude_measured_m: Option<f64>,
+    /// Predicted 1X semi-major axis (m).
+    pub one_x_amplitude_predicted_m: Option<f64>,
+    /// Predicted minus measured 1X semi-major axis (m).
+    pub one_x_amplitude_error_m: Option<f64>,
+    /// Predicted minus measured phase of the forward 1X component, in (−180, 180] (degrees).
+    pub one_x_phase_error_deg: Option<f64>,
+    /// Largest predicted sub-synchronous semi-major axis (m).
+    pub subsync_amplitude_predicted_m: Option<f64>,
+    /// Largest measured sub-synchronous semi-major axis (m).
+    pub subsync_amplitude_measured_m: Option<f64>,
+    /// Its order (frequency / running frequency), null unless it counts (the monitor's rule).
+    pub subsync_ratio_predicted: Option<f64>,
+    /// Measured sub-synchronous order, null unless it counts.
+    pub subsync_ratio_measured: Option<f64>,
+    /// RMS distance between the predicted and measured orbits, means removed (m).
+    pub orbit_rms_distance_m: Option<f64>,
+    /// Distance between the mean positions (m).
+    pub mean_position_distance_m: Option<f64>,
+    /// Blocks of 8 revolutions over the whole bag (amplitude against speed).
+    pub blocks: Vec<WindowComparison>,
+}
+
+/// When the instability set in, predicted and observed (null where there is none).
+#[derive(Debug, Clone, Default, Serialize, PartialEq)]
+pub struct OnsetReport {
+    /// First 8-revolution block whose predicted probe orbit shows a sub-synchronous component
+    /// that counts (bag time, s).
+    pub predicted_time_s: Option<f64>,
+    /// The same detector on the measured orbit (s).
+    pub observed_time_s: Option<f64>,
+    /// Speed at the predicted onset (rpm).
+    pub predicted_speed_rpm: Option<f64>,
+    /// Speed at the observed onset (rpm).
+    pub observed_speed_rpm: Option<f64>,
+    /// The twin's first whirl/whip/contact warning (bag time, s).
+    pub twin_warning_time_s: Option<f64>,
+    /// Speed at that warning (rpm).
+    pub twin_warning_speed_rpm: Option<f64>,
+    /// How onset is detected.
+    pub detector: String,
+}
+
+/// A change of the twin's classification.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct StateChange {
+    /// Bag time (s).
+    pub time_s: f64,
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// none (stable) | whirl | whip | contact.
+    pub state: String,
+    /// Warning level: 0 OK, 1 WARN, 2 ERROR.
+    pub level: u8,
+}
+
+/// Inputs refused on one topic.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Rejections {
+    /// Topic (as in the bag).
+    pub topic: String,
+    /// How many.
+    pub count: u64,
+    /// The last reason.
+    pub last_reason: String,
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ReplayReport {
+    /// Bag time replayed, first to last message (s).
+    pub bag_duration_s: f64,
+    /// Wall time of the replay (s).
+    pub wall_time_s: f64,
+    /// Bag time over wall time.
+    pub real_time_factor: f64,
+    /// Messages read from the bag and processed.
+    pub messages_in: u64,
+    /// Messages written to the output bag.
+    pub messages_out: u64,
+    /// Damage found in the bag (the replay covers what came before it).
+    pub damage: Vec<String>,
+    /// Inputs refused, per topic.
+    pub rejected: Vec<Rejections>,
+    /// Predicted against measured, per probe station with measurements.
+    pub stations: Vec<StationReport>,
+    /// Onset of instability.
+    pub onset: OnsetReport,
+    /// The twin's classification over time (its changes).
+    pub states: Vec<StateChange>,
+}
+
+impl ReplayReport {
+    /// An empty report of `bag`.
+    pub fn empty(bag: &Bag, wall_time_s: f64) -> Self {
+        Self {
+            bag_duration_s: 0.0,
+            wall_time_s,
+            real_time_factor: 0.0,
+            messages_in: 0,
+            messages_out: 0,
+            damage: bag.damage.iter().map(|d| d.to_string()).collect(),
+            rejected: Vec::new(),
+            stations: Vec::new(),
+            onset: OnsetReport::default(),
+            states: Vec::new(),
+        }
+    }
+
+    /// Counts a refused input.
+    pub(super) fn note_rejection(&mut self, topic: &str, why: &str) {
+        match self.rejected.iter_mut().find(|r| r.topic == topic) {
+            Some(r) => {
+                r.count += 1;
+                r.last_reason = why.into();
+            }
+            None => self.rejected.push(Rejections {
+                topic: topic.into(),
+                count: 1,
+                last_reason: why.into(),
+            }),
+        }
+    }
+
+    /// Notes the twin's warnings (state changes, first onset).
+    pub(super) fn note_output(&mut self, o: &Outgoing, t0_ns: u64, session: &Option<Session>) {
+        let Outgoing::Warning(w) = o else {
+            return;
+        };
+        if !matches!(w.kind.as_str(), "none" | "whirl" | "whip" | "contact") {
+            return;
+        }
+        let time_s = (w.header.stamp.as_nanos() - t0_ns as i64) as f64 * 1e-9;
+        let speed_rpm = session.as_ref().map_or(0.0, |s| {
+            s.twin().output().speed_rad_s * 30.0 / std::f64::consts::PI
+        });
+        if w.kind != "none" && self.onset.twin_warning_time_s.is_none() {
+            self.onset.twin_warning_time_s = Some(time_s);
+            self.onset.twin_warning_speed_rpm = Some(speed_rpm);
+        }
+        if self.states.last().is_none_or(|s| s.state != w.kind) {
+            self.states.push(StateChange {
+                time_s,
+                speed_rpm,
+                state: w.kind.clone(),
+                level: w.level,
+            });
+        }
+    }
+
+    /// Fills the comparison and timing.
+    pub(super) fn finish(&mut self, comparisons: &[StationComparison], wall_time_s: f64) {
+        self.wall_time_s = wall_time_s;
+        self.real_time_factor = if wall_time_s > 0.0 {
+            self.bag_duration_s / wall_time_s
+        } else {
+            0.0
+        };
+        self.onset.detector = format!(
+            "first block of {} revolutions at any probe station whose largest sub-synchronous component is ≥ 2 % of the clearance and ≥ half the 1X amplitude",
+            super::compare::BLOCK_REVS
+        );
+        let earliest = |found: Vec<(f64, f64)>| {
+            found
+                .into_iter()
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map_or((None, None), |(t, w)| (Some(t), Some(w)))
+        };
+        (self.onset.predicted_time_s, self.onset.predicted_speed_rpm) =
+            earliest(comparisons.iter().filter_map(|c| c.onset(true)).collect());
+        (self.onset.observed_time_s, self.onset.observed_speed_rpm) =
+            earliest(comparisons.iter().filter_map(|c| c.onset(false)).collect());
+        self.stations = comparisons
+            .iter()
+            .filter(|c| c.samples > 0)
+            .map(|c| {
+                let w = c.summary();
+                let get = |f: fn(&WindowComparison) -> f64| w.as_ref().map(f);
+                StationReport {
+                    station: c.station.clone(),
+                    samples: c.samples,
+                    window_start_s: get(|w| w.start_s),
+                    window_end_s: get(|w| w.end_s),
+                    window_speed_rpm: get(|w| w.speed_rpm),
+                    one_x_amplitude_measured_m: get(|w| w.measured.one_x_amplitude_m),
+                    one_x_amplitude_predicted_m: get(|w| w.predicted.one_x_amplitude_m),
+                    one_x_amplitude_error_m: get(|w| {
+                        w.predicted.one_x_amplitude_m - w.measured.one_x_amplitude_m
+                    }),
+                    one_x_phase_error_deg: get(|w| {
+                        phase_difference_deg(
+                            w.predicted.one_x_phase_deg,
+                            w.measured.one_x_phase_deg,
+                        )
+                    }),
+                    subsync_amplitude_predicted_m: get(|w| w.predicted.subsync_amplitude_m),
+                    subsync_amplitude_measured_m: get(|w| w.measured.subsync_amplitude_m),
+                    subsync_ratio_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ratio),
+                    subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
+                    orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
+                    mean_position_distance_m: get(|w| w.mean_position_distance_m),
+                    blocks: c.blocks.clone(),
+                }
+            })
+            .collect();
+    }
+
+    /// A few lines for the terminal.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "replayed {:.2} s of bag in {:.2} s ({:.2}× real time): {} messages in, {} out\n",
+            self.bag_duration_s,
+            self.wall_time_s,
+            self.real_time_factor,
+            self.messages_in,
+            self.messages_out
+        );
+        for d in &self.damage {
+            s += &format!("DAMAGED BAG: {d}; replayed what came before\n");
+        }
+        for r in &self.rejected {
+            s += &format!(
+                "rejected {} input(s) on {}; last: {}\n",
+                r.count, r.topic, r.last_reason
+            );
+        }
+        let um = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} µm", v * 1e6));
+        let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
+        for st in &self.stations {
+            s += &format!(
+                "{}: 1X {} predicted vs {} measured (phase error {}), sub-synchronous {} at {} vs {} at {}, orbit shape RMS distance {}\n",
+                st.station,
+                um(st.one_x_amplitude_predicted_m),
+                um(st.one_x_amplitude_measured_m),
+                st.one_x_phase_error_deg.map_or("—".into(), |v| format!("{v:.1}°")),
+                um(st.subsync_amplitude_predicted_m),
+                ratio(st.subsync_ratio_predicted),
+                um(st.subsync_amplitude_measured_m),
+                ratio(st.subsync_ratio_measured),
+                um(st.orbit_rms_distance_m),
+            );
+        }
+        let at = |t: Option<f64>, w: Option<f64>| match (t, w) {
+            (Some(t), Some(w)) => format!("{t:.2} s ({w:.0} rpm)"),
+            _ => "none".into(),
+        };
+        s += &format!(
+            "instability onset: predicted {}, observed {}; twin's first warning {}\n",
+            at(self.onset.predicted_time_s, self.onset.predicted_speed_rpm),
+            at(self.onset.observed_time_s, self.onset.observed_speed_rpm),
+            at(
+                self.onset.twin_warning_time_s,
+                self.onset.twin_warning_speed_rpm
+            ),
+        );
+        let states: Vec<String> = self
+            .states
+            .iter()
+            .map(|c| format!("{} at {:.2} s", c.state, c.time_s))
+            .collect();
+        s += &format!("states: {}\n", states.join(" → "));
+        s
+    }
+}

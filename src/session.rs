@@ -1,0 +1,399 @@
+//! A twin session: the twin core and its monitor, turning each step into the messages the node
+//! publishes and the replay records (journal and film states, orbits, warnings, residuals). It
+//! knows no bus, no file and no wall clock: stamps come from the model time plus an epoch the
+//! caller gives, and warning reminders are paced in model time, so a replay is deterministic.
+
+use crate::dynamics::{StepInput, Twin, TwinConfig, TwinError};
+use crate::messages::*;
+use crate::monitor::{ClassifierSettings, Monitor, RevolutionReport, RotorState, PRESSURE_POINTS};
+use crate::rotor::Rotor;
+
+/// Output rates and warning thresholds of a session.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SessionSettings {
+    /// Journal and film states per second of model time (Hz).
+    pub state_rate_hz: f64,
+    /// Film states that carry the mid-plane pressure profile, per second (Hz).
+    pub pressure_map_rate_hz: f64,
+    /// Orbit radius over clearance above which a stable rotor still gets a warning (level WARN).
+    pub warning_amplitude_ratio: f64,
+    /// While not stable, the warning is repeated this often (s of model time).
+    pub warning_repeat_s: f64,
+}
+
+impl Default for SessionSettings {
+    fn default() -> Self {
+        Self {
+            state_rate_hz: 1000.0,
+            pressure_map_rate_hz: 10.0,
+            warning_amplitude_ratio: 0.5,
+            warning_repeat_s: 1.0,
+        }
+    }
+}
+
+/// A message of the twin, for the bus and the recording.
+#[derive(Debug, Clone)]
+pub enum Outgoing {
+    /// Journal state of one bearing.
+    Journal(JournalState),
+    /// Film state of one bearing.
+    Film(FilmState),
+    /// One revolution's orbit of one bearing.
+    Orbit(Orbit),
+    /// A warning.
+    Warning(InstabilityWarning),
+    /// Diagnostics.
+    Diagnostics(DiagnosticArray),
+    /// Predicted minus measured displacement at a probe station.
+    Residual(OrbitResidual),
+    /// Distance from the linear stability threshold.
+    Margin(StabilityMargin),
+}
+
+/// A message header stamped `ns` (ns since the epoch) in frame `frame`.
+pub fn header(ns: i64, frame: &str) -> Header {
+    Header {
+        stamp: Time::from_nanos(ns),
+        frame_id: frame.to_string(),
+    }
+}
+
+/// A warning message of `level` and `kind`.
+pub fn warning(ns: i64, level: u8, kind: &str, bearing: &str, evidence: String) -> Outgoing {
+    Outgoing::Warning(InstabilityWarning {
+        header: header(ns, bearing),
+        level,
+        kind: kind.into(),
+        bearing: bearing.into(),
+        evidence,
+        ..Default::default()
+    })
+}
+
+/// The twin, its monitor and the message products.
+pub struct Session {
+    twin: Twin,
+    monitor: Monitor,
+    settings: SessionSettings,
+    names: Vec<String>,
+    stations: Vec<String>,
+    clearances: Vec<f64>,
+    angles: Vec<f64>,
+    profile: Vec<f64>,
+    epoch_ns: i64,
+    step_index: u64,
+    decimation: u64,
+    map_decimation: u64,
+    last_state: RotorState,
+    last_warning_s: f64,
+    /// probe displacements (m) and time (s) before the last step, for interpolation
+    previous_probes: Vec<[f64; 2]>,
+    previous_time_s: f64,
+    previous_angle_rad: f64,
+}
+
+impl Session {
+    /// Starts a twin of `rotor` at `speed_rad_s` (static equilibrium), its time zero stamped
+    /// `epoch_ns` (ns since the epoch).
+    pub fn new(
+        rotor: &Rotor,
+        config: TwinConfig,
+        speed_rad_s: f64,
+        settings: SessionSettings,
+        epoch_ns: i64,
+    ) -> Result<Self, TwinError> {
+        let twin = Twin::new(rotor, config, speed_rad_s)?;
+        let steps_per_rev =
+            (std::f64::consts::TAU / rotor.rated_speed_rad_s.max(1e-9) / config.time_step_s)
+                .round()
+                .max(8.0) as usize;
+        let monitor = Monitor::new(&twin, 2 * steps_per_rev, ClassifierSettings::default());
+        let names = twin.bearing_names().map(str::to_string).collect();
+        let clearances = twin.bearing_clearances_m();
+        let o = twin.output();
+        let previous_probes = o.probes.iter().map(|p| p.displacement_m).collect();
+        let (previous_time_s, previous_angle_rad) = (o.time_s, o.angle_rad);
+        let mut s = Self {
+            twin,
+            monitor,
+            settings,
+            names,
+            stations: rotor.probes.iter().map(|p| p.name.clone()).collect(),
+            clearances,
+            angles: (0..PRESSURE_POINTS)
+                .map(|k| std::f64::consts::TAU * k as f64 / PRESSURE_POINTS as f64)
+                .collect(),
+            profile: vec![0.0; PRESSURE_POINTS],
+            epoch_ns,
+            step_index: 0,
+            decimation: 1,
+            map_decimation: 1,
+            last_state: RotorState::Stable,
+            last_warning_s: f64::NEG_INFINITY,
+            previous_probes,
+            previous_time_s,
+            previous_angle_rad,
+        };
+        s.set_settings(settings);
+        Ok(s)
+    }
+
+    /// Changes the output rates and thresholds (at run time).
+    pub fn set_settings(&mut self, settings: SessionSettings) {
+        let h = self.twin.config().time_step_s;
+        self.settings = settings;
+        self.decimation = ((1.0 / settings.state_rate_hz) / h).round().max(1.0) as u64;
+        self.map_decimation = ((1.0 / settings.pressure_map_rate_hz) / h).round().max(1.0) as u64;
+    }
+
+    /// The twin (read only).
+    pub fn twin(&self) -> &Twin {
+        &self.twin
+    }
+
+    /// The twin, to change its unbalance or forces.
+    pub fn twin_mut(&mut self) -> &mut Twin {
+        &mut self.twin
+    }
+
+    /// The monitor's latest revolution report.
+    pub fn report(&self) -> &RevolutionReport {
+        self.monitor.report()
+    }
+
+    /// Model time zero, ns since the epoch.
+    pub fn epoch_ns(&self) -> i64 {
+        self.epoch_ns
+    }
+
+    /// Sets model time zero (ns since the epoch), e.g. to the first `/clock` time.
+    pub fn set_epoch_ns(&mut self, epoch_ns: i64) {
+        self.epoch_ns = epoch_ns;
+    }
+
+    /// The stamp (ns since the epoch) of the twin's present time.
+    pub fn stamp_ns(&self) -> i64 {
+        self.epoch_ns + (self.twin.time_s() * 1e9).round() as i64
+    }
+
+    /// Probe station names, in machine order.
+    pub fn stations(&self) -> &[String] {
+        &self.stations
+    }
+
+    /// Advances one step and hands its messages to `emit`. On an error the twin state is
+    /// unchanged and nothing is emitted.
+    pub fn step(
+        &mut self,
+        input: &StepInput,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Result<(), TwinError> {
+        {
+            let o = self.twin.output();
+            for (p, q) in self.previous_probes.iter_mut().zip(&o.probes) {
+                *p = q.displacement_m;
+            }
+            self.previous_time_s = o.time_s;
+            self.previous_angle_rad = o.angle_rad;
+        }
+        self.twin.step(input)?;
+        self.step_index += 1;
+        let stamp = self.stamp_ns();
+        if self.step_index % self.decimation == 0 {
+            self.emit_states(stamp, emit);
+        }
+        if self.monitor.record(&self.twin).is_some() {
+            self.emit_revolution(stamp, emit);
+        }
+        Ok(())
+    }
+
+    /// The predicted displacement (m) of probe station `station` at model time `time_s`, linear
+    /// between the last two steps (clamped to them), and the shaft angle (rad) there.
+    pub fn predicted_probe(&self, station: usize, time_s: f64) -> Option<([f64; 2], f64)> {
+        let o = self.twin.output();
+        let now = o.probes.get(station)?.displacement_m;
+        let before = self.previous_probes.get(station)?;
+        let span = o.time_s - self.previous_time_s;
+        let a = if span > 0.0 {
+            ((time_s - self.previous_time_s) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let lerp = |u: f64, v: f64| u + a * (v - u);
+        Some((
+            [lerp(before[0], now[0]), lerp(before[1], now[1])],
+            lerp(self.previous_angle_rad, o.angle_rad),
+        ))
+    }
+
+    /// The residual message for a measured displacement (m) at station `station` stamped
+    /// `stamp_ns`, against the prediction at that time (None for an unknown station).
+    pub fn residual(
+        &self,
+        station: usize,
+        measured: [f64; 2],
+        stamp_ns: i64,
+    ) -> Option<OrbitResidual> {
+        let name = self.stations.get(station)?;
+        let t = (stamp_ns - self.epoch_ns) as f64 * 1e-9;
+        let ([px, py], _) = self.predicted_probe(station, t)?;
+        Some(OrbitResidual {
+            header: header(stamp_ns, name),
+            station: name.clone(),
+            predicted_x: px,
+            predicted_y: py,
+            measured_x: measured[0],
+            measured_y: measured[1],
+            residual_x: px - measured[0],
+            residual_y: py - measured[1],
+        })
+    }
+
+    fn emit_states(&mut self, stamp: i64, emit: &mut impl FnMut(Outgoing)) {
+        let with_map = self.step_index % self.map_decimation == 0;
+        for k in 0..self.names.len() {
+            let o = self.twin.output();
+            let b = o.bearings[k];
+            let speed = o.speed_rad_s;
+            emit(Outgoing::Journal(JournalState {
+                header: header(stamp, &self.names[k]),
+                bearing: self.names[k].clone(),
+                x: b.position_m[0],
+                y: b.position_m[1],
+                vx: b.velocity_m_s[0],
+                vy: b.velocity_m_s[1],
+                eccentricity_ratio: b.eccentricity_ratio,
+                attitude: b.attitude_rad,
+                speed,
+                contact: b.contact,
+            }));
+            if with_map {
+                self.twin.midplane_pressure(k, &mut self.profile);
+            }
+            emit(Outgoing::Film(FilmState {
+                header: header(stamp, &self.names[k]),
+                bearing: self.names[k].clone(),
+                force_x: b.force_n[0],
+                force_y: b.force_n[1],
+                max_pressure: b.max_pressure_pa,
+                max_pressure_angle: b.max_pressure_angle_rad,
+                film_start: b.film_start_rad,
+                film_end: b.film_end_rad,
+                power_loss: b.power_loss_w,
+                pressure_angles: if with_map {
+                    self.angles.clone()
+                } else {
+                    Vec::new()
+                },
+                pressure: if with_map {
+                    self.profile.clone()
+                } else {
+                    Vec::new()
+                },
+            }));
+        }
+    }
+
+    /// Orbits of the revolution just completed, and a warning on a change of state (repeated
+    /// every `warning_repeat_s` of model time while not stable).
+    fn emit_revolution(&mut self, stamp: i64, emit: &mut impl FnMut(Outgoing)) {
+        let rep = self.monitor.report();
+        for (k, b) in rep.bearings.iter().enumerate() {
+            let orbit = self.monitor.recent_orbit(k, 1);
+            emit(Outgoing::Orbit(Orbit {
+                header: header(stamp, &self.names[k]),
+                bearing: self.names[k].clone(),
+                revolution: rep.revolution,
+                speed: rep.speed_rad_s,
+                clearance: self.clearances[k],
+                x: orbit.iter().map(|p| p[0]).collect(),
+                y: orbit.iter().map(|p| p[1]).collect(),
+                one_x_amplitude: b.one_x_amplitude_m,
+                subsync_ratio: b.subsync_ratio,
+                subsync_amplitude: b.subsync_amplitude_m,
+            }));
+        }
+        let now = self.twin.time_s();
+        let reminder = rep.state != RotorState::Stable
+            && now - self.last_warning_s >= self.settings.warning_repeat_s;
+        if rep.state == self.last_state && !reminder {
+            return;
+        }
+        self.last_warning_s = now;
+        self.last_state = rep.state;
+        let (k, b) = rep
+            .bearings
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.state.cmp(&b.1.state))
+            .map(|(k, b)| (k, *b))
+            .unwrap_or_default();
+        let (level, kind) = match rep.state {
+            RotorState::Stable => (InstabilityWarning::OK, "none"),
+            RotorState::Whirl => (InstabilityWarning::WARN, "whirl"),
+            RotorState::Whip => (InstabilityWarning::ERROR, "whip"),
+            RotorState::Contact => (InstabilityWarning::ERROR, "contact"),
+        };
+        let amplitude = 0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m)
+            / self.clearances.get(k).copied().unwrap_or(1.0);
+        let level = if rep.state == RotorState::Stable
+            && amplitude > self.settings.warning_amplitude_ratio
+        {
+            InstabilityWarning::WARN
+        } else {
+            level
+        };
+        emit(Outgoing::Warning(InstabilityWarning {
+            header: header(stamp, self.names.get(k).map_or("", String::as_str)),
+            level,
+            kind: kind.into(),
+            bearing: self.names.get(k).cloned().unwrap_or_default(),
+            whirl_ratio: b.subsync_ratio,
+            amplitude_over_clearance: amplitude,
+            evidence: rep.evidence(),
+        }));
+    }
+}
+
+/// The linear stability threshold of `rotor` from its damped eigenvalues at the static
+/// equilibrium, searched from 10 % to 200 % of the rated speed: Some((speed rad/s, whirl
+/// ratio)), or None if stable over that range or not computable.
+pub fn linear_threshold(rotor: &Rotor) -> Option<(f64, f64)> {
+    let rated_rpm = rotor.rated_speed_rad_s * 30.0 / std::f64::consts::PI;
+    let st = crate::rotor::static_solution(rotor).ok()?;
+    let found = crate::rotor::stability_threshold(
+        rotor,
+        &st,
+        (0.1 * rated_rpm).max(100.0),
+        2.0 * rated_rpm,
+        rated_rpm / 20.0,
+    )
+    .ok()??;
+    Some((
+        found.speed_rpm * std::f64::consts::PI / 30.0,
+        found.whirl_ratio,
+    ))
+}
+
+/// The stability margin message at speed `speed_rad_s` against `threshold` (as from
+/// [`linear_threshold`]), stamped `ns`.
+pub fn margin(ns: i64, speed_rad_s: f64, threshold: Option<(f64, f64)>) -> StabilityMargin {
+    let (threshold_found, threshold_speed, whirl_ratio) = match threshold {
+        Some((s, r)) => (true, s, r),
+        None => (false, 0.0, 0.0),
+    };
+    StabilityMargin {
+        header: header(ns, ""),
+        speed: speed_rad_s,
+        threshold_found,
+        threshold_speed,
+        margin: if threshold_found {
+            threshold_speed - speed_rad_s
+        } else {
+            0.0
+        },
+        whirl_ratio,
+    }
+}
