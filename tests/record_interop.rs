@@ -9,20 +9,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-/// The interop venv (created on first use by tests/interop/setup-venv.sh).
-pub fn python() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("run setup-venv.sh");
-    assert!(
-        out.status.success(),
-        "setup-venv.sh failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    root.join("tests/.venv/bin/python")
-}
+mod common;
+use common::python;
 
 fn read_bag(path: &Path, stream: bool) -> Value {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

@@ -4,6 +4,7 @@
 //! by a crash, a bad chunk) yields every message before the damage and says what and where the
 //! damage is; it is not an error unless nothing at all can be read.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -126,73 +127,108 @@ impl Bag {
             })?;
             bag.read_file(file, &bytes)?;
         }
-        bag.messages.sort_by_key(|m| m.log_time_ns);
         Ok(bag)
     }
 
-    /// Reads one file's messages from `bytes` (an MCAP file's contents).
+    /// Reads one file's messages from `bytes` (an MCAP file's contents) and puts all messages
+    /// in receive-time order again. Reading stops at the first damaged record, which is noted in
+    /// [`Bag::damage`]; nothing read is an error only if the file has no message at all.
     pub fn read_file(&mut self, file: &Path, bytes: &[u8]) -> Result<(), BagError> {
-        let stream = mcap::MessageStream::new(bytes).map_err(|e| BagError::NotMcap {
-            path: file.to_path_buf(),
-            why: e.to_string(),
-        })?;
+        use mcap::records::Record;
+        use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+        // the reader trusts the sizes a file declares: the limit keeps a damaged size from
+        // making it allocate without bound; chunk CRCs catch damaged compressed data
+        let mut reader = LinearReader::new_with_options(
+            LinearReaderOptions::default()
+                .with_record_length_limit(MAX_RECORD_BYTES)
+                .with_validate_chunk_crcs(true),
+        );
+        let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
+        let mut channel_topic: HashMap<u16, usize> = HashMap::new();
+        let messages_at_start = self.messages.len();
         let mut last_time = None;
-        let mut channel_topic: std::collections::HashMap<u16, usize> = Default::default();
-        for (read, item) in stream.enumerate() {
-            let message = match item {
-                Ok(m) => m,
+        let mut rest = bytes;
+        let mut failure = None;
+        while let Some(event) = reader.next_event() {
+            let (opcode, data) = match event {
+                Ok(LinearReadEvent::ReadRequest(need)) => {
+                    let n = need.min(rest.len());
+                    reader.insert(n).copy_from_slice(&rest[..n]);
+                    reader.notify_read(n);
+                    rest = &rest[n..];
+                    continue;
+                }
+                Ok(LinearReadEvent::Record { opcode, data }) => (opcode, data),
                 Err(e) => {
-                    if read == 0 && self.messages.is_empty() {
-                        return Err(BagError::NotMcap {
-                            path: file.to_path_buf(),
-                            why: e.to_string(),
-                        });
-                    }
-                    self.damage.push(BagDamage {
-                        file: file.to_path_buf(),
-                        messages_before: read,
-                        last_good_log_time_ns: last_time,
-                        why: e.to_string(),
-                    });
+                    failure = Some(e.to_string());
                     break;
                 }
             };
-            let channel = &message.channel;
-            let topic = match channel_topic.get(&channel.id) {
-                Some(&t) => t,
-                None => {
-                    let t = self.topic_index(channel);
-                    channel_topic.insert(channel.id, t);
-                    t
+            match mcap::parse_record(opcode, data) {
+                Ok(Record::Schema { header, data }) => {
+                    schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
                 }
-            };
-            let start = self.payloads.len();
-            self.payloads.extend_from_slice(&message.data);
-            self.messages.push(BagMessage {
-                topic,
-                log_time_ns: message.log_time,
-                publish_time_ns: message.publish_time,
-                start,
-                len: message.data.len(),
-            });
-            last_time = Some(message.log_time);
+                Ok(Record::Channel(c)) => {
+                    let (type_name, schema_encoding, schema) =
+                        schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                    let topic = self.topic_index(BagTopic {
+                        name: c.topic,
+                        type_name,
+                        schema_encoding,
+                        schema,
+                        message_encoding: c.message_encoding,
+                        offered_qos_profiles: c.metadata.get("offered_qos_profiles").cloned(),
+                    });
+                    channel_topic.insert(c.id, topic);
+                }
+                Ok(Record::Message { header, data }) => {
+                    let Some(&topic) = channel_topic.get(&header.channel_id) else {
+                        failure = Some(format!(
+                            "message {} names channel {}, which was never defined",
+                            header.sequence, header.channel_id
+                        ));
+                        break;
+                    };
+                    let start = self.payloads.len();
+                    self.payloads.extend_from_slice(&data);
+                    self.messages.push(BagMessage {
+                        topic,
+                        log_time_ns: header.log_time,
+                        publish_time_ns: header.publish_time,
+                        start,
+                        len: data.len(),
+                    });
+                    last_time = Some(header.log_time);
+                }
+                // the summary repeats schemas and channels; the rest is not needed to replay
+                Ok(Record::DataEnd(_)) => break,
+                Ok(_) => {}
+                Err(e) => {
+                    failure = Some(e.to_string());
+                    break;
+                }
+            }
         }
+        let read = self.messages.len() - messages_at_start;
+        if let Some(why) = failure {
+            if read == 0 {
+                return Err(BagError::NotMcap {
+                    path: file.to_path_buf(),
+                    why,
+                });
+            }
+            self.damage.push(BagDamage {
+                file: file.to_path_buf(),
+                messages_before: read,
+                last_good_log_time_ns: last_time,
+                why,
+            });
+        }
+        self.messages.sort_by_key(|m| m.log_time_ns);
         Ok(())
     }
 
-    fn topic_index(&mut self, channel: &mcap::Channel) -> usize {
-        let (type_name, schema_encoding, schema) = match &channel.schema {
-            Some(s) => (s.name.clone(), s.encoding.clone(), s.data.to_vec()),
-            None => (String::new(), String::new(), Vec::new()),
-        };
-        let topic = BagTopic {
-            name: channel.topic.clone(),
-            type_name,
-            schema_encoding,
-            schema,
-            message_encoding: channel.message_encoding.clone(),
-            offered_qos_profiles: channel.metadata.get("offered_qos_profiles").cloned(),
-        };
+    fn topic_index(&mut self, topic: BagTopic) -> usize {
         if let Some(i) = self.topics.iter().position(|t| *t == topic) {
             return i;
         }
@@ -287,3 +323,7 @@ fn relative_file_paths(text: &str) -> Option<Vec<String>> {
             .collect(),
     )
 }
+
+/// Largest record believed (bytes): 256 MiB. A damaged length above it is reported, not
+/// allocated.
+const MAX_RECORD_BYTES: usize = 256 << 20;

@@ -4,7 +4,9 @@ mod bearing;
 mod bench;
 mod modes;
 mod node;
+mod replay;
 mod simulate;
+mod synth;
 
 use clap::{Parser, Subcommand};
 
@@ -28,6 +30,11 @@ enum Command {
     Sweep(simulate::SweepArgs),
     /// The live ROS 2 node: the twin beside a plant or rig, recorded to MCAP.
     Node(node::NodeArgs),
+    /// A recorded bag through the twin: predictions, warnings, predicted vs measured orbits.
+    Replay(replay::ReplayArgs),
+    /// Write a SYNTHETIC bag (a plant model run through a speed profile, noisy probes) to try
+    /// the replay on.
+    SynthBag(synth::SynthArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
 }
@@ -40,6 +47,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Simulate(args)) => simulate::run_simulate(&args),
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
         Some(Command::Node(args)) => node::run(args),
+        Some(Command::Replay(args)) => replay::run(&args),
+        Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         None => bearing::run(&bearing::BearingArgs::default_bearing()),
     }

@@ -423,7 +423,11 @@ impl Monitor {
                         (0.5 * (a - cc) / denom).clamp(-0.5, 0.5) / SPECTRUM_REVOLUTIONS as f64;
                 }
             }
-            let dominant = abest > s.subsync_min_clearance_share * c
+            // a window shorter than its resolution cannot resolve orders: no verdict on
+            // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
+            let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
+            let dominant = full_window
+                && abest > s.subsync_min_clearance_share * c
                 && abest > s.subsync_min_one_x_share * one_x.semi_major_m();
             let b_state = if contact {
                 RotorState::Contact

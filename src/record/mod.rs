@@ -112,6 +112,7 @@ pub struct Recorder {
     first_ns: Option<u64>,
     last_ns: u64,
     last_flush: Instant,
+    custom_data: BTreeMap<String, String>,
 }
 
 impl Recorder {
@@ -140,6 +141,8 @@ impl Recorder {
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
             .library("rotor-twin")
+            // chunks of 64 KiB: a file cut off (a crash, a full disk) loses at most that much
+            .chunk_size(Some(64 * 1024))
             .create(BufWriter::new(file))?;
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -150,6 +153,7 @@ impl Recorder {
             first_ns: None,
             last_ns: 0,
             last_flush: Instant::now(),
+            custom_data: BTreeMap::new(),
         })
     }
 
@@ -203,6 +207,12 @@ impl Recorder {
             count: 0,
         });
         Ok(self.topics.len() - 1)
+    }
+
+    /// Notes `key: value` about the whole bag: in metadata.yaml's `custom_data` (as `ros2 bag
+    /// record --custom-data` does) and in an MCAP metadata record named `rotor_twin`.
+    pub fn set_custom_data(&mut self, key: &str, value: &str) {
+        self.custom_data.insert(key.into(), value.into());
     }
 
     /// Records `message` on topic handle `topic`, received at `log_time_ns` and sent at
@@ -274,6 +284,12 @@ impl Recorder {
 
     /// Writes the summary section and `metadata.yaml`. Returns the bag directory.
     pub fn finish(mut self) -> Result<PathBuf, RecordError> {
+        if !self.custom_data.is_empty() {
+            self.writer.write_metadata(&mcap::records::Metadata {
+                name: "rotor_twin".into(),
+                metadata: self.custom_data.clone(),
+            })?;
+        }
         self.writer.finish()?;
         let metadata = self.metadata_yaml();
         let path = self.dir.join("metadata.yaml");
@@ -299,8 +315,20 @@ impl Recorder {
             ));
         }
         format!(
-            "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n  - {file}\n  files:\n  - path: {file}\n    starting_time:\n      nanoseconds_since_epoch: {start}\n    duration:\n      nanoseconds: {duration}\n    message_count: {total}\n  custom_data: {{}}\n  ros_distro: jazzy\n",
-            file = self.file_name
+            "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n  - {file}\n  files:\n  - path: {file}\n    starting_time:\n      nanoseconds_since_epoch: {start}\n    duration:\n      nanoseconds: {duration}\n    message_count: {total}\n  custom_data: {custom}\n  ros_distro: jazzy\n",
+            file = self.file_name,
+            custom = if self.custom_data.is_empty() {
+                "{}".to_string()
+            } else {
+                // JSON strings are valid YAML scalars (quotes and escapes included)
+                let quote = |v: &String| serde_json::to_string(v).unwrap_or_default();
+                let items: String = self
+                    .custom_data
+                    .iter()
+                    .map(|(k, v)| format!("\n    {}: {}", quote(k), quote(v)))
+                    .collect();
+                items
+            }
         )
     }
 }

@@ -51,6 +51,9 @@ pub struct ReplayOptions {
     pub duration_s: Option<f64>,
     /// Where to write the output bag (None: no output bag).
     pub out_bag: Option<PathBuf>,
+    /// A gap between messages longer than this (s) stops the twin; it restarts at the next
+    /// speed message (a bag spanning a pause is not modelled through the pause).
+    pub max_gap_s: f64,
 }
 
 impl Default for ReplayOptions {
@@ -66,6 +69,7 @@ impl Default for ReplayOptions {
             rate: None,
             duration_s: None,
             out_bag: None,
+            max_gap_s: 5.0,
         }
     }
 }
@@ -113,13 +117,14 @@ enum Role {
 }
 
 /// Replays `bag` through a twin of `rotor`. `progress` is called now and then with the share of
-/// the bag done (0–1). Returns the report (with `wall_time_s` measured here).
+/// the bag done (0–1). Returns the report (with `wall_time_s` measured here) and the comparison
+/// at each probe station (for plots).
 pub fn replay(
     bag: &Bag,
     rotor: &Rotor,
     options: &ReplayOptions,
     progress: &mut dyn FnMut(f64),
-) -> Result<ReplayReport, ReplayError> {
+) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
     let wall = std::time::Instant::now();
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     let roles = map_topics(bag, options, &stations)?;
@@ -146,10 +151,13 @@ pub fn replay(
     };
     let threshold = crate::session::linear_threshold(rotor);
     let Some((t0, t_last)) = bag.time_span_ns() else {
-        return Ok(ReplayReport::empty(bag, wall.elapsed().as_secs_f64()));
+        return Ok((
+            ReplayReport::empty(bag, wall.elapsed().as_secs_f64()),
+            comparisons,
+        ));
     };
     let t_end = match options.duration_s {
-        Some(d) => t_last.min(t0 + (d * 1e9) as u64),
+        Some(d) => t_last.min(t0.saturating_add((d * 1e9) as u64)),
         None => t_last,
     };
     let mut report = ReplayReport::empty(bag, 0.0);
@@ -162,11 +170,27 @@ pub fn replay(
     let mut next_margin_ns = t0;
     let mut emitted: Vec<Outgoing> = Vec::new();
     let mut last_progress = std::time::Instant::now();
-    for (index, m) in bag.messages.iter().enumerate() {
+    let mut last_ns = t0 as i64;
+    for m in &bag.messages {
         if m.log_time_ns > t_end {
             break;
         }
-        let t_ns = m.log_time_ns as i64;
+        let t_ns = m.log_time_ns.min(i64::MAX as u64) as i64;
+        if t_ns - last_ns > (options.max_gap_s * 1e9) as i64 && session.is_some() {
+            session = None;
+            emitted.push(warning(
+                t_ns,
+                InstabilityWarning::WARN,
+                "stale_input",
+                "",
+                format!(
+                    "a gap of {:.3} s in the bag (over {} s): the twin restarts at the next speed message",
+                    (t_ns - last_ns) as f64 * 1e-9,
+                    options.max_gap_s
+                ),
+            ));
+        }
+        last_ns = t_ns;
         // the twin up to this message's time
         if let (Some(s), Some((w, a))) = (session.as_mut(), speed) {
             let input = StepInput {
@@ -211,6 +235,10 @@ pub fn replay(
                                             let _ = s.twin_mut().set_unbalance(plane, me, phase);
                                         }
                                     }
+                                    report.note_start(
+                                        (t_ns - t0 as i64) as f64 * 1e-9,
+                                        w * 30.0 / std::f64::consts::PI,
+                                    );
                                     session = Some(s);
                                 }
                                 Err(e) => emitted.push(warning(
@@ -301,7 +329,7 @@ pub fn replay(
             out.write_input(bag, m)?;
         }
         if let Some(rate) = options.rate {
-            let due = (m.log_time_ns - t0) as f64 * 1e-9 / rate;
+            let due = m.log_time_ns.saturating_sub(t0) as f64 * 1e-9 / rate;
             let ahead = due - wall.elapsed().as_secs_f64();
             if ahead > 0.0 {
                 std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
@@ -309,8 +337,7 @@ pub fn replay(
         }
         if last_progress.elapsed().as_millis() >= 200 {
             last_progress = std::time::Instant::now();
-            progress((m.log_time_ns - t0) as f64 / (t_end - t0).max(1) as f64);
-            let _ = index;
+            progress(m.log_time_ns.saturating_sub(t0) as f64 / (t_end - t0).max(1) as f64);
         }
     }
     progress(1.0);
@@ -318,7 +345,15 @@ pub fn replay(
     if let Some(out) = out {
         report.messages_out = out.finish()?;
     }
-    Ok(report)
+    Ok((report, comparisons))
+}
+
+/// Checks, before anything is written, that `bag` can drive a twin of `rotor` with `options`:
+/// the speed topic is there (after remapping), mapped topics have usable types, named probe
+/// stations exist.
+pub fn check_mapping(bag: &Bag, rotor: &Rotor, options: &ReplayOptions) -> Result<(), ReplayError> {
+    let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
+    map_topics(bag, options, &stations).map(|_| ())
 }
 
 /// The role of each bag topic, checking that the speed topic is there and the types fit.

@@ -71,7 +71,8 @@ pub struct StateChange {
     pub time_s: f64,
     /// Speed (rpm).
     pub speed_rpm: f64,
-    /// none (stable) | whirl | whip | contact.
+    /// start (the twin (re)started, from the static equilibrium) | none (stable) | whirl |
+    /// whip | contact.
     pub state: String,
     /// Warning level: 0 OK, 1 WARN, 2 ERROR.
     pub level: u8,
@@ -143,6 +144,17 @@ impl ReplayReport {
                 last_reason: why.into(),
             }),
         }
+    }
+
+    /// Notes a (re)start of the twin at bag time `time_s` and `speed_rpm`: stable, from the
+    /// static equilibrium.
+    pub(super) fn note_start(&mut self, time_s: f64, speed_rpm: f64) {
+        self.states.push(StateChange {
+            time_s,
+            speed_rpm,
+            state: "start".into(),
+            level: 0,
+        });
     }
 
     /// Notes the twin's warnings (state changes, first onset).

@@ -95,3 +95,18 @@ pub fn run_cli(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// The interop venv (created on first use by tests/interop/setup-venv.sh).
+pub fn python() -> PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("bash")
+        .arg(root.join("tests/interop/setup-venv.sh"))
+        .output()
+        .expect("run setup-venv.sh");
+    assert!(
+        out.status.success(),
+        "setup-venv.sh failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    root.join("tests/.venv/bin/python")
+}

@@ -1,0 +1,234 @@
+//! `rotor-twin replay`: a recorded bag through the twin, predicted against measured orbits.
+
+use crate::bag::Bag;
+use crate::dynamics::Coupling;
+use crate::replay::{replay, ReplayOptions};
+use crate::ros::SpeedUnit;
+use crate::rotor::{MachineDescription, Rotor};
+use crate::session::SessionSettings;
+use anyhow::Context;
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// The bag shipped with the project (a synthetic run-up of the built-in microturbine).
+pub const SAMPLE_BAG: &str = "bags/orc_runup_synthetic";
+
+/// Arguments of `rotor-twin replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The bag: a rosbag2 directory (metadata.yaml + .mcap) or a bare .mcap file.
+    #[arg(default_value = SAMPLE_BAG)]
+    pub bag: PathBuf,
+    /// Machine description (YAML); default: the built-in microturbine.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Output directory: the output bag (bag/), report.json and the plots. Default:
+    /// replay_<bag name> in the current directory. A previous replay's output there is replaced.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replay at this many times the bag's pace (1 = as recorded).
+    #[arg(long, conflicts_with = "fast")]
+    pub rate: Option<f64>,
+    /// As fast as the model runs (the default).
+    #[arg(long)]
+    pub fast: bool,
+    /// Topic remapping FROM:=TO, e.g. --remap /plant/rpm:=/rotor_twin/speed (repeatable).
+    #[arg(long, value_parser = parse_remap)]
+    pub remap: Vec<(String, String)>,
+    /// Unit of a std_msgs/Float64 speed topic: rpm, rad_s or hz.
+    #[arg(long, default_value = "rpm", value_parser = parse_unit)]
+    pub speed_unit: SpeedUnit,
+    /// A geometry_msgs/PointStamped probe pair (x, y in m): STATION=TOPIC (repeatable).
+    #[arg(long, value_parser = parse_probe_point)]
+    pub probe_point: Vec<(String, String)>,
+    /// Bearing coupling: nonlinear (reference), linear or prehistory.
+    #[arg(long, default_value = "nonlinear")]
+    pub model: String,
+    /// Prehistory relaxation factor δ in (0, 1].
+    #[arg(long, default_value_t = 0.3)]
+    pub delta: f64,
+    /// Time steps per revolution at rated speed.
+    #[arg(long, default_value_t = 128)]
+    pub steps_per_rev: usize,
+    /// Journal and film states per second of bag time in the output bag (Hz).
+    #[arg(long, default_value_t = 1000.0)]
+    pub state_rate_hz: f64,
+    /// Replay only the first this many seconds of the bag.
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// No output bag (report and plots only).
+    #[arg(long)]
+    pub no_bag: bool,
+    /// Print the JSON report to standard output instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_remap(s: &str) -> Result<(String, String), String> {
+    let (from, to) = s
+        .split_once(":=")
+        .ok_or_else(|| format!("--remap '{s}': expected FROM:=TO"))?;
+    if !from.starts_with('/') || !to.starts_with('/') {
+        return Err(format!("--remap '{s}': topic names must be absolute (/…)"));
+    }
+    Ok((from.into(), to.into()))
+}
+
+fn parse_probe_point(s: &str) -> Result<(String, String), String> {
+    let (station, topic) = s
+        .split_once('=')
+        .ok_or_else(|| format!("--probe-point '{s}': expected STATION=TOPIC"))?;
+    if !topic.starts_with('/') {
+        return Err(format!("--probe-point '{s}': topic must be absolute (/…)"));
+    }
+    // stored as (topic, station)
+    Ok((topic.into(), station.into()))
+}
+
+fn parse_unit(s: &str) -> Result<SpeedUnit, String> {
+    match s {
+        "rpm" => Ok(SpeedUnit::Rpm),
+        "rad_s" => Ok(SpeedUnit::RadPerS),
+        "hz" => Ok(SpeedUnit::Hz),
+        _ => Err(format!("--speed-unit '{s}': must be rpm, rad_s or hz")),
+    }
+}
+
+/// Runs `rotor-twin replay`.
+pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
+    let coupling = match args.model.as_str() {
+        "nonlinear" => Coupling::Nonlinear,
+        "linear" => Coupling::Linear,
+        "prehistory" if args.delta > 0.0 && args.delta <= 1.0 => {
+            Coupling::Prehistory { delta: args.delta }
+        }
+        "prehistory" => anyhow::bail!("--delta {}: must be in (0, 1]", args.delta),
+        other => anyhow::bail!("--model '{other}': must be nonlinear, linear or prehistory"),
+    };
+    if let Some(r) = args.rate {
+        anyhow::ensure!(r.is_finite() && r > 0.0, "--rate {r}: must be positive");
+    }
+    if let Some(d) = args.duration {
+        anyhow::ensure!(
+            d.is_finite() && d > 0.0,
+            "--duration {d}: must be positive (s)"
+        );
+    }
+    anyhow::ensure!(
+        args.state_rate_hz.is_finite() && args.state_rate_hz > 0.0,
+        "--state-rate-hz {}: must be positive",
+        args.state_rate_hz
+    );
+    anyhow::ensure!(
+        (16..=4096).contains(&args.steps_per_rev),
+        "--steps-per-rev {}: must be 16 to 4096",
+        args.steps_per_rev
+    );
+    let desc = match &args.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    let rotor = Rotor::from_description(&desc);
+    let bag =
+        Bag::read(&args.bag).with_context(|| format!("reading bag {}", args.bag.display()))?;
+    for d in &bag.damage {
+        eprintln!("warning: {d}; replaying what came before it");
+    }
+    let out_dir = args.out.clone().unwrap_or_else(|| {
+        let stem = args
+            .bag
+            .file_stem()
+            .map_or("bag".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from(format!("replay_{stem}"))
+    });
+    let options = ReplayOptions {
+        coupling,
+        steps_per_rev: args.steps_per_rev,
+        session: SessionSettings {
+            state_rate_hz: args.state_rate_hz,
+            ..SessionSettings::default()
+        },
+        remaps: args.remap.clone(),
+        speed_unit: args.speed_unit,
+        probe_points: args.probe_point.clone(),
+        rate: if args.fast { None } else { args.rate },
+        duration_s: args.duration,
+        out_bag: (!args.no_bag).then(|| out_dir.join("bag")),
+        ..ReplayOptions::default()
+    };
+    crate::replay::check_mapping(&bag, &rotor, &options)?;
+    prepare_out_dir(&out_dir)?;
+    let bar = indicatif::ProgressBar::new(1000);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "replay [{elapsed_precise}] {wide_bar} {percent}% of the bag, {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let started = std::time::Instant::now();
+    let bag_s = bag
+        .time_span_ns()
+        .map_or(0.0, |(a, b)| (b - a) as f64 * 1e-9);
+    let (report, comparisons) = replay(&bag, &rotor, &options, &mut |done| {
+        bar.set_position((done * 1000.0) as u64);
+        let wall = started.elapsed().as_secs_f64();
+        if wall > 0.0 {
+            bar.set_message(format!("{:.2}× real time", done * bag_s / wall));
+        }
+    })?;
+    bar.finish_and_clear();
+    let json = serde_json::to_string_pretty(&report)?;
+    std::fs::write(out_dir.join("report.json"), &json)?;
+    for c in &comparisons {
+        if c.samples == 0 {
+            continue;
+        }
+        let name = &c.station;
+        crate::plot::orbit_comparison_svg(
+            &out_dir.join(format!("orbit_{name}.svg")),
+            &format!("{name}: predicted over measured orbit, last 4 revolutions"),
+            &c.recent_samples(4),
+            c.clearance_m(),
+        )?;
+        if let Some((m, p)) = c.summary_spectra() {
+            crate::plot::spectrum_comparison_svg(
+                &out_dir.join(format!("spectrum_{name}.svg")),
+                &format!("{name}: order spectrum, last revolutions of the bag"),
+                &m,
+                &p,
+            )?;
+        }
+        crate::plot::amplitude_speed_svg(
+            &out_dir.join(format!("amplitude_speed_{name}.svg")),
+            &format!("{name}: amplitude against speed (blocks of 8 revolutions)"),
+            &c.blocks,
+        )?;
+    }
+    if args.json {
+        println!("{json}");
+    } else {
+        print!("{}", report.summary());
+        println!("output: {}", out_dir.display());
+    }
+    Ok(())
+}
+
+/// Creates `dir`, or clears a previous replay's output in it (a directory holding anything
+/// else is refused, so nothing of the user's is overwritten).
+fn prepare_out_dir(dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() {
+        anyhow::ensure!(
+            dir.join("report.json").exists(),
+            "--out {}: exists and is not a previous replay's output (no report.json); choose another",
+            dir.display()
+        );
+        let bag = dir.join("bag");
+        if bag.exists() {
+            std::fs::remove_dir_all(&bag)
+                .with_context(|| format!("removing the previous output bag {}", bag.display()))?;
+        }
+    } else {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,230 @@
+//! Plots of a replay: predicted over measured orbit at a probe station, their order spectra,
+//! and 1X and sub-synchronous amplitude against speed over the bag.
+
+use crate::monitor::OrderComponent;
+use crate::replay::compare::{Sample, WindowComparison};
+use plotters::prelude::*;
+use std::path::Path;
+
+const MEASURED: RGBColor = RGBColor(200, 30, 30);
+const PREDICTED: RGBColor = RGBColor(30, 60, 200);
+
+/// Predicted over measured orbit (µm), 1:1, inside the clearance circle.
+pub fn orbit_comparison_svg(
+    path: &Path,
+    title: &str,
+    samples: &[Sample],
+    clearance_m: f64,
+) -> anyhow::Result<()> {
+    let extent = samples
+        .iter()
+        .flat_map(|s| [s.measured_m, s.predicted_m])
+        .map(|p| p[0].hypot(p[1]))
+        .fold(clearance_m, f64::max);
+    let lim = 1.1 * extent * 1e6;
+    let root = SVGBackend::new(path, (640, 640)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(-lim..lim, -lim..lim)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (µm)")
+        .y_desc("y (µm)")
+        .draw()?;
+    let c = clearance_m * 1e6;
+    chart
+        .draw_series(LineSeries::new(
+            (0..=360).map(|k| {
+                let a = (k as f64).to_radians();
+                (c * a.cos(), c * a.sin())
+            }),
+            BLACK,
+        ))?
+        .label("bearing clearance circle")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+    chart
+        .draw_series(LineSeries::new(
+            samples
+                .iter()
+                .map(|s| (s.measured_m[0] * 1e6, s.measured_m[1] * 1e6)),
+            MEASURED,
+        ))?
+        .label("measured")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], MEASURED));
+    chart
+        .draw_series(LineSeries::new(
+            samples
+                .iter()
+                .map(|s| (s.predicted_m[0] * 1e6, s.predicted_m[1] * 1e6)),
+            PREDICTED,
+        ))?
+        .label("predicted")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PREDICTED));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Measured and predicted order spectra (semi-major axis, µm) side by side.
+pub fn spectrum_comparison_svg(
+    path: &Path,
+    title: &str,
+    measured: &[OrderComponent],
+    predicted: &[OrderComponent],
+) -> anyhow::Result<()> {
+    let max_order = measured.last().map_or(2.0, |c| c.order) + 0.05;
+    let top = measured
+        .iter()
+        .chain(predicted)
+        .map(|c| c.semi_major_m())
+        .fold(1e-9, f64::max)
+        * 1e6
+        * 1.1;
+    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..max_order, 0.0..top)?;
+    chart
+        .configure_mesh()
+        .x_desc("order (frequency / running frequency)")
+        .y_desc("semi-major axis (µm)")
+        .draw()?;
+    let bin = measured.first().map_or(0.05, |c| c.order);
+    for (set, color, offset, label) in [
+        (measured, MEASURED, -0.2, "measured"),
+        (predicted, PREDICTED, 0.2, "predicted"),
+    ] {
+        chart
+            .draw_series(set.iter().map(|c| {
+                let x = c.order + offset * bin;
+                Rectangle::new(
+                    [
+                        (x - 0.15 * bin, 0.0),
+                        (x + 0.15 * bin, c.semi_major_m() * 1e6),
+                    ],
+                    color.filled(),
+                )
+            }))?
+            .label(label)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 12, y + 4)], color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// 1X and sub-synchronous semi-major axes (µm) against speed (rpm), block by block.
+pub fn amplitude_speed_svg(
+    path: &Path,
+    title: &str,
+    blocks: &[WindowComparison],
+) -> anyhow::Result<()> {
+    let (lo, hi) = blocks
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, b| {
+            (a.0.min(b.speed_rpm), a.1.max(b.speed_rpm))
+        });
+    let (lo, hi) = if lo.is_finite() && hi > lo + 1.0 {
+        (lo, hi)
+    } else {
+        (lo.min(0.0) - 10.0, hi.max(0.0) + 10.0)
+    };
+    let top = blocks
+        .iter()
+        .flat_map(|b| {
+            [
+                b.measured.one_x_amplitude_m,
+                b.predicted.one_x_amplitude_m,
+                b.measured.subsync_amplitude_m,
+                b.predicted.subsync_amplitude_m,
+            ]
+        })
+        .fold(1e-9, f64::max)
+        * 1e6
+        * 1.1;
+    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(lo..hi, 0.0..top)?;
+    chart
+        .configure_mesh()
+        .x_desc("speed (rpm)")
+        .y_desc("semi-major axis (µm)")
+        .draw()?;
+    type Pick = fn(&WindowComparison) -> f64;
+    let series: [(&str, Pick, RGBColor, bool); 4] = [
+        (
+            "1X measured",
+            |b| b.measured.one_x_amplitude_m,
+            MEASURED,
+            true,
+        ),
+        (
+            "1X predicted",
+            |b| b.predicted.one_x_amplitude_m,
+            PREDICTED,
+            true,
+        ),
+        (
+            "sub-synchronous measured",
+            |b| b.measured.subsync_amplitude_m,
+            MEASURED,
+            false,
+        ),
+        (
+            "sub-synchronous predicted",
+            |b| b.predicted.subsync_amplitude_m,
+            PREDICTED,
+            false,
+        ),
+    ];
+    for (label, pick, color, solid) in series {
+        let points: Vec<(f64, f64)> = blocks
+            .iter()
+            .map(|b| (b.speed_rpm, pick(b) * 1e6))
+            .collect();
+        if solid {
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(2)))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        } else {
+            chart
+                .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
