@@ -80,28 +80,6 @@ pub struct BearingArgs {
     json: bool,
 }
 
-impl BearingArgs {
-    /// The built-in default bearing (seed: D 60 mm, L 30 mm, c 40 µm, µ 0.0008 Pa·s, 9000 rpm, 275 N).
-    pub(crate) fn default_bearing() -> Self {
-        Self {
-            diameter_m: 0.06,
-            length_m: 0.03,
-            clearance_m: 40e-6,
-            viscosity_pa_s: 0.0008,
-            density_kg_m3: 900.0,
-            speed_rpm: 9000.0,
-            load_n: None,
-            eccentricity_ratio: None,
-            grooves: Grooves::None,
-            groove_width_deg: 20.0,
-            supply_pressure_pa: 0.0,
-            grid: FilmGrid::DEFAULT,
-            model: ModelKind::Finite,
-            json: false,
-        }
-    }
-}
-
 /// The `--json` report (field names carry their units).
 #[derive(Debug, Serialize)]
 struct BearingReport {

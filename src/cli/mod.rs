@@ -39,7 +39,8 @@ enum Command {
     Bench(bench::BenchArgs),
 }
 
-/// Runs the command line; with no subcommand, the main job on the built-in default machine.
+/// Runs the command line; with no subcommand, the main job: the shipped sample bag replayed on
+/// the built-in default machine.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bearing(args)) => bearing::run(&args),
@@ -50,6 +51,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Replay(args)) => replay::run(&args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
-        None => bearing::run(&bearing::BearingArgs::default_bearing()),
+        None => replay::run_sample(),
     }
 }

@@ -94,6 +94,25 @@ fn parse_unit(s: &str) -> Result<SpeedUnit, String> {
     }
 }
 
+/// The main job: the shipped sample bag through the built-in machine, the summary printed, the
+/// output in `replay_orc_runup_synthetic/`.
+pub fn run_sample() -> anyhow::Result<()> {
+    let mut bag = PathBuf::from(SAMPLE_BAG);
+    if !bag.exists() {
+        // run from elsewhere than the repository root
+        bag = Path::new(env!("CARGO_MANIFEST_DIR")).join(SAMPLE_BAG);
+    }
+    println!(
+        "rotor-twin: replaying the shipped SYNTHETIC bag {} on the built-in machine",
+        bag.display()
+    );
+    let args = <ReplayArgs as clap::FromArgMatches>::from_arg_matches(
+        &<ReplayArgs as clap::Args>::augment_args(clap::Command::new("replay"))
+            .get_matches_from(["replay", &bag.to_string_lossy()]),
+    )?;
+    run(&args)
+}
+
 /// Runs `rotor-twin replay`.
 pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let coupling = match args.model.as_str() {

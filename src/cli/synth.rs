@@ -43,7 +43,7 @@ pub struct SynthArgs {
     #[arg(long, default_value_t = 5.0)]
     pub ramp: f64,
     /// Seconds at the end speed.
-    #[arg(long, default_value_t = 1.5)]
+    #[arg(long, default_value_t = 2.5)]
     pub hold_end: f64,
     /// Probe samples per revolution.
     #[arg(long, default_value_t = 16)]
@@ -51,8 +51,9 @@ pub struct SynthArgs {
     /// Standard deviation of the probe noise (µm).
     #[arg(long, default_value_t = 0.3)]
     pub noise_um: f64,
-    /// The plant's lubricant viscosity over the machine description's.
-    #[arg(long, default_value_t = 0.95)]
+    /// The plant's lubricant viscosity over the machine description's (1.05: a slightly cooler
+    /// oil than the twin assumes).
+    #[arg(long, default_value_t = 1.05)]
     pub viscosity_factor: f64,
     /// The plant's film grid over the machine description's, in each direction (1: the twin's).
     #[arg(long, default_value_t = 1.5)]
