@@ -1,7 +1,7 @@
 //! Offline transient runs at a constant speed: drive the twin core and its monitor for a number
 //! of revolutions and gather what `simulate`, `sweep`, the tests and the benchmark report.
 
-use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig, TwinError};
+use crate::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig, TwinError};
 use crate::film::FilmGrid;
 use crate::monitor::{ClassifierSettings, Monitor, OrderComponent, RevolutionReport};
 use crate::rotor::{BearingModel, Rotor};
@@ -21,6 +21,8 @@ pub struct TransientSpec {
     pub steps_per_rev: usize,
     /// Film grid for every finite film bearing, overriding the machine file.
     pub grid: Option<FilmGrid>,
+    /// Film evaluation: direct (the reference) or tabulated.
+    pub film: FilmEvaluation,
 }
 
 /// What a run gives.
@@ -143,7 +145,10 @@ pub fn run_transient_from(
     }
     let rotor = with_grid(rotor, spec.grid);
     let omega = rpm_to_rad_s(spec.speed_rpm);
-    let config = TwinConfig::with_steps_per_rev(spec.coupling, omega, spec.steps_per_rev);
+    let config = TwinConfig {
+        film: spec.film,
+        ..TwinConfig::with_steps_per_rev(spec.coupling, omega, spec.steps_per_rev)
+    };
     let mut twin = Twin::new(&rotor, config, omega)?;
     if let Some((q, qd, qdd)) = initial {
         twin.set_state_vectors(q, qd, qdd)?;

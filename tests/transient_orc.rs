@@ -7,7 +7,7 @@
 //! revolution's points from the path of the two before it; "pressure diff" the relative L2
 //! difference of the last two revolutions' mid-plane pressure fields, sample by sample.
 
-use rotor_twin::dynamics::Coupling;
+use rotor_twin::dynamics::{Coupling, FilmEvaluation};
 use rotor_twin::film::FilmGrid;
 use rotor_twin::monitor::RotorState;
 use rotor_twin::rotor::{damped_modes, MachineDescription, Rotor};
@@ -24,6 +24,7 @@ fn spec(speed_rpm: f64, revolutions: usize, coupling: Coupling) -> TransientSpec
         coupling,
         steps_per_rev: 128,
         grid: None,
+        film: FilmEvaluation::Direct,
     }
 }
 

@@ -36,6 +36,9 @@ pub struct BenchArgs {
     /// Film grid over the half bearing.
     #[arg(long, default_value = "60x10", value_parser = FilmGrid::parse)]
     grid: FilmGrid,
+    /// Film evaluation for ORC-9000: direct or table.
+    #[arg(long, value_enum, default_value_t = super::simulate::FilmArg::Direct)]
+    film: super::simulate::FilmArg,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -100,7 +103,10 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         Some(args.grid),
     );
     let omega = rpm_to_rad_s(9000.0);
-    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128);
+    let config = TwinConfig {
+        film: args.film.into(),
+        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128)
+    };
     let mut twin = Twin::new(&rotor, config, omega)?;
     let input = StepInput {
         speed_rad_s: omega,
@@ -145,7 +151,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&fig)?);
     } else {
-        println!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{}, 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z);
+        println!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
         println!(
             "  {} steps: median {:.1} µs, p99 {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
             fig.steps, fig.median_step_us, fig.p99_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step

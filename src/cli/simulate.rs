@@ -42,6 +42,28 @@ pub(crate) struct RunOptions {
     /// Film grid NTHxNZ for every finite film bearing (default: the machine file's).
     #[arg(long, value_parser = FilmGrid::parse)]
     grid: Option<FilmGrid>,
+    /// Film evaluation: direct (the finite solver at every evaluation, the reference) or table
+    /// (the same solutions tabulated once and interpolated; plain bearings).
+    #[arg(long, value_enum, default_value_t = FilmArg::Direct)]
+    film: FilmArg,
+}
+
+/// `--film`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum FilmArg {
+    /// The finite solver at every evaluation.
+    Direct,
+    /// Tabulated finite solutions, interpolated.
+    Table,
+}
+
+impl From<FilmArg> for crate::dynamics::FilmEvaluation {
+    fn from(f: FilmArg) -> Self {
+        match f {
+            FilmArg::Direct => Self::Direct,
+            FilmArg::Table => Self::Table,
+        }
+    }
 }
 
 impl RunOptions {
@@ -80,6 +102,7 @@ impl RunOptions {
             coupling: self.coupling()?,
             steps_per_rev: self.steps_per_rev,
             grid: self.grid,
+            film: self.film.into(),
         })
     }
 }

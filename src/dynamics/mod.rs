@@ -40,6 +40,18 @@ pub enum Coupling {
     },
 }
 
+/// How the film force of a fluid-film bearing is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FilmEvaluation {
+    /// The film model itself at every evaluation (the finite-length Reynolds solver: the
+    /// reference).
+    #[default]
+    Direct,
+    /// The same finite-length solutions, tabulated once over (ε, ψ) and interpolated
+    /// ([`crate::film::TabulatedFilm`]); plain bearings on the finite model only.
+    Table,
+}
+
 /// Settings of the twin core.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwinConfig {
@@ -59,6 +71,8 @@ pub struct TwinConfig {
     pub speed_refactor_tolerance: f64,
     /// Wall contact.
     pub contact: ContactModel,
+    /// Film evaluation.
+    pub film: FilmEvaluation,
 }
 
 impl TwinConfig {
@@ -71,6 +85,7 @@ impl TwinConfig {
             max_newton_iterations: 25,
             speed_refactor_tolerance: 2e-3,
             contact: ContactModel::default(),
+            film: FilmEvaluation::Direct,
         }
     }
 }

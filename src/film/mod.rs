@@ -9,7 +9,9 @@
 //! - [`FiniteFilm`]: the finite-length Reynolds equation (seed eq. 2, isoviscous) by finite
 //!   volumes, with the Reynolds (Swift–Stieber) cavitation condition solved as the
 //!   complementarity problem it is (primal–dual active set with a banded Cholesky factor);
-//! - [`ShortFilm`]: Ocvirk's short-bearing closed form with the π-film condition.
+//! - [`ShortFilm`]: Ocvirk's short-bearing closed form with the π-film condition;
+//! - [`TabulatedFilm`]: the finite film of a plain bearing solved once over every state it can be
+//!   in (two parameters suffice) and interpolated.
 
 mod banded;
 mod coefficients;
@@ -18,6 +20,7 @@ mod error;
 mod finite;
 mod geometry;
 mod short;
+mod table;
 
 pub use coefficients::FilmCoefficients;
 pub use equilibrium::{
@@ -28,6 +31,7 @@ pub use error::FilmError;
 pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
 pub use short::ShortFilm;
+pub use table::{FilmTable, TabulatedFilm};
 
 /// Position and velocity of the journal centre relative to the bearing centre, and its speed.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -72,6 +72,22 @@ impl FilmBearing {
     }
 }
 
+impl FilmBearing {
+    /// The tabulated film of this bearing (the table shared in the process, built on first use):
+    /// for plain bearings on the finite model.
+    pub fn tabulated_solver(&self) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        if self.short {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "film model (tabulated film)",
+                value: 0.0,
+                rule: "the table tabulates the finite model; this bearing uses the short-bearing model",
+            });
+        }
+        let table = crate::film::FilmTable::shared(&self.geometry, self.lubricant, self.grid)?;
+        Ok(Box::new(crate::film::TabulatedFilm::new(table)))
+    }
+}
+
 /// A bearing at a shaft node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BearingSite {

@@ -3,7 +3,9 @@
 use super::{State, Twin, HELD};
 use crate::dynamics::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
 use crate::dynamics::linear::{SparseRows, StepFactor};
-use crate::dynamics::{BearingState, Coupling, ProbeState, StepOutput, TwinConfig, TwinError};
+use crate::dynamics::{
+    BearingState, Coupling, FilmEvaluation, ProbeState, StepOutput, TwinConfig, TwinError,
+};
 use crate::film::{equilibrium_under_load, FilmCoefficients};
 use crate::rotor::{static_solution, BearingModel, Rotor};
 use faer::linalg::solvers::Solve;
@@ -75,7 +77,12 @@ impl Twin {
                     clearance_m: f.geometry.radial_clearance_m,
                     radius_m: f.geometry.radius_m(),
                     viscosity_pa_s: f.lubricant.viscosity_pa_s,
-                    film: f.solver(),
+                    film: match config.film {
+                        FilmEvaluation::Direct => f.solver(),
+                        FilmEvaluation::Table => f
+                            .tabulated_solver()
+                            .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", b.name)))?,
+                    },
                     linear_reference: None,
                     previous_raw: None,
                     last: LinkEvaluation::default(),

@@ -1,0 +1,443 @@
+//! The finite-length film of a plain bearing, solved once over all the states it can be in and
+//! interpolated: the same Reynolds solutions as [`FiniteFilm`], at a fraction of the cost.
+//!
+//! Why two parameters suffice. In the frame of the line of centres (journal at eccentricity ε on
+//! its x axis), the Reynolds equation's source (seed eq. 2) is
+//!   ω ∂h/∂θ + 2 ∂h/∂t = U sin θ − W cos θ,  U = ω ε − 2 ε φ̇,  W = 2 ε̇,
+//! (h = 1 − ε cos θ over c; φ̇ the whirl rate of the line of centres, ε̇ the radial rate). For a
+//! plain bearing without supply pressure, the film pressure solves a complementarity problem
+//! (Reynolds cavitation condition) whose data are the film shape (ε only) and this source; the
+//! problem is positively homogeneous in the source: scaling (U, W) by λ > 0 scales the pressure
+//! by λ and leaves the cavitated zone alone. So, with V = √(U² + W²) and ψ = atan2(W, U),
+//!   p(θ, z) = V · P(θ, z; ε, ψ),
+//! and every film quantity is V (or ω, for the Couette shear) times a function of (ε, ψ) alone.
+//! [`FilmTable`] holds those functions on a grid in (ε, ψ), made with [`FiniteFilm`]; the
+//! evaluation interpolates bicubically (Catmull–Rom) and rotates back by the attitude φ. The
+//! eight coefficients are central differences of the interpolant. The table is checked against
+//! the direct solver at random states in `tests/film_table.rs`.
+
+use super::{
+    wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmGrid, FilmModel, FilmResult,
+    FiniteFilm, JournalKinematics, Lubricant, MAX_ECCENTRICITY_RATIO,
+};
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Table nodes along u = −ln(1 − ε), from ε = 0 to [`MAX_ECCENTRICITY_RATIO`].
+const N_ECC: usize = 160;
+/// Table nodes around ψ (periodic).
+const N_PSI: usize = 192;
+
+/// Quantities tabulated at each node, per unit V (1/s) unless said otherwise.
+#[derive(Debug, Clone, Copy, Default)]
+struct Node {
+    /// Film force along the line of centres and 90° ahead of it (N·s).
+    force: [f64; 2],
+    /// Largest pressure (Pa·s).
+    p_max: f64,
+    /// Unit vectors of the angles (from the line of centres) of p_max, ζ1 and ζ2.
+    angles: [[f64; 2]; 3],
+    /// Pressure-flow friction torque (N·m·s).
+    torque_pressure: f64,
+    /// Couette friction torque per unit ω (N·m·s).
+    torque_couette: f64,
+    /// Side flow (m³).
+    side_flow: f64,
+    /// Pressure part of the inflow at ζ1 (m³).
+    inflow_pressure: f64,
+    /// Couette part of the inflow per unit ω (m³).
+    inflow_couette: f64,
+}
+
+/// One row of the table as built: its index, nodes and mid-plane profiles.
+type Row = (usize, Vec<Node>, Vec<f64>);
+
+/// The film functions of one bearing over (ε, ψ).
+pub struct FilmTable {
+    geometry: BearingGeometry,
+    nodes: Vec<Node>,
+    /// mid-plane pressure per unit V at the grid's n_θ angles from the line of centres (Pa·s)
+    profiles: Vec<f64>,
+    n_theta: usize,
+    u_max: f64,
+}
+
+impl FilmTable {
+    /// The table of a plain bearing (no grooves) on `grid`, shared between all users of the same
+    /// bearing in this process: built on first use (about N_ECC × N_PSI × 2 film solves, on all
+    /// cores), then reused.
+    pub fn shared(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+    ) -> Result<Arc<FilmTable>, FilmError> {
+        static CACHE: OnceLock<Mutex<HashMap<String, Arc<FilmTable>>>> = OnceLock::new();
+        let key = format!("{geometry:?}|{lubricant:?}|{grid:?}");
+        let cache = CACHE.get_or_init(Default::default);
+        if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+            return Ok(t.clone());
+        }
+        let table = Arc::new(Self::build(geometry, lubricant, grid)?);
+        cache
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(key, table.clone());
+        Ok(table)
+    }
+
+    /// Builds the table with the direct solver.
+    pub fn build(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+    ) -> Result<FilmTable, FilmError> {
+        if !geometry.grooves.is_empty() {
+            return Err(FilmError::InvalidParameter {
+                name: "bearing grooves (tabulated film)",
+                value: geometry.grooves.len() as f64,
+                rule: "the table is for plain bearings; grooved bearings use the direct solver",
+            });
+        }
+        let u_max = -(1.0 - MAX_ECCENTRICITY_RATIO).ln();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let rows: Vec<usize> = (0..N_ECC).collect();
+        let chunks: Vec<&[usize]> = rows.chunks(N_ECC.div_ceil(threads)).collect();
+        let n_theta = grid.n_theta;
+        let results: Vec<Result<Vec<Row>, FilmError>> = std::thread::scope(|s| {
+            let handles: Vec<_> = chunks
+                .iter()
+                .map(|chunk| {
+                    let geometry = geometry.clone();
+                    s.spawn(move || {
+                        let mut film = FiniteFilm::new(geometry.clone(), lubricant, grid)?;
+                        let mut out = Vec::new();
+                        for &i in chunk.iter() {
+                            let eps = 1.0 - (-(i as f64) * u_max / (N_ECC - 1) as f64).exp();
+                            let (nodes, profiles) =
+                                row(&mut film, &geometry, eps.min(0.9989), n_theta)?;
+                            out.push((i, nodes, profiles));
+                        }
+                        Ok(out)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("table builder thread"))
+                .collect()
+        });
+        let mut nodes = vec![Node::default(); N_ECC * N_PSI];
+        let mut profiles = vec![0.0; N_ECC * N_PSI * n_theta];
+        for part in results {
+            for (i, row_nodes, row_profiles) in part? {
+                nodes[i * N_PSI..(i + 1) * N_PSI].copy_from_slice(&row_nodes);
+                profiles[i * N_PSI * n_theta..(i + 1) * N_PSI * n_theta]
+                    .copy_from_slice(&row_profiles);
+            }
+        }
+        Ok(FilmTable {
+            geometry: geometry.clone(),
+            nodes,
+            profiles,
+            n_theta,
+            u_max,
+        })
+    }
+
+    /// Interpolation weights: (first row, first column, row weights, column weights) of the
+    /// 4 × 4 Catmull–Rom stencil at (ε, ψ).
+    fn stencil(&self, eps: f64, psi: f64) -> ([usize; 4], [usize; 4], [f64; 4], [f64; 4]) {
+        let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();
+        let fu = (u / self.u_max * (N_ECC - 1) as f64).clamp(0.0, (N_ECC - 1) as f64 - 1e-9);
+        let iu = fu.floor() as usize;
+        let fp = wrap_angle_rad(psi) / TAU * N_PSI as f64;
+        let ip = (fp.floor() as usize).min(N_PSI - 1);
+        // columns periodic; rows beyond the ends are linear extrapolations of the last two,
+        // folded into the weights of the rows that exist
+        let mut wr = catmull_rom(fu - iu as f64);
+        let rows = if iu == 0 {
+            // row −1 = 2·row 0 − row 1
+            wr = [0.0, wr[1] + 2.0 * wr[0], wr[2] - wr[0], wr[3]];
+            [0, 0, 1, 2]
+        } else if iu + 2 > N_ECC - 1 {
+            // row N = 2·row N−1 − row N−2
+            wr = [wr[0], wr[1] - wr[3], wr[2] + 2.0 * wr[3], 0.0];
+            [iu - 1, iu, iu + 1, iu + 1]
+        } else {
+            [iu - 1, iu, iu + 1, iu + 2]
+        };
+        let cols = [
+            (ip + N_PSI - 1) % N_PSI,
+            ip,
+            (ip + 1) % N_PSI,
+            (ip + 2) % N_PSI,
+        ];
+        (rows, cols, wr, catmull_rom(fp - ip as f64))
+    }
+
+    /// The interpolated node at (ε, ψ).
+    fn node_at(&self, eps: f64, psi: f64) -> Node {
+        let (rows, cols, wr, wc) = self.stencil(eps, psi);
+        let mut n = Node::default();
+        for (a, &r) in rows.iter().enumerate() {
+            for (b, &c) in cols.iter().enumerate() {
+                let w = wr[a] * wc[b];
+                let m = &self.nodes[r * N_PSI + c];
+                n.force[0] += w * m.force[0];
+                n.force[1] += w * m.force[1];
+                n.p_max += w * m.p_max;
+                for k in 0..3 {
+                    n.angles[k][0] += w * m.angles[k][0];
+                    n.angles[k][1] += w * m.angles[k][1];
+                }
+                n.torque_pressure += w * m.torque_pressure;
+                n.torque_couette += w * m.torque_couette;
+                n.side_flow += w * m.side_flow;
+                n.inflow_pressure += w * m.inflow_pressure;
+                n.inflow_couette += w * m.inflow_couette;
+            }
+        }
+        n
+    }
+
+    /// Only the force along and across the line of centres, per unit V (N·s).
+    fn force_at(&self, eps: f64, psi: f64) -> [f64; 2] {
+        let (rows, cols, wr, wc) = self.stencil(eps, psi);
+        let mut f = [0.0; 2];
+        for (a, &r) in rows.iter().enumerate() {
+            for (b, &c) in cols.iter().enumerate() {
+                let w = wr[a] * wc[b];
+                let m = &self.nodes[r * N_PSI + c];
+                f[0] += w * m.force[0];
+                f[1] += w * m.force[1];
+            }
+        }
+        f
+    }
+
+    /// The film force `[F_x, F_y]` (N) in the fixed frame for `kin` (no checks).
+    pub fn force(&self, kin: &JournalKinematics) -> [f64; 2] {
+        let s = LineOfCentres::of(kin, self.geometry.radial_clearance_m);
+        if s.v == 0.0 {
+            return [0.0, 0.0];
+        }
+        let [fr, ft] = self.force_at(s.eps, s.psi);
+        s.rotate_to_fixed([s.v * fr, s.v * ft])
+    }
+}
+
+/// The Catmull–Rom weights of the four stencil values at fraction `t` ∈ [0, 1).
+fn catmull_rom(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    ]
+}
+
+/// One row of the table (fixed ε): two direct solves at each ψ, with the journal on the grid's x
+/// axis. Solve 1 has ω = 0 and the whole source from the journal's velocity (pressure parts);
+/// solve 2 adds ω = 1 rad/s with the whirl that keeps U (the Couette parts, by difference).
+fn row(
+    film: &mut FiniteFilm,
+    geometry: &BearingGeometry,
+    eps: f64,
+    n_theta: usize,
+) -> Result<(Vec<Node>, Vec<f64>), FilmError> {
+    let c = geometry.radial_clearance_m;
+    let mut nodes = Vec::with_capacity(N_PSI);
+    let mut profiles = vec![0.0; N_PSI * n_theta];
+    for j in 0..N_PSI {
+        let psi = TAU * j as f64 / N_PSI as f64;
+        let (u, w) = (psi.cos(), psi.sin());
+        // U = ω ε − 2 v_t / c, W = 2 v_r / c, journal at (ε c, 0): v_r = ẋ, v_t = ẏ
+        let kin = |omega: f64| JournalKinematics {
+            position_m: [eps * c, 0.0],
+            velocity_m_s: [0.5 * w * c, 0.5 * (omega * eps - u) * c],
+            speed_rad_s: omega,
+        };
+        let pressure = film.solve(&kin(0.0))?;
+        film.midplane_pressure(&mut profiles[j * n_theta..(j + 1) * n_theta]);
+        let with_shear = film.solve(&kin(1.0))?;
+        let unit = |a: f64| [a.cos(), a.sin()];
+        let zone = pressure.max_pressure_pa > 0.0;
+        nodes.push(Node {
+            force: pressure.force_n,
+            p_max: pressure.max_pressure_pa,
+            angles: if zone {
+                [
+                    unit(pressure.max_pressure_angle_rad),
+                    unit(pressure.film_start_rad),
+                    unit(pressure.film_end_rad),
+                ]
+            } else {
+                [[0.0; 2]; 3]
+            },
+            torque_pressure: pressure.friction_torque_n_m,
+            torque_couette: with_shear.friction_torque_n_m - pressure.friction_torque_n_m,
+            side_flow: pressure.side_flow_m3_s,
+            inflow_pressure: pressure.inflow_m3_s,
+            inflow_couette: with_shear.inflow_m3_s - pressure.inflow_m3_s,
+        });
+    }
+    Ok((nodes, profiles))
+}
+
+/// A journal state in the frame of its line of centres.
+#[derive(Debug, Clone, Copy)]
+struct LineOfCentres {
+    eps: f64,
+    /// attitude φ (rad) and its cosine and sine
+    cos_phi: f64,
+    sin_phi: f64,
+    phi: f64,
+    /// V = √(U² + W²) (1/s) and ψ = atan2(W, U)
+    v: f64,
+    psi: f64,
+}
+
+impl LineOfCentres {
+    fn of(kin: &JournalKinematics, c: f64) -> Self {
+        let [x, y] = kin.position_m;
+        let [vx, vy] = kin.velocity_m_s;
+        let e = x.hypot(y);
+        // at the centre the frame is arbitrary: the x axis
+        let (cos_phi, sin_phi) = if e > 1e-12 * c {
+            (x / e, y / e)
+        } else {
+            (1.0, 0.0)
+        };
+        let v_r = vx * cos_phi + vy * sin_phi;
+        let v_t = -vx * sin_phi + vy * cos_phi;
+        let eps = e / c;
+        let u = kin.speed_rad_s * eps - 2.0 * v_t / c;
+        let w = 2.0 * v_r / c;
+        Self {
+            eps,
+            cos_phi,
+            sin_phi,
+            phi: sin_phi.atan2(cos_phi),
+            v: u.hypot(w),
+            psi: w.atan2(u),
+        }
+    }
+
+    fn rotate_to_fixed(&self, f: [f64; 2]) -> [f64; 2] {
+        [
+            f[0] * self.cos_phi - f[1] * self.sin_phi,
+            f[0] * self.sin_phi + f[1] * self.cos_phi,
+        ]
+    }
+}
+
+/// A film model that evaluates a [`FilmTable`] (see the module documentation).
+#[derive(Clone)]
+pub struct TabulatedFilm {
+    table: Arc<FilmTable>,
+    last: JournalKinematics,
+}
+
+impl TabulatedFilm {
+    /// A model reading `table`.
+    pub fn new(table: Arc<FilmTable>) -> Self {
+        Self {
+            table,
+            last: JournalKinematics::default(),
+        }
+    }
+}
+
+impl FilmModel for TabulatedFilm {
+    fn geometry(&self) -> &BearingGeometry {
+        &self.table.geometry
+    }
+
+    fn clone_box(&self) -> Box<dyn FilmModel + Send> {
+        Box::new(self.clone())
+    }
+
+    fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
+        let c = self.table.geometry.radial_clearance_m;
+        kin.validate(c)?;
+        self.last = *kin;
+        let s = LineOfCentres::of(kin, c);
+        let n = self.table.node_at(s.eps, s.psi);
+        let omega = kin.speed_rad_s;
+        let angle = |k: usize| wrap_angle_rad(s.phi + n.angles[k][1].atan2(n.angles[k][0]));
+        let zone = s.v > 0.0 && n.p_max > 0.0;
+        let torque = omega * n.torque_couette + s.v * n.torque_pressure;
+        Ok(FilmResult {
+            force_n: s.rotate_to_fixed([s.v * n.force[0], s.v * n.force[1]]),
+            max_pressure_pa: (s.v * n.p_max).max(0.0),
+            max_pressure_angle_rad: if zone { angle(0) } else { 0.0 },
+            film_start_rad: if zone { angle(1) } else { 0.0 },
+            film_end_rad: if zone { angle(2) } else { 0.0 },
+            friction_torque_n_m: torque,
+            power_loss_w: torque * omega,
+            side_flow_m3_s: s.v * n.side_flow,
+            inflow_m3_s: omega * n.inflow_couette + s.v * n.inflow_pressure,
+        })
+    }
+
+    fn solve_with_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let result = self.solve(kin)?;
+        let c = self.table.geometry.radial_clearance_m;
+        // central differences of the interpolant, with steps of 1e-4 c and 1e-4 c ω (at least
+        // 1e-4 c /s): small against the table's spacing (ε steps ≥ 0.04 up to ε = 0.9), so the
+        // difference follows the smooth interpolant, yet large enough that its small
+        // inconsistencies under rotation do not swamp the derivative near the centre, where the
+        // attitude angle turns fast with the position
+        let dq = 1e-4 * c;
+        let dv = 1e-4 * c * kin.speed_rad_s.abs().max(1.0);
+        let mut k = [[0.0; 2]; 2];
+        let mut d = [[0.0; 2]; 2];
+        for j in 0..2 {
+            let mut plus = *kin;
+            let mut minus = *kin;
+            plus.position_m[j] += dq;
+            minus.position_m[j] -= dq;
+            let (fp, fm) = (self.table.force(&plus), self.table.force(&minus));
+            let mut vplus = *kin;
+            let mut vminus = *kin;
+            vplus.velocity_m_s[j] += dv;
+            vminus.velocity_m_s[j] -= dv;
+            let (gp, gm) = (self.table.force(&vplus), self.table.force(&vminus));
+            for i in 0..2 {
+                k[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
+                d[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
+            }
+        }
+        Ok((
+            result,
+            FilmCoefficients {
+                stiffness_n_per_m: k,
+                damping_n_s_per_m: d,
+            },
+        ))
+    }
+
+    fn midplane_pressure(&self, out: &mut [f64]) {
+        let t = &self.table;
+        let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
+        let (rows, cols, wr, wc) = t.stencil(s.eps, s.psi);
+        let len = out.len().max(1);
+        for (k, p) in out.iter_mut().enumerate() {
+            // the grid column nearest to θ_k − φ in the frame of the line of centres
+            let theta = wrap_angle_rad(TAU * k as f64 / len as f64 - s.phi);
+            let i = ((theta / TAU * t.n_theta as f64).round() as usize) % t.n_theta;
+            let mut v = 0.0;
+            for (a, &r) in rows.iter().enumerate() {
+                for (b, &c) in cols.iter().enumerate() {
+                    v += wr[a] * wc[b] * t.profiles[(r * N_PSI + c) * t.n_theta + i];
+                }
+            }
+            *p = (s.v * v).max(0.0);
+        }
+    }
+}
