@@ -78,7 +78,8 @@ fn station<'a>(report: &'a Value, name: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no station {name} in {report}"))
 }
 
-/// A bag recorded from the twin's own model, without noise, must replay to itself: the replay
+/// A bag recorded from the twin's own model (the direct film solver), without noise, must
+/// replay to itself with that model: the replay
 /// starts at the same time with the same step, and predicts each probe sample at its own
 /// time, so any offset in time, angle or interpolation would show. Then the same bag replayed
 /// again gives the same output bag, byte for byte, and the same report.
@@ -86,7 +87,7 @@ fn station<'a>(report: &'a Value, name: &str) -> &'a Value {
 fn the_twins_own_model_replays_to_itself_and_deterministically() {
     let bag = own_model_bag("own", 0.3, 0.0);
     let out = scratch("own-out");
-    let r = replay_json(&bag, &out, &[]);
+    let r = replay_json(&bag, &out, &["--film", "direct"]);
     assert!(r["damage"].as_array().unwrap().is_empty());
     assert!(r["messages_in"].as_u64().unwrap() > 1000);
     for name in ["probe_pulley_end", "probe_outboard"] {
@@ -105,7 +106,7 @@ fn the_twins_own_model_replays_to_itself_and_deterministically() {
     assert!(r["onset"]["predicted_time_s"].is_null() && r["onset"]["observed_time_s"].is_null());
     // determinism
     let out2 = scratch("own-out2");
-    let r2 = replay_json(&bag, &out2, &[]);
+    let r2 = replay_json(&bag, &out2, &["--film", "direct"]);
     let strip = |mut v: Value| {
         v["wall_time_s"] = Value::Null;
         v["real_time_factor"] = Value::Null;
@@ -123,7 +124,7 @@ fn the_twins_own_model_replays_to_itself_and_deterministically() {
 fn probe_noise_shows_as_its_rms_in_the_orbit_distance() {
     let sigma = 0.5e-6;
     let bag = own_model_bag("noise", 0.3, sigma * 1e6);
-    let r = replay_json(&bag, &scratch("noise-out"), &["--no-bag"]);
+    let r = replay_json(&bag, &scratch("noise-out"), &["--no-bag", "--film", "direct"]);
     for name in ["probe_pulley_end", "probe_outboard"] {
         let s = station(&r, name);
         let d = s["orbit_rms_distance_m"].as_f64().unwrap();

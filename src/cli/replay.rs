@@ -44,6 +44,10 @@ pub struct ReplayArgs {
     /// Bearing coupling: nonlinear (reference), linear or prehistory.
     #[arg(long, default_value = "nonlinear")]
     pub model: String,
+    /// Film evaluation: table (tabulated finite-length solutions, interpolated; plain bearings)
+    /// or direct (the finite solver at every evaluation, the reference).
+    #[arg(long, value_enum, default_value_t = super::simulate::FilmArg::Table)]
+    pub film: super::simulate::FilmArg,
     /// Prehistory relaxation factor δ in (0, 1].
     #[arg(long, default_value_t = 0.3)]
     pub delta: f64,
@@ -163,6 +167,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let options = ReplayOptions {
         coupling,
         steps_per_rev: args.steps_per_rev,
+        film: args.film.into(),
         session: SessionSettings {
             state_rate_hz: args.state_rate_hz,
             ..SessionSettings::default()

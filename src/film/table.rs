@@ -290,10 +290,9 @@ fn row(
 #[derive(Debug, Clone, Copy)]
 struct LineOfCentres {
     eps: f64,
-    /// attitude φ (rad) and its cosine and sine
+    /// cosine and sine of the attitude φ
     cos_phi: f64,
     sin_phi: f64,
-    phi: f64,
     /// V = √(U² + W²) (1/s) and ψ = atan2(W, U)
     v: f64,
     psi: f64,
@@ -303,7 +302,7 @@ impl LineOfCentres {
     fn of(kin: &JournalKinematics, c: f64) -> Self {
         let [x, y] = kin.position_m;
         let [vx, vy] = kin.velocity_m_s;
-        let e = x.hypot(y);
+        let e = (x * x + y * y).sqrt();
         // at the centre the frame is arbitrary: the x axis
         let (cos_phi, sin_phi) = if e > 1e-12 * c {
             (x / e, y / e)
@@ -319,10 +318,14 @@ impl LineOfCentres {
             eps,
             cos_phi,
             sin_phi,
-            phi: sin_phi.atan2(cos_phi),
-            v: u.hypot(w),
+            v: (u * u + w * w).sqrt(),
             psi: w.atan2(u),
         }
+    }
+
+    /// The attitude φ (rad).
+    fn phi(&self) -> f64 {
+        self.sin_phi.atan2(self.cos_phi)
     }
 
     fn rotate_to_fixed(&self, f: [f64; 2]) -> [f64; 2] {
@@ -366,7 +369,7 @@ impl FilmModel for TabulatedFilm {
         let s = LineOfCentres::of(kin, c);
         let n = self.table.node_at(s.eps, s.psi);
         let omega = kin.speed_rad_s;
-        let angle = |k: usize| wrap_angle_rad(s.phi + n.angles[k][1].atan2(n.angles[k][0]));
+        let angle = |k: usize| wrap_angle_rad(s.phi() + n.angles[k][1].atan2(n.angles[k][0]));
         let zone = s.v > 0.0 && n.p_max > 0.0;
         let torque = omega * n.torque_couette + s.v * n.torque_pressure;
         Ok(FilmResult {
@@ -429,7 +432,7 @@ impl FilmModel for TabulatedFilm {
         let len = out.len().max(1);
         for (k, p) in out.iter_mut().enumerate() {
             // the grid column nearest to θ_k − φ in the frame of the line of centres
-            let theta = wrap_angle_rad(TAU * k as f64 / len as f64 - s.phi);
+            let theta = wrap_angle_rad(TAU * k as f64 / len as f64 - s.phi());
             let i = ((theta / TAU * t.n_theta as f64).round() as usize) % t.n_theta;
             let mut v = 0.0;
             for (a, &r) in rows.iter().enumerate() {

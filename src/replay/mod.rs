@@ -11,7 +11,7 @@ mod report;
 pub use report::{OnsetReport, ReplayReport, StateChange, StationReport};
 
 use crate::bag::{Bag, BagMessage};
-use crate::dynamics::{Coupling, StepInput, TwinConfig};
+use crate::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
 use crate::messages::{self, from_cdr, InstabilityWarning, RosMessage};
 use crate::record::{Recorder, TopicQos};
 use crate::ros::{check_probe, check_unbalance, SpeedGate, SpeedUnit};
@@ -35,6 +35,8 @@ pub struct ReplayOptions {
     pub coupling: Coupling,
     /// Time steps per revolution at rated speed.
     pub steps_per_rev: usize,
+    /// Film evaluation.
+    pub film: FilmEvaluation,
     /// Output rates and thresholds.
     pub session: SessionSettings,
     /// Below this speed (rad/s) the twin pauses.
@@ -61,6 +63,7 @@ impl Default for ReplayOptions {
         Self {
             coupling: Coupling::Nonlinear,
             steps_per_rev: 128,
+            film: FilmEvaluation::Table,
             session: SessionSettings::default(),
             min_speed_rad_s: 100.0 * std::f64::consts::PI / 30.0,
             remaps: Vec::new(),
@@ -128,11 +131,14 @@ pub fn replay(
     let wall = std::time::Instant::now();
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     let roles = map_topics(bag, options, &stations)?;
-    let config = TwinConfig::with_steps_per_rev(
-        options.coupling,
-        rotor.rated_speed_rad_s,
-        options.steps_per_rev,
-    );
+    let config = TwinConfig {
+        film: options.film,
+        ..TwinConfig::with_steps_per_rev(
+            options.coupling,
+            rotor.rated_speed_rad_s,
+            options.steps_per_rev,
+        )
+    };
     let clearance = rotor
         .bearings
         .iter()

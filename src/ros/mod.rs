@@ -179,6 +179,7 @@ async fn run_async(
     for (name, value) in [
         ("model", ParameterValue::String(params.model.clone())),
         ("delta", ParameterValue::Double(params.delta)),
+        ("film", ParameterValue::String(params.film.clone())),
         (
             "steps_per_rev",
             ParameterValue::Integer(params.steps_per_rev as i64),

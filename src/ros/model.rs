@@ -3,7 +3,7 @@
 //! it falls behind it says so.
 
 use super::params::NodeParams;
-use crate::dynamics::{Coupling, StepInput, TwinConfig};
+use crate::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
@@ -81,7 +81,14 @@ pub fn run(
         _ => Coupling::Nonlinear,
     };
     let rated = rotor.rated_speed_rad_s;
-    let config = TwinConfig::with_steps_per_rev(coupling, rated, params.steps_per_rev);
+    let config = TwinConfig {
+        film: if params.film == "direct" {
+            FilmEvaluation::Direct
+        } else {
+            FilmEvaluation::Table
+        },
+        ..TwinConfig::with_steps_per_rev(coupling, rated, params.steps_per_rev)
+    };
     let h = config.time_step_s;
     let mut min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
     let mut seen_version = 0u64;

@@ -33,6 +33,9 @@ pub struct NodeParams {
     pub model: String,
     /// `delta`: prehistory relaxation factor δ in (0, 1].
     pub delta: f64,
+    /// `film`: table (the finite-length solutions tabulated and interpolated, fast enough for
+    /// real time) | direct (the finite solver at every evaluation, the reference).
+    pub film: String,
     /// `steps_per_rev`: time steps per revolution at rated speed.
     pub steps_per_rev: usize,
     /// `state_rate_hz`: rate of journal and film states (Hz), decimated from the step rate.
@@ -60,6 +63,7 @@ impl Default for NodeParams {
         Self {
             model: "nonlinear".into(),
             delta: 0.5,
+            film: "table".into(),
             steps_per_rev: 128,
             state_rate_hz: 200.0,
             pressure_map_rate_hz: 2.0,
@@ -98,6 +102,10 @@ impl NodeParams {
                         "parameter model: '{value}' must be linear, nonlinear or prehistory"
                     ))
                 }
+            },
+            "film" => match value {
+                "table" | "direct" => self.film = value.into(),
+                _ => return Err(format!("parameter film: '{value}' must be table or direct")),
             },
             "delta" => {
                 let d = num(value)?;
