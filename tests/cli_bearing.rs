@@ -89,8 +89,8 @@ fn models_grooves_and_eccentricity_mode() {
 }
 
 #[test]
-fn default_run_prints_a_table() {
-    let (ok, out, _) = run_cli(&[]);
+fn default_bearing_run_prints_a_table() {
+    let (ok, out, _) = run_cli(&["bearing"]);
     assert!(ok);
     assert!(out.contains("eccentricity ratio") && out.contains("stiffness k (N/m)"));
 }

@@ -124,7 +124,11 @@ fn the_twins_own_model_replays_to_itself_and_deterministically() {
 fn probe_noise_shows_as_its_rms_in_the_orbit_distance() {
     let sigma = 0.5e-6;
     let bag = own_model_bag("noise", 0.3, sigma * 1e6);
-    let r = replay_json(&bag, &scratch("noise-out"), &["--no-bag", "--film", "direct"]);
+    let r = replay_json(
+        &bag,
+        &scratch("noise-out"),
+        &["--no-bag", "--film", "direct"],
+    );
     for name in ["probe_pulley_end", "probe_outboard"] {
         let s = station(&r, name);
         let d = s["orbit_rms_distance_m"].as_f64().unwrap();
@@ -249,6 +253,28 @@ fn a_rosbags_bag_in_standard_types_replays_with_remaps() {
         rosbags["counts"]["/rotor_twin/speed"],
         counts["/plant/speed_rpm"]
     );
+}
+
+/// The shipped sample bag (the main job's input) is readable, says it is synthetic, and its
+/// first second replays at 8,000 rpm with both probe stations compared.
+#[test]
+fn the_shipped_sample_bag_replays() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let bag = root.join("bags/orc_runup_synthetic");
+    let meta = std::fs::read_to_string(bag.join("metadata.yaml")).unwrap();
+    assert!(meta.contains("\"synthetic\": \"true\""), "{meta}");
+    let r = replay_json(
+        &bag,
+        &scratch("sample-out"),
+        &["--duration", "1", "--no-bag"],
+    );
+    assert!(r["damage"].as_array().unwrap().is_empty());
+    for name in ["probe_pulley_end", "probe_outboard"] {
+        let s = station(&r, name);
+        assert!(s["samples"].as_u64().unwrap() > 1000);
+        let speed = s["window_speed_rpm"].as_f64().unwrap();
+        assert!((8000.0..8200.0).contains(&speed), "{speed} rpm");
+    }
 }
 
 /// A bag cut off part-way replays what comes before the cut, and says where it is damaged.

@@ -52,6 +52,19 @@ pub enum FilmEvaluation {
     Table,
 }
 
+/// Builds (or finds) the film tables of every plain finite-film bearing of `rotor`, so that a
+/// twin with [`FilmEvaluation::Table`] starts without delay.
+pub fn prepare_film_tables(rotor: &crate::rotor::Rotor) -> Result<(), crate::film::FilmError> {
+    for b in &rotor.bearings {
+        if let crate::rotor::BearingModel::Film(f) = &b.model {
+            if !f.short && f.geometry.grooves.is_empty() {
+                crate::film::FilmTable::shared(&f.geometry, f.lubricant, f.grid)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Settings of the twin core.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwinConfig {

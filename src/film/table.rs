@@ -148,6 +148,12 @@ impl FilmTable {
     /// Interpolation weights: (first row, first column, row weights, column weights) of the
     /// 4 × 4 Catmull–Rom stencil at (ε, ψ).
     fn stencil(&self, eps: f64, psi: f64) -> ([usize; 4], [usize; 4], [f64; 4], [f64; 4]) {
+        let s = self.stencil_with_slopes(eps, psi);
+        (s.rows, s.cols, s.wr, s.wc)
+    }
+
+    /// The stencil at (ε, ψ) with the weights' derivatives d/dε and d/dψ.
+    fn stencil_with_slopes(&self, eps: f64, psi: f64) -> Stencil {
         let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();
         let fu = (u / self.u_max * (N_ECC - 1) as f64).clamp(0.0, (N_ECC - 1) as f64 - 1e-9);
         let iu = fu.floor() as usize;
@@ -155,14 +161,20 @@ impl FilmTable {
         let ip = (fp.floor() as usize).min(N_PSI - 1);
         // columns periodic; rows beyond the ends are linear extrapolations of the last two,
         // folded into the weights of the rows that exist
-        let mut wr = catmull_rom(fu - iu as f64);
+        let fold = |w: [f64; 4]| -> [f64; 4] {
+            if iu == 0 {
+                // row −1 = 2·row 0 − row 1
+                [0.0, w[1] + 2.0 * w[0], w[2] - w[0], w[3]]
+            } else if iu + 2 > N_ECC - 1 {
+                // row N = 2·row N−1 − row N−2
+                [w[0], w[1] - w[3], w[2] + 2.0 * w[3], 0.0]
+            } else {
+                w
+            }
+        };
         let rows = if iu == 0 {
-            // row −1 = 2·row 0 − row 1
-            wr = [0.0, wr[1] + 2.0 * wr[0], wr[2] - wr[0], wr[3]];
             [0, 0, 1, 2]
         } else if iu + 2 > N_ECC - 1 {
-            // row N = 2·row N−1 − row N−2
-            wr = [wr[0], wr[1] - wr[3], wr[2] + 2.0 * wr[3], 0.0];
             [iu - 1, iu, iu + 1, iu + 1]
         } else {
             [iu - 1, iu, iu + 1, iu + 2]
@@ -173,7 +185,40 @@ impl FilmTable {
             (ip + 1) % N_PSI,
             (ip + 2) % N_PSI,
         ];
-        (rows, cols, wr, catmull_rom(fp - ip as f64))
+        let (tu, tp) = (fu - iu as f64, fp - ip as f64);
+        // d(fu)/dε = (N_ECC − 1)/u_max · 1/(1 − ε); d(fp)/dψ = N_PSI/2π
+        let dfu = (N_ECC - 1) as f64 / self.u_max / (1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO));
+        let dfp = N_PSI as f64 / TAU;
+        Stencil {
+            rows,
+            cols,
+            wr: fold(catmull_rom(tu)),
+            wc: catmull_rom(tp),
+            dwr: fold(catmull_rom_slope(tu)).map(|w| w * dfu),
+            dwc: catmull_rom_slope(tp).map(|w| w * dfp),
+        }
+    }
+
+    /// The force along and across the line of centres per unit V (N·s) at (ε, ψ), and its
+    /// derivatives with respect to ε and ψ (those of the interpolant).
+    fn force_with_slopes(&self, eps: f64, psi: f64) -> [[f64; 2]; 3] {
+        let st = self.stencil_with_slopes(eps, psi);
+        let mut out = [[0.0; 2]; 3];
+        for a in 0..4 {
+            for b in 0..4 {
+                let m = &self.nodes[st.rows[a] * N_PSI + st.cols[b]];
+                let w = [
+                    st.wr[a] * st.wc[b],
+                    st.dwr[a] * st.wc[b],
+                    st.wr[a] * st.dwc[b],
+                ];
+                for (o, wk) in out.iter_mut().zip(w) {
+                    o[0] += wk * m.force[0];
+                    o[1] += wk * m.force[1];
+                }
+            }
+        }
+        out
     }
 
     /// The interpolated node at (ε, ψ).
@@ -225,6 +270,107 @@ impl FilmTable {
         let [fr, ft] = self.force_at(s.eps, s.psi);
         s.rotate_to_fixed([s.v * fr, s.v * ft])
     }
+}
+
+impl FilmTable {
+    /// −∂F/∂(x, y) and −∂F/∂(ẋ, ẏ) of the interpolant by the chain rule through the line of
+    /// centres: F = R(φ) V f(ε, ψ), with U = ω ε − 2 v_t / c, W = 2 v_r / c, V = √(U² + W²),
+    /// ψ = atan2(W, U). Away from the centre (ε > 10⁻³) only.
+    fn analytic_coefficients(
+        &self,
+        kin: &JournalKinematics,
+        s: &LineOfCentres,
+    ) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+        let c = self.geometry.radial_clearance_m;
+        let (cp, sp) = (s.cos_phi, s.sin_phi);
+        let e = s.eps * c;
+        let [vx, vy] = kin.velocity_m_s;
+        let v_r = vx * cp + vy * sp;
+        let v_t = -vx * sp + vy * cp;
+        let omega = kin.speed_rad_s;
+        let (u, w) = (omega * s.eps - 2.0 * v_t / c, 2.0 * v_r / c);
+        let [f, f_eps, f_psi] = self.force_with_slopes(s.eps, s.psi);
+        let g = [s.v * f[0], s.v * f[1]];
+        // per variable x, y, ẋ, ẏ: derivatives of ε, φ, v_r, v_t
+        let eps_q = [cp / c, sp / c, 0.0, 0.0];
+        let phi_q = [-sp / e, cp / e, 0.0, 0.0];
+        let vr_q = [v_t * phi_q[0], v_t * phi_q[1], cp, sp];
+        let vt_q = [-v_r * phi_q[0], -v_r * phi_q[1], -sp, cp];
+        let mut dfdq = [[0.0; 2]; 4];
+        for q in 0..4 {
+            let u_q = omega * eps_q[q] - 2.0 * vt_q[q] / c;
+            let w_q = 2.0 * vr_q[q] / c;
+            let v_q = (u * u_q + w * w_q) / s.v;
+            let psi_q = (u * w_q - w * u_q) / (s.v * s.v);
+            // dg/dq + J g φ_q, J = [[0, −1], [1, 0]] (the turn of the frame), then back to x, y
+            let local = [
+                v_q * f[0] + s.v * (f_eps[0] * eps_q[q] + f_psi[0] * psi_q) - g[1] * phi_q[q],
+                v_q * f[1] + s.v * (f_eps[1] * eps_q[q] + f_psi[1] * psi_q) + g[0] * phi_q[q],
+            ];
+            dfdq[q] = s.rotate_to_fixed(local);
+        }
+        let mut k = [[0.0; 2]; 2];
+        let mut d = [[0.0; 2]; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                k[i][j] = -dfdq[j][i];
+                d[i][j] = -dfdq[2 + j][i];
+            }
+        }
+        (k, d)
+    }
+
+    /// The same by central differences of the interpolant (near the centre, where the attitude
+    /// turns fast with the position): steps of 1e-4 c and 1e-4 c ω (at least 1e-4 c /s), small
+    /// against the table's spacing, large enough that the interpolant's small inconsistencies
+    /// under rotation do not swamp the derivative.
+    fn difference_coefficients(&self, kin: &JournalKinematics) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+        let c = self.geometry.radial_clearance_m;
+        let dq = 1e-4 * c;
+        let dv = 1e-4 * c * kin.speed_rad_s.abs().max(1.0);
+        let mut k = [[0.0; 2]; 2];
+        let mut d = [[0.0; 2]; 2];
+        for j in 0..2 {
+            let mut plus = *kin;
+            let mut minus = *kin;
+            plus.position_m[j] += dq;
+            minus.position_m[j] -= dq;
+            let (fp, fm) = (self.force(&plus), self.force(&minus));
+            let mut vplus = *kin;
+            let mut vminus = *kin;
+            vplus.velocity_m_s[j] += dv;
+            vminus.velocity_m_s[j] -= dv;
+            let (gp, gm) = (self.force(&vplus), self.force(&vminus));
+            for i in 0..2 {
+                k[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
+                d[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
+            }
+        }
+        (k, d)
+    }
+}
+
+/// Rows and columns of a 4 × 4 interpolation stencil, the weights and their derivatives.
+struct Stencil {
+    rows: [usize; 4],
+    cols: [usize; 4],
+    wr: [f64; 4],
+    wc: [f64; 4],
+    /// d wr / dε
+    dwr: [f64; 4],
+    /// d wc / dψ
+    dwc: [f64; 4],
+}
+
+/// The derivatives of the Catmull–Rom weights with respect to `t`.
+fn catmull_rom_slope(t: f64) -> [f64; 4] {
+    let t2 = t * t;
+    [
+        0.5 * (-3.0 * t2 + 4.0 * t - 1.0),
+        0.5 * (9.0 * t2 - 10.0 * t),
+        0.5 * (-9.0 * t2 + 8.0 * t + 1.0),
+        0.5 * (3.0 * t2 - 2.0 * t),
+    ]
 }
 
 /// The Catmull–Rom weights of the four stencil values at fraction `t` ∈ [0, 1).
@@ -391,31 +537,12 @@ impl FilmModel for TabulatedFilm {
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
         let result = self.solve(kin)?;
         let c = self.table.geometry.radial_clearance_m;
-        // central differences of the interpolant, with steps of 1e-4 c and 1e-4 c ω (at least
-        // 1e-4 c /s): small against the table's spacing (ε steps ≥ 0.04 up to ε = 0.9), so the
-        // difference follows the smooth interpolant, yet large enough that its small
-        // inconsistencies under rotation do not swamp the derivative near the centre, where the
-        // attitude angle turns fast with the position
-        let dq = 1e-4 * c;
-        let dv = 1e-4 * c * kin.speed_rad_s.abs().max(1.0);
-        let mut k = [[0.0; 2]; 2];
-        let mut d = [[0.0; 2]; 2];
-        for j in 0..2 {
-            let mut plus = *kin;
-            let mut minus = *kin;
-            plus.position_m[j] += dq;
-            minus.position_m[j] -= dq;
-            let (fp, fm) = (self.table.force(&plus), self.table.force(&minus));
-            let mut vplus = *kin;
-            let mut vminus = *kin;
-            vplus.velocity_m_s[j] += dv;
-            vminus.velocity_m_s[j] -= dv;
-            let (gp, gm) = (self.table.force(&vplus), self.table.force(&vminus));
-            for i in 0..2 {
-                k[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
-                d[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
-            }
-        }
+        let s = LineOfCentres::of(kin, c);
+        let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
+            self.table.analytic_coefficients(kin, &s)
+        } else {
+            self.table.difference_coefficients(kin)
+        };
         Ok((
             result,
             FilmCoefficients {
@@ -441,6 +568,70 @@ impl FilmModel for TabulatedFilm {
                 }
             }
             *p = (s.v * v).max(0.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The chain-rule coefficients of the interpolant equal its central differences (steps
+    /// 1e-6 c, 1e-6 c ω) to 1e-4 of the matrix scale, at states across the table.
+    #[test]
+    fn analytic_coefficients_match_differences_of_the_interpolant() {
+        let geometry = BearingGeometry::plain(0.06, 0.03, 40e-6).unwrap();
+        let lubricant = Lubricant::new(900.0, 0.0008).unwrap();
+        let table =
+            FilmTable::shared(&geometry, lubricant, FilmGrid::new(60, 10).unwrap()).unwrap();
+        let c = 40e-6;
+        let w = 942.0;
+        for (eps, phi, vr, vt) in [
+            (0.3, 0.4, 0.01, -0.02),
+            (0.6, 2.0, -0.05, 0.1),
+            (0.85, 4.0, 0.2, 0.05),
+            (0.95, 5.5, -0.1, -0.2),
+            (0.05, 1.0, 0.0, 0.0),
+        ] {
+            let (vr, vt) = (vr * c * w, vt * c * w);
+            let kin = JournalKinematics {
+                position_m: [eps * c * f64::cos(phi), eps * c * f64::sin(phi)],
+                velocity_m_s: [
+                    vr * f64::cos(phi) - vt * f64::sin(phi),
+                    vr * f64::sin(phi) + vt * f64::cos(phi),
+                ],
+                speed_rad_s: w,
+            };
+            let s = LineOfCentres::of(&kin, c);
+            let (ka, da) = table.analytic_coefficients(&kin, &s);
+            // fine central differences (not the coarse fallback's steps)
+            let (dq, dv) = (1e-6 * c, 1e-6 * c * w);
+            for j in 0..2 {
+                let (mut p, mut m) = (kin, kin);
+                p.position_m[j] += dq;
+                m.position_m[j] -= dq;
+                let (fp, fm) = (table.force(&p), table.force(&m));
+                let (mut pv, mut mv) = (kin, kin);
+                pv.velocity_m_s[j] += dv;
+                mv.velocity_m_s[j] -= dv;
+                let (gp, gm) = (table.force(&pv), table.force(&mv));
+                let kscale = ka.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+                let dscale = da.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+                for i in 0..2 {
+                    let kf = -(fp[i] - fm[i]) / (2.0 * dq);
+                    let df = -(gp[i] - gm[i]) / (2.0 * dv);
+                    assert!(
+                        (ka[i][j] - kf).abs() < 1e-4 * kscale,
+                        "ε {eps}: k[{i}][{j}] {} vs {kf}",
+                        ka[i][j]
+                    );
+                    assert!(
+                        (da[i][j] - df).abs() < 1e-4 * dscale,
+                        "ε {eps}: c[{i}][{j}] {} vs {df}",
+                        da[i][j]
+                    );
+                }
+            }
         }
     }
 }

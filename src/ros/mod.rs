@@ -117,6 +117,12 @@ pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
         None => MachineDescription::builtin_default(),
     };
     let rotor = Rotor::from_description(&desc);
+    if params.film == "table" && params.model != "linear" {
+        // the film tables are built before the node joins the bus, so that the first speed
+        // starts the twin at once
+        eprintln!("rotor_twin: tabulating the bearing films…");
+        crate::dynamics::prepare_film_tables(&rotor)?;
+    }
     let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
         Ok(v) if !v.trim().is_empty() => v
             .trim()

@@ -21,6 +21,18 @@ struct State {
     qdd: Vec<f64>,
 }
 
+impl State {
+    /// Becomes a copy of `other` in place (same sizes: no allocation).
+    fn copy_from(&mut self, other: &State) {
+        self.time_s = other.time_s;
+        self.angle_rad = other.angle_rad;
+        self.speed_rad_s = other.speed_rad_s;
+        self.q.copy_from_slice(&other.q);
+        self.qd.copy_from_slice(&other.qd);
+        self.qdd.copy_from_slice(&other.qdd);
+    }
+}
+
 /// A saved twin state: restoring it makes the following steps repeat exactly.
 pub struct Checkpoint {
     state: State,
@@ -59,6 +71,8 @@ pub struct Twin {
     tmp: Vec<f64>,
     q_lin: Vec<f64>,
     next: State,
+    /// the state before a step, for retries
+    saved: State,
     qb: Vec<f64>,
     a_b: Vec<f64>,
     f_b: Vec<f64>,

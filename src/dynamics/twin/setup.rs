@@ -77,9 +77,10 @@ impl Twin {
                     clearance_m: f.geometry.radial_clearance_m,
                     radius_m: f.geometry.radius_m(),
                     viscosity_pa_s: f.lubricant.viscosity_pa_s,
-                    film: match config.film {
-                        FilmEvaluation::Direct => f.solver(),
-                        FilmEvaluation::Table => f
+                    // the linear coupling evaluates films only to re-linearise: direct
+                    film: match (config.film, config.coupling) {
+                        (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.solver(),
+                        (FilmEvaluation::Table, _) => f
                             .tabulated_solver()
                             .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", b.name)))?,
                     },
@@ -223,6 +224,7 @@ impl Twin {
             factors,
             probes,
             next: state.clone(),
+            saved: state.clone(),
             state,
             rated_speed_rad_s: rotor.rated_speed_rad_s,
             rhs: vec![0.0; n],

@@ -33,7 +33,8 @@ impl Twin {
         self.fallbacks = 0;
         for level in 0..3 {
             let substeps = 1usize << level;
-            let saved = self.state.clone();
+            // the state to return to if the step must be retried (scratch reused: no allocation)
+            self.saved.copy_from(&self.state);
             let mut ok = true;
             for s in 1..=substeps {
                 let speed =
@@ -41,7 +42,7 @@ impl Twin {
                 match self.advance(level, speed, input.accel_rad_s2) {
                     Ok(it) => iterations += it,
                     Err(Some(e)) => {
-                        self.state = saved;
+                        self.state.copy_from(&self.saved);
                         return Err(e);
                     }
                     Err(None) => {
@@ -54,7 +55,7 @@ impl Twin {
                 self.fill_output(iterations, substeps);
                 return Ok(&self.output);
             }
-            self.state = saved;
+            self.state.copy_from(&self.saved);
         }
         Err(TwinError::NotConverged {
             time_s: self.state.time_s,
