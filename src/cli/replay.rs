@@ -54,8 +54,9 @@ pub struct ReplayArgs {
     /// Time steps per revolution at rated speed.
     #[arg(long, default_value_t = 128)]
     pub steps_per_rev: usize,
-    /// Journal and film states per second of bag time in the output bag (Hz).
-    #[arg(long, default_value_t = 1000.0)]
+    /// Journal and film states per second of bag time in the output bag (Hz; the node's
+    /// default too).
+    #[arg(long, default_value_t = 200.0)]
     pub state_rate_hz: f64,
     /// Replay only the first this many seconds of the bag.
     #[arg(long)]

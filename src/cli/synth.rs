@@ -58,6 +58,10 @@ pub struct SynthArgs {
     /// The plant's film grid over the machine description's, in each direction (1: the twin's).
     #[arg(long, default_value_t = 1.5)]
     pub grid_factor: f64,
+    /// The plant's film evaluation: direct (the reference, the default) or table (fast, for long
+    /// bags such as benchmarks).
+    #[arg(long, value_enum, default_value_t = super::simulate::FilmArg::Direct)]
+    pub film: super::simulate::FilmArg,
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -117,7 +121,10 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         }
     };
     let total = args.hold_start + args.ramp + args.hold_end;
-    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, plant.rated_speed_rad_s, 128);
+    let config = TwinConfig {
+        film: args.film.into(),
+        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, plant.rated_speed_rad_s, 128)
+    };
     let w0 = args.from_rpm * PI / 30.0;
     let mut session = Session::new(&plant, config, w0, SessionSettings::default(), EPOCH_NS)
         .context("starting the plant model")?;
@@ -126,8 +133,9 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     rec.set_custom_data(
         "made_by",
         &format!(
-            "rotor-twin synth-bag {} (nonlinear film, plant = machine '{}' with film grid ×{} and viscosity ×{}; {} samples/rev; noise {} µm RMS; seed {})",
+            "rotor-twin synth-bag {} (nonlinear film, {:?} evaluation, plant = machine '{}' with film grid ×{} and viscosity ×{}; {} samples/rev; noise {} µm RMS; seed {})",
             env!("CARGO_PKG_VERSION"),
+            args.film,
             twin_rotor.name,
             args.grid_factor,
             args.viscosity_factor,

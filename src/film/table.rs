@@ -557,17 +557,30 @@ impl FilmModel for TabulatedFilm {
         let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
         let (rows, cols, wr, wc) = t.stencil(s.eps, s.psi);
         let len = out.len().max(1);
-        for (k, p) in out.iter_mut().enumerate() {
-            // the grid column nearest to θ_k − φ in the frame of the line of centres
-            let theta = wrap_angle_rad(TAU * k as f64 / len as f64 - s.phi());
-            let i = ((theta / TAU * t.n_theta as f64).round() as usize) % t.n_theta;
-            let mut v = 0.0;
-            for (a, &r) in rows.iter().enumerate() {
-                for (b, &c) in cols.iter().enumerate() {
-                    v += wr[a] * wc[b] * t.profiles[(r * N_PSI + c) * t.n_theta + i];
+        // the grid column nearest to θ_k − φ in the frame of the line of centres, for the first
+        // 256 output angles kept on the stack (beyond them, computed again for each node)
+        let shift = s.phi() / TAU * t.n_theta as f64;
+        let scale = t.n_theta as f64 / len as f64;
+        let nt = t.n_theta as i64;
+        let column = |k: usize| ((k as f64 * scale - shift).round() as i64).rem_euclid(nt) as usize;
+        let mut columns = [0usize; 256];
+        for (k, col) in columns.iter_mut().enumerate().take(len) {
+            *col = column(k);
+        }
+        let column = |k: usize| if k < 256 { columns[k] } else { column(k) };
+        out.fill(0.0);
+        // node by node, so that each node's profile is read in one sweep
+        for (a, &r) in rows.iter().enumerate() {
+            for (b, &c) in cols.iter().enumerate() {
+                let w = wr[a] * wc[b];
+                let profile = &t.profiles[(r * N_PSI + c) * t.n_theta..][..t.n_theta];
+                for (k, p) in out.iter_mut().enumerate() {
+                    *p += w * profile[column(k)];
                 }
             }
-            *p = (s.v * v).max(0.0);
+        }
+        for p in out.iter_mut() {
+            *p = (s.v * *p).max(0.0);
         }
     }
 }
