@@ -202,7 +202,30 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
                 .map(|(r, c)| r.force_n[0] + c.stiffness_n_per_m[0][0])
         },
     )?;
-    Ok(vec![cold, warm, warm_same, coefficients])
+    // the same film tabulated (built before timing): interpolation and chain-rule coefficients
+    let table = crate::film::FilmTable::shared(film.geometry(), lubricant, args.grid)?;
+    let mut tabulated = crate::film::TabulatedFilm::new(table);
+    let mut times = Vec::with_capacity(1 << 20);
+    let start = Instant::now();
+    let mut k = 0usize;
+    while start.elapsed() < budget && times.len() < (1 << 20) {
+        let q = if k % 2 == 0 { moved } else { q0 };
+        let t = Instant::now();
+        let (r, c) = tabulated.solve_with_coefficients(&at(q))?;
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+        black_box(r.force_n[0] + c.stiffness_n_per_m[0][0]);
+        k += 1;
+    }
+    times.sort_by(f64::total_cmp);
+    let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    let table_case = CaseFigures {
+        case: "tabulated film + 8 coefficients, after a 1 % c move",
+        samples: times.len(),
+        median_us: pick(0.5),
+        p99_us: pick(0.99),
+        mean_active_set_passes: 0.0,
+    };
+    Ok(vec![cold, warm, warm_same, coefficients, table_case])
 }
 
 fn measure(
