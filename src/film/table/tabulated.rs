@@ -1,0 +1,178 @@
+//! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
+//! interpolated, the eight coefficients by the chain rule.
+
+use super::{FilmTable, LineOfCentres, N_PSI};
+use crate::film::{
+    wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
+    JournalKinematics,
+};
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// A film model that evaluates a [`FilmTable`] (see the module documentation).
+#[derive(Clone)]
+pub struct TabulatedFilm {
+    table: Arc<FilmTable>,
+    last: JournalKinematics,
+}
+
+impl TabulatedFilm {
+    /// A model reading `table`.
+    pub fn new(table: Arc<FilmTable>) -> Self {
+        Self {
+            table,
+            last: JournalKinematics::default(),
+        }
+    }
+}
+
+impl FilmModel for TabulatedFilm {
+    fn geometry(&self) -> &BearingGeometry {
+        &self.table.geometry
+    }
+
+    fn clone_box(&self) -> Box<dyn FilmModel + Send> {
+        Box::new(self.clone())
+    }
+
+    fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
+        let c = self.table.geometry.radial_clearance_m;
+        kin.validate(c)?;
+        self.last = *kin;
+        let s = LineOfCentres::of(kin, c);
+        let n = self.table.node_at(s.eps, s.psi);
+        let omega = kin.speed_rad_s;
+        let angle = |k: usize| wrap_angle_rad(s.phi() + n.angles[k][1].atan2(n.angles[k][0]));
+        let zone = s.v > 0.0 && n.p_max > 0.0;
+        let torque = omega * n.torque_couette + s.v * n.torque_pressure;
+        Ok(FilmResult {
+            force_n: s.rotate_to_fixed([s.v * n.force[0], s.v * n.force[1]]),
+            max_pressure_pa: (s.v * n.p_max).max(0.0),
+            max_pressure_angle_rad: if zone { angle(0) } else { 0.0 },
+            film_start_rad: if zone { angle(1) } else { 0.0 },
+            film_end_rad: if zone { angle(2) } else { 0.0 },
+            friction_torque_n_m: torque,
+            power_loss_w: torque * omega,
+            side_flow_m3_s: s.v * n.side_flow,
+            inflow_m3_s: omega * n.inflow_couette + s.v * n.inflow_pressure,
+        })
+    }
+
+    fn solve_with_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let result = self.solve(kin)?;
+        let c = self.table.geometry.radial_clearance_m;
+        let s = LineOfCentres::of(kin, c);
+        let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
+            self.table.analytic_coefficients(kin, &s)
+        } else {
+            self.table.difference_coefficients(kin)
+        };
+        Ok((
+            result,
+            FilmCoefficients {
+                stiffness_n_per_m: k,
+                damping_n_s_per_m: d,
+            },
+        ))
+    }
+
+    fn midplane_pressure(&self, out: &mut [f64]) {
+        let t = &self.table;
+        let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
+        let (rows, cols, wr, wc) = t.stencil(s.eps, s.psi);
+        let len = out.len().max(1);
+        // the grid column nearest to θ_k − φ in the frame of the line of centres, for the first
+        // 256 output angles kept on the stack (beyond them, computed again for each node)
+        let shift = s.phi() / TAU * t.n_theta as f64;
+        let scale = t.n_theta as f64 / len as f64;
+        let nt = t.n_theta as i64;
+        let column = |k: usize| ((k as f64 * scale - shift).round() as i64).rem_euclid(nt) as usize;
+        let mut columns = [0usize; 256];
+        for (k, col) in columns.iter_mut().enumerate().take(len) {
+            *col = column(k);
+        }
+        let column = |k: usize| if k < 256 { columns[k] } else { column(k) };
+        out.fill(0.0);
+        // node by node, so that each node's profile is read in one sweep
+        for (a, &r) in rows.iter().enumerate() {
+            for (b, &c) in cols.iter().enumerate() {
+                let w = wr[a] * wc[b];
+                let profile = &t.profiles[(r * N_PSI + c) * t.n_theta..][..t.n_theta];
+                for (k, p) in out.iter_mut().enumerate() {
+                    *p += w * profile[column(k)];
+                }
+            }
+        }
+        for p in out.iter_mut() {
+            *p = (s.v * *p).max(0.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::{FilmGrid, Lubricant};
+
+    /// The chain-rule coefficients of the interpolant equal its central differences (steps
+    /// 1e-6 c, 1e-6 c ω) to 1e-4 of the matrix scale, at states across the table.
+    #[test]
+    fn analytic_coefficients_match_differences_of_the_interpolant() {
+        let geometry = BearingGeometry::plain(0.06, 0.03, 40e-6).unwrap();
+        let lubricant = Lubricant::new(900.0, 0.0008).unwrap();
+        let table =
+            FilmTable::shared(&geometry, lubricant, FilmGrid::new(60, 10).unwrap()).unwrap();
+        let c = 40e-6;
+        let w = 942.0;
+        for (eps, phi, vr, vt) in [
+            (0.3, 0.4, 0.01, -0.02),
+            (0.6, 2.0, -0.05, 0.1),
+            (0.85, 4.0, 0.2, 0.05),
+            (0.95, 5.5, -0.1, -0.2),
+            (0.05, 1.0, 0.0, 0.0),
+        ] {
+            let (vr, vt) = (vr * c * w, vt * c * w);
+            let kin = JournalKinematics {
+                position_m: [eps * c * f64::cos(phi), eps * c * f64::sin(phi)],
+                velocity_m_s: [
+                    vr * f64::cos(phi) - vt * f64::sin(phi),
+                    vr * f64::sin(phi) + vt * f64::cos(phi),
+                ],
+                speed_rad_s: w,
+            };
+            let s = LineOfCentres::of(&kin, c);
+            let (ka, da) = table.analytic_coefficients(&kin, &s);
+            // fine central differences (not the coarse fallback's steps)
+            let (dq, dv) = (1e-6 * c, 1e-6 * c * w);
+            for j in 0..2 {
+                let (mut p, mut m) = (kin, kin);
+                p.position_m[j] += dq;
+                m.position_m[j] -= dq;
+                let (fp, fm) = (table.force(&p), table.force(&m));
+                let (mut pv, mut mv) = (kin, kin);
+                pv.velocity_m_s[j] += dv;
+                mv.velocity_m_s[j] -= dv;
+                let (gp, gm) = (table.force(&pv), table.force(&mv));
+                let kscale = ka.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+                let dscale = da.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+                for i in 0..2 {
+                    let kf = -(fp[i] - fm[i]) / (2.0 * dq);
+                    let df = -(gp[i] - gm[i]) / (2.0 * dv);
+                    assert!(
+                        (ka[i][j] - kf).abs() < 1e-4 * kscale,
+                        "ε {eps}: k[{i}][{j}] {} vs {kf}",
+                        ka[i][j]
+                    );
+                    assert!(
+                        (da[i][j] - df).abs() < 1e-4 * dscale,
+                        "ε {eps}: c[{i}][{j}] {} vs {df}",
+                        da[i][j]
+                    );
+                }
+            }
+        }
+    }
+}
