@@ -17,23 +17,25 @@
 mod inputs;
 mod model;
 mod params;
+mod recording;
 
 pub use inputs::{check_probe, check_unbalance, SpeedGate};
 pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit, RUNTIME_PARAMETERS};
 
 use crate::messages::{self, RosMessage};
-use crate::record::{Recorder, TopicQos};
+use crate::record::TopicQos;
 use crate::rotor::{MachineDescription, Rotor};
 use anyhow::Context as _;
 use futures::StreamExt;
 use model::{now_ns, Inputs, Outgoing};
+use recording::ToRecord;
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, ParameterValue,
 };
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Everything `rotor-twin node` needs.
 #[derive(Debug, Clone)]
@@ -94,15 +96,6 @@ fn type_name<T: RosMessage>() -> MessageTypeName {
     let pkg = parts.next().unwrap_or_default();
     let ty = parts.next_back().unwrap_or_default();
     MessageTypeName::new(pkg, ty)
-}
-
-/// A record request for the recorder thread.
-enum ToRecord {
-    Out(Outgoing, i64),
-    Speed(messages::RotorSpeed, i64),
-    Speed64(messages::Float64, i64),
-    Unbalance(messages::Unbalance, i64),
-    Probe(messages::ProbeDisplacement, i64),
 }
 
 /// Runs the node until SIGINT or SIGTERM.
@@ -256,65 +249,17 @@ async fn run_async(
     let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
     let stop = Arc::new(AtomicBool::new(false));
     let recorder_thread = match &setup.record {
-        Some(dir) => {
-            let stop = stop.clone();
-            let mut rec = Recorder::create(dir)?;
-            let h_speed = if params.speed_type == "float64" {
-                rec.add_topic::<messages::Float64>(SPEED, input_qos)?
-            } else {
-                rec.add_topic::<messages::RotorSpeed>(SPEED, input_qos)?
-            };
-            let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE, input_qos)?;
-            let h_journal = rec.add_topic::<messages::JournalState>(JOURNAL, state_qos)?;
-            let h_film = rec.add_topic::<messages::FilmState>(FILM, state_qos)?;
-            let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, state_qos)?;
-            let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, warning_qos)?;
-            let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, state_qos)?;
-            let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input_qos)?;
-            let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, state_qos)?;
-            let h_margin =
-                rec.add_topic::<messages::StabilityMargin>(MARGIN, TopicQos::latched(1))?;
-            Some(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
-                loop {
-                    match rec_rx.recv_timeout(Duration::from_millis(200)) {
-                        Ok(item) => {
-                            let t = |ns: &i64| *ns as u64;
-                            match &item {
-                                ToRecord::Speed(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
-                                ToRecord::Speed64(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
-                                ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
-                                ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
-                                ToRecord::Out(o, ns) => match o {
-                                    Outgoing::Journal(m) => {
-                                        rec.write(h_journal, m, t(ns), t(ns))?
-                                    }
-                                    Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,
-                                    Outgoing::Orbit(m) => rec.write(h_orbit, m, t(ns), t(ns))?,
-                                    Outgoing::Warning(m) => {
-                                        rec.write(h_warning, m, t(ns), t(ns))?
-                                    }
-                                    Outgoing::Diagnostics(m) => {
-                                        rec.write(h_diag, m, t(ns), t(ns))?
-                                    }
-                                    Outgoing::Residual(m) => {
-                                        rec.write(h_residual, m, t(ns), t(ns))?
-                                    }
-                                    Outgoing::Margin(m) => rec.write(h_margin, m, t(ns), t(ns))?,
-                                },
-                            }
-                        }
-                        // after shutdown, the first quiet moment ends the recording
-                        Err(mpsc::RecvTimeoutError::Timeout) if stop.load(Ordering::Relaxed) => {
-                            break
-                        }
-                        Err(mpsc::RecvTimeoutError::Timeout) => {}
-                        Err(mpsc::RecvTimeoutError::Disconnected) => break,
-                    }
-                    rec.flush_if_due(Duration::from_secs(1))?;
-                }
-                Ok(rec.finish()?)
-            }))
-        }
+        Some(dir) => Some(recording::spawn(
+            dir,
+            params.speed_type == "float64",
+            recording::Qos {
+                input: input_qos,
+                state: state_qos,
+                warning: warning_qos,
+            },
+            rec_rx,
+            stop.clone(),
+        )?),
         None => {
             drop(rec_rx);
             None

@@ -1,0 +1,86 @@
+//! The node's recording: every input as received and every output, on their own thread, to a
+//! rosbag2 MCAP bag flushed every second and finished when the node stops.
+
+use super::model::Outgoing;
+use super::{
+    DIAGNOSTICS, FILM, JOURNAL, MARGIN, ORBIT, PROBE, RESIDUAL, SPEED, UNBALANCE, WARNING,
+};
+use crate::messages;
+use crate::record::{Recorder, TopicQos};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// A record request for the recorder thread: a message and its receive or send time (ns).
+pub(super) enum ToRecord {
+    Out(Outgoing, i64),
+    Speed(messages::RotorSpeed, i64),
+    Speed64(messages::Float64, i64),
+    Unbalance(messages::Unbalance, i64),
+    Probe(messages::ProbeDisplacement, i64),
+}
+
+/// The QoS the node offers, as recorded.
+pub(super) struct Qos {
+    pub input: TopicQos,
+    pub state: TopicQos,
+    pub warning: TopicQos,
+}
+
+/// Starts recording to bag directory `dir` what arrives on `rx` (the speed as std_msgs/Float64
+/// if `speed_float64`), until `stop` is set and a quiet moment follows or the senders are gone.
+pub(super) fn spawn(
+    dir: &Path,
+    speed_float64: bool,
+    qos: Qos,
+    rx: mpsc::Receiver<ToRecord>,
+    stop: Arc<AtomicBool>,
+) -> anyhow::Result<JoinHandle<anyhow::Result<PathBuf>>> {
+    let mut rec = Recorder::create(dir)?;
+    let h_speed = if speed_float64 {
+        rec.add_topic::<messages::Float64>(SPEED, qos.input)?
+    } else {
+        rec.add_topic::<messages::RotorSpeed>(SPEED, qos.input)?
+    };
+    let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE, qos.input)?;
+    let h_journal = rec.add_topic::<messages::JournalState>(JOURNAL, qos.state)?;
+    let h_film = rec.add_topic::<messages::FilmState>(FILM, qos.state)?;
+    let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, qos.state)?;
+    let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, qos.warning)?;
+    let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, qos.state)?;
+    let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, qos.input)?;
+    let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos.state)?;
+    let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, TopicQos::latched(1))?;
+    Ok(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
+        loop {
+            match rx.recv_timeout(Duration::from_millis(200)) {
+                Ok(item) => {
+                    let t = |ns: &i64| *ns as u64;
+                    match &item {
+                        ToRecord::Speed(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
+                        ToRecord::Speed64(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
+                        ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
+                        ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
+                        ToRecord::Out(o, ns) => match o {
+                            Outgoing::Journal(m) => rec.write(h_journal, m, t(ns), t(ns))?,
+                            Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,
+                            Outgoing::Orbit(m) => rec.write(h_orbit, m, t(ns), t(ns))?,
+                            Outgoing::Warning(m) => rec.write(h_warning, m, t(ns), t(ns))?,
+                            Outgoing::Diagnostics(m) => rec.write(h_diag, m, t(ns), t(ns))?,
+                            Outgoing::Residual(m) => rec.write(h_residual, m, t(ns), t(ns))?,
+                            Outgoing::Margin(m) => rec.write(h_margin, m, t(ns), t(ns))?,
+                        },
+                    }
+                }
+                // after shutdown, the first quiet moment ends the recording
+                Err(mpsc::RecvTimeoutError::Timeout) if stop.load(Ordering::Relaxed) => break,
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            rec.flush_if_due(Duration::from_secs(1))?;
+        }
+        Ok(rec.finish()?)
+    }))
+}
