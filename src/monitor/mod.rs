@@ -76,9 +76,10 @@ pub struct BearingRevolution {
     /// RMS distance between the last two revolutions' orbits, sample by sample, over the
     /// clearance.
     pub orbit_diff: f64,
-    /// RMS distance from each point of the last revolution's orbit to the path traced in the two
-    /// revolutions before it, over the clearance: small when the journal repeats a closed path
-    /// (a limit cycle, even one that takes two revolutions), whatever the timing.
+    /// RMS distance from the points of the last revolution's orbit (up to 32, evenly spread) to
+    /// the path traced in the two revolutions before it, over the clearance: small when the
+    /// journal repeats a closed path (a limit cycle, even one that takes two revolutions),
+    /// whatever the timing.
     pub orbit_path_diff: f64,
     /// Relative L2 difference between the last two revolutions' mid-plane pressure fields.
     pub pressure_diff: f64,
@@ -366,8 +367,12 @@ impl Monitor {
             // path distance: each point of the last revolution to the polyline of the two before
             let mut path_diff = self.report.bearings[bi].orbit_path_diff;
             if last > 1 && self.len >= 3 * last {
-                let mut sum = 0.0;
-                for back in 0..last {
+                // every point against every segment costs O(n²) a revolution: up to 32 points of
+                // the revolution, evenly spread, are compared (all segments are searched)
+                let stride = last.div_ceil(32);
+                let (mut sum, mut points) = (0.0, 0usize);
+                for back in (0..last).step_by(stride) {
+                    points += 1;
                     let p = idx(back);
                     let (px, py) = (h.x[p], h.y[p]);
                     let mut best = f64::MAX;
@@ -379,18 +384,22 @@ impl Monitor {
                     }
                     sum += best;
                 }
-                path_diff = (sum / last as f64).sqrt() / c;
+                path_diff = (sum / points as f64).sqrt() / c;
             }
-            // spectrum over the window (oldest first)
+            // spectrum over the window (oldest first), from at most 32 samples a revolution: the
+            // orders resolved go up to 2, far below that rate's Nyquist order of 16
             let start = window;
-            let xs = (0..window).map(|k| h.x[idx(start - 1 - k)]);
-            let ys = (0..window).map(|k| h.y[idx(start - 1 - k)]);
-            let angles = (0..window).map(|k| self.angle[idx(start - 1 - k)]);
+            let per_rev = window / self.rev_lengths.len().clamp(1, SPECTRUM_REVOLUTIONS);
+            let stride = per_rev.div_ceil(32).max(1);
+            let picks = window.div_ceil(stride);
+            let xs = (0..picks).map(|k| h.x[idx(start - 1 - k * stride)]);
+            let ys = (0..picks).map(|k| h.y[idx(start - 1 - k * stride)]);
+            let angles = (0..picks).map(|k| self.angle[idx(start - 1 - k * stride)]);
             order_spectrum(
                 xs,
                 ys,
                 angles,
-                window,
+                picks,
                 SPECTRUM_REVOLUTIONS,
                 &mut self.spectrum,
             );

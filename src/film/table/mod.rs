@@ -155,6 +155,23 @@ impl FilmTable {
         (s.rows, s.cols, s.wr, s.wc)
     }
 
+    /// The four nodes around (ε, ψ) and their bilinear weights (rows, columns, row weights,
+    /// column weights): for the mid-plane profile, where a smooth display suffices.
+    fn bilinear(&self, eps: f64, psi: f64) -> ([usize; 2], [usize; 2], [f64; 2], [f64; 2]) {
+        let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();
+        let fu = (u / self.u_max * (N_ECC - 1) as f64).clamp(0.0, (N_ECC - 1) as f64 - 1e-9);
+        let iu = fu.floor() as usize;
+        let fp = wrap_angle_rad(psi) / TAU * N_PSI as f64;
+        let ip = (fp.floor() as usize).min(N_PSI - 1);
+        let (tu, tp) = (fu - iu as f64, fp - ip as f64);
+        (
+            [iu, (iu + 1).min(N_ECC - 1)],
+            [ip, (ip + 1) % N_PSI],
+            [1.0 - tu, tu],
+            [1.0 - tp, tp],
+        )
+    }
+
     /// The stencil at (ε, ψ) with the weights' derivatives d/dε and d/dψ.
     fn stencil_with_slopes(&self, eps: f64, psi: f64) -> Stencil {
         let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();

@@ -82,7 +82,9 @@ impl FilmModel for TabulatedFilm {
     fn midplane_pressure(&self, out: &mut [f64]) {
         let t = &self.table;
         let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
-        let (rows, cols, wr, wc) = t.stencil(s.eps, s.psi);
+        // bilinear between the four nodes around the state: the profile is for display and the
+        // monitor's revolution-to-revolution pressure difference, not for the force
+        let (rows, cols, wr, wc) = t.bilinear(s.eps, s.psi);
         let len = out.len().max(1);
         // the grid column nearest to θ_k − φ in the frame of the line of centres, for the first
         // 256 output angles kept on the stack (beyond them, computed again for each node)
