@@ -87,7 +87,7 @@ fn station<'a>(report: &'a Value, name: &str) -> &'a Value {
 fn the_twins_own_model_replays_to_itself_and_deterministically() {
     let bag = own_model_bag("own", 0.3, 0.0);
     let out = scratch("own-out");
-    let r = replay_json(&bag, &out, &["--film", "direct"]);
+    let r = replay_json(&bag, &out, &["--film", "direct", "--steps-per-rev", "128"]);
     assert!(r["damage"].as_array().unwrap().is_empty());
     assert!(r["messages_in"].as_u64().unwrap() > 1000);
     for name in ["probe_pulley_end", "probe_outboard"] {
@@ -106,7 +106,7 @@ fn the_twins_own_model_replays_to_itself_and_deterministically() {
     assert!(r["onset"]["predicted_time_s"].is_null() && r["onset"]["observed_time_s"].is_null());
     // determinism
     let out2 = scratch("own-out2");
-    let r2 = replay_json(&bag, &out2, &["--film", "direct"]);
+    let r2 = replay_json(&bag, &out2, &["--film", "direct", "--steps-per-rev", "128"]);
     let strip = |mut v: Value| {
         v["wall_time_s"] = Value::Null;
         v["real_time_factor"] = Value::Null;
@@ -127,7 +127,7 @@ fn probe_noise_shows_as_its_rms_in_the_orbit_distance() {
     let r = replay_json(
         &bag,
         &scratch("noise-out"),
-        &["--no-bag", "--film", "direct"],
+        &["--no-bag", "--film", "direct", "--steps-per-rev", "128"],
     );
     for name in ["probe_pulley_end", "probe_outboard"] {
         let s = station(&r, name);

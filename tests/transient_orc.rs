@@ -139,6 +139,7 @@ fn stable_at_8000_whip_at_9000_and_converged_in_step_and_grid() {
         100.0 * (w1 / w0 - 1.0), c1 * 1e6, a0 * 1e6, 100.0 * (c1 / a0 - 1.0), whip.wall_time_s / whip_t.wall_time_s
     );
     assert_eq!(stable_t.report.state, RotorState::Stable);
+    assert!(stable_t.report.rev_to_rev_pressure_diff < 5e-3);
     assert!((s1 - s0).abs() < 0.01 * s0);
     assert!(matches!(
         whip_t.report.state,

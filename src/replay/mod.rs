@@ -62,7 +62,7 @@ impl Default for ReplayOptions {
     fn default() -> Self {
         Self {
             coupling: Coupling::Nonlinear,
-            steps_per_rev: 128,
+            steps_per_rev: 64,
             film: FilmEvaluation::Table,
             session: SessionSettings::default(),
             min_speed_rad_s: 100.0 * std::f64::consts::PI / 30.0,

@@ -64,7 +64,9 @@ impl Default for NodeParams {
             model: "nonlinear".into(),
             delta: 0.5,
             film: "table".into(),
-            steps_per_rev: 128,
+            // 64 steps a revolution at rated speed: the whip's sub-synchronous amplitude within
+            // 0.07 % of 128 steps (tests/transient_orc.rs), at half the cost
+            steps_per_rev: 64,
             state_rate_hz: 200.0,
             pressure_map_rate_hz: 2.0,
             input_timeout_s: 1.0,

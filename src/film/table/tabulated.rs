@@ -86,25 +86,29 @@ impl FilmModel for TabulatedFilm {
         // monitor's revolution-to-revolution pressure difference, not for the force
         let (rows, cols, wr, wc) = t.bilinear(s.eps, s.psi);
         let len = out.len().max(1);
-        // the grid column nearest to θ_k − φ in the frame of the line of centres, for the first
-        // 256 output angles kept on the stack (beyond them, computed again for each node)
+        // θ_k − φ in grid columns of the line-of-centres frame, linear between the two columns
+        // around it (a nearest column would jump as the attitude turns)
         let shift = s.phi() / TAU * t.n_theta as f64;
         let scale = t.n_theta as f64 / len as f64;
         let nt = t.n_theta as i64;
-        let column = |k: usize| ((k as f64 * scale - shift).round() as i64).rem_euclid(nt) as usize;
-        let mut columns = [0usize; 256];
-        for (k, col) in columns.iter_mut().enumerate().take(len) {
-            *col = column(k);
-        }
-        let column = |k: usize| if k < 256 { columns[k] } else { column(k) };
+        let at = |k: usize| {
+            let x = k as f64 * scale - shift;
+            let i = x.floor();
+            let i0 = (i as i64).rem_euclid(nt) as usize;
+            (i0, (i0 + 1) % t.n_theta, x - i)
+        };
         out.fill(0.0);
         // node by node, so that each node's profile is read in one sweep
         for (a, &r) in rows.iter().enumerate() {
             for (b, &c) in cols.iter().enumerate() {
                 let w = wr[a] * wc[b];
+                if w == 0.0 {
+                    continue;
+                }
                 let profile = &t.profiles[(r * N_PSI + c) * t.n_theta..][..t.n_theta];
                 for (k, p) in out.iter_mut().enumerate() {
-                    *p += w * profile[column(k)];
+                    let (i0, i1, f) = at(k);
+                    *p += w * (profile[i0] + f * (profile[i1] - profile[i0]));
                 }
             }
         }
