@@ -188,3 +188,41 @@ fn node_follows_simulation_time() {
     assert!((span - 3.0).abs() < 0.6, "span {span} s");
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// The parameter services over the bus (`rotor-twin param`, ros2-client's rcl_interfaces
+/// client, as `ros2 param` would call them): a run-time parameter is set and reads back, a
+/// start-only one is refused with the node's reason, and so is a bad value.
+#[test]
+fn parameters_are_set_over_the_bus_where_safe() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::env::temp_dir().join(format!("rotor-twin-param-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let status = Command::new("unshare")
+        .args(["-n", "bash"])
+        .arg(root.join("tests/interop/param_scenario.sh"))
+        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
+        .arg(&out)
+        .status()
+        .expect("unshare");
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("param.out")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let expect = [
+        "state_rate_hz:=50: set",
+        "rc=0",
+        "state_rate_hz: Double(50.0)",
+        "model: String(\"nonlinear\")",
+        "rc=0",
+        "model:=linear: REFUSED: parameter model can only be set at start",
+        "rc=1",
+        "state_rate_hz:=-1: REFUSED: parameter state_rate_hz: -1 must be a rate above zero",
+        "rc=1",
+    ];
+    let mut at = 0;
+    for e in expect {
+        let found = lines[at..].iter().position(|l| l.starts_with(e));
+        assert!(found.is_some(), "missing '{e}' in:\n{text}");
+        at += found.unwrap() + 1;
+    }
+    std::fs::remove_dir_all(&out).ok();
+}

@@ -30,6 +30,8 @@ enum Command {
     Sweep(simulate::SweepArgs),
     /// The live ROS 2 node: the twin beside a plant or rig, recorded to MCAP.
     Node(node::NodeArgs),
+    /// A running node's parameters: get, or set where the node allows it at run time.
+    Param(node::ParamArgs),
     /// A recorded bag through the twin: predictions, warnings, predicted vs measured orbits.
     Replay(replay::ReplayArgs),
     /// Write a SYNTHETIC bag (a plant model run through a speed profile, noisy probes) to try
@@ -49,6 +51,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
         Some(Command::Node(args)) => node::run(args),
         Some(Command::Replay(args)) => replay::run(&args),
+        Some(Command::Param(args)) => node::run_param(args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         None => replay::run_sample(),

@@ -16,10 +16,12 @@
 
 mod inputs;
 mod model;
+mod param_client;
 mod params;
 mod recording;
 
 pub use inputs::{check_probe, check_unbalance, SpeedGate};
+pub use param_client::{run as param_call, ParamCall};
 pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit, RUNTIME_PARAMETERS};
 
 use crate::messages::{self, RosMessage};
@@ -98,6 +100,27 @@ fn type_name<T: RosMessage>() -> MessageTypeName {
     MessageTypeName::new(pkg, ty)
 }
 
+/// True if the environment asks for discovery on this host only: ROS_AUTOMATIC_DISCOVERY_RANGE
+/// LOCALHOST (or OFF, which this node treats the same way: it has no static peers), or the older
+/// ROS_LOCALHOST_ONLY=1. An unknown value is an error naming it.
+fn discovery_localhost_only() -> anyhow::Result<bool> {
+    let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
+    if let Some(range) = var("ROS_AUTOMATIC_DISCOVERY_RANGE") {
+        return match range.trim() {
+            "LOCALHOST" | "OFF" => Ok(true),
+            "SUBNET" | "SYSTEM_DEFAULT" => Ok(false),
+            other => anyhow::bail!(
+                "ROS_AUTOMATIC_DISCOVERY_RANGE '{other}': must be SUBNET, LOCALHOST, OFF or SYSTEM_DEFAULT"
+            ),
+        };
+    }
+    Ok(match var("ROS_LOCALHOST_ONLY").as_deref().map(str::trim) {
+        Some("1") => true,
+        Some("0") | None => false,
+        Some(other) => anyhow::bail!("ROS_LOCALHOST_ONLY '{other}': must be 0 or 1"),
+    })
+}
+
 /// Runs the node until SIGINT or SIGTERM.
 pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
@@ -137,8 +160,17 @@ async fn run_async(
     rotor: Rotor,
     domain: u16,
 ) -> anyhow::Result<()> {
-    let context = Context::with_options(ContextOptions::new().domain_id(domain))
-        .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))?;
+    let context = if discovery_localhost_only()? {
+        // only the loopback interface for multicast and advertised locators
+        let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(domain)
+            .with_only_networks([std::net::IpAddr::from([127, 0, 0, 1])])
+            .build()
+            .map_err(|e| anyhow::anyhow!("DDS participant: {e:?}"))?;
+        Context::from_domain_participant(participant)
+    } else {
+        Context::with_options(ContextOptions::new().domain_id(domain))
+    }
+    .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))?;
     // parameters that may change at run time are shared with the model thread
     let live_params = Arc::new(Mutex::new(params.clone()));
     let params_version = Arc::new(std::sync::atomic::AtomicU64::new(0));
