@@ -224,6 +224,11 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
                 &p,
             )?;
         }
+        crate::plot::waterfall_svg(
+            &out_dir.join(format!("waterfall_{name}.svg")),
+            &format!("{name}: order spectra through the bag (blocks of 8 revolutions)"),
+            &c.block_spectra,
+        )?;
         crate::plot::amplitude_speed_svg(
             &out_dir.join(format!("amplitude_speed_{name}.svg")),
             &format!("{name}: amplitude against speed (blocks of 8 revolutions)"),

@@ -5,5 +5,7 @@ mod replay;
 mod transient;
 
 pub use campbell::campbell_svg;
-pub use replay::{amplitude_speed_svg, orbit_comparison_svg, spectrum_comparison_svg};
+pub use replay::{
+    amplitude_speed_svg, orbit_comparison_svg, spectrum_comparison_svg, waterfall_svg,
+};
 pub use transient::{orbit_svg, pressure_map_svg, spectrum_svg, sweep_svg};

@@ -2,7 +2,7 @@
 //! and 1X and sub-synchronous amplitude against speed over the bag.
 
 use crate::monitor::OrderComponent;
-use crate::replay::compare::{Sample, WindowComparison};
+use crate::replay::compare::{BlockSpectra, Sample, WindowComparison, BLOCK_REVS};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -225,6 +225,62 @@ pub fn amplitude_speed_svg(
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Waterfall (cascade) of the order spectra of the bag's blocks of 8 revolutions, measured on
+/// the left and predicted on the right: one trace per block (at most 60, evenly chosen), raised
+/// by its time in the bag, semi-major axis scaled so that the largest peak spans 3 traces.
+pub fn waterfall_svg(path: &Path, title: &str, blocks: &[BlockSpectra]) -> anyhow::Result<()> {
+    let root = SVGBackend::new(path, (1000, 640)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 18))?;
+    let picked: Vec<&BlockSpectra> = if blocks.len() > 60 {
+        (0..60)
+            .map(|i| &blocks[i * (blocks.len() - 1) / 59])
+            .collect()
+    } else {
+        blocks.iter().collect()
+    };
+    let t_end = picked.last().map_or(1.0, |b| b.end_s).max(1e-9);
+    let peak = picked
+        .iter()
+        .flat_map(|b| b.measured_m.iter().chain(&b.predicted_m))
+        .fold(1e-12_f64, |a, &v| a.max(v));
+    let spacing = t_end / picked.len().max(1) as f64;
+    let scale = 3.0 * spacing / peak;
+    let halves = root.split_evenly((1, 2));
+    for (area, (label, color, measured)) in halves.iter().zip([
+        ("measured", MEASURED, true),
+        ("predicted", PREDICTED, false),
+    ]) {
+        let mut chart = ChartBuilder::on(area)
+            .caption(label, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..2.0 + 0.05, 0.0..t_end + 3.5 * spacing)?;
+        chart
+            .configure_mesh()
+            .x_desc("order (frequency / running frequency)")
+            .y_desc("bag time (s); traces: semi-major axis")
+            .draw()?;
+        for b in &picked {
+            let values = if measured {
+                &b.measured_m
+            } else {
+                &b.predicted_m
+            };
+            chart.draw_series(LineSeries::new(
+                values
+                    .iter()
+                    .enumerate()
+                    .map(|(k, v)| ((k + 1) as f64 / BLOCK_REVS as f64, b.end_s + scale * v)),
+                color,
+            ))?;
+        }
+    }
     root.present()?;
     Ok(())
 }

@@ -67,6 +67,19 @@ pub struct WindowComparison {
     pub mean_position_distance_m: f64,
 }
 
+/// The order spectra of one block of [`BLOCK_REVS`] revolutions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlockSpectra {
+    /// Mean speed (rpm).
+    pub speed_rpm: f64,
+    /// End of the block, bag time (s).
+    pub end_s: f64,
+    /// Measured semi-major axes (m) at orders k/8, k = 1 … 16.
+    pub measured_m: [f64; 2 * BLOCK_REVS],
+    /// Predicted semi-major axes (m) at the same orders.
+    pub predicted_m: [f64; 2 * BLOCK_REVS],
+}
+
 /// The streaming comparison at one station.
 #[derive(Debug, Clone)]
 pub struct StationComparison {
@@ -78,6 +91,9 @@ pub struct StationComparison {
     recent: VecDeque<Sample>,
     /// Completed blocks.
     pub blocks: Vec<WindowComparison>,
+    /// Each block's order spectra, semi-major axes (m) at orders k/8, k = 1 … 16: measured,
+    /// predicted (for the waterfall plot).
+    pub block_spectra: Vec<BlockSpectra>,
     /// Samples compared.
     pub samples: usize,
 }
@@ -92,6 +108,7 @@ impl StationComparison {
             block: Vec::new(),
             recent: VecDeque::new(),
             blocks: Vec::new(),
+            block_spectra: Vec::new(),
             samples: 0,
         }
     }
@@ -108,6 +125,19 @@ impl StationComparison {
             if s.angle_rad - first.angle_rad >= BLOCK_REVS as f64 * TAU || s.time_s < first.time_s {
                 let block = std::mem::take(&mut self.block);
                 if let Some(w) = self.compare(&block, BLOCK_REVS) {
+                    let semi = |spec: Vec<OrderComponent>| {
+                        let mut out = [0.0; 2 * BLOCK_REVS];
+                        for (o, c) in out.iter_mut().zip(spec) {
+                            *o = c.semi_major_m();
+                        }
+                        out
+                    };
+                    self.block_spectra.push(BlockSpectra {
+                        speed_rpm: w.speed_rpm,
+                        end_s: w.end_s,
+                        measured_m: semi(spectrum(&block, BLOCK_REVS, |s| s.measured_m)),
+                        predicted_m: semi(spectrum(&block, BLOCK_REVS, |s| s.predicted_m)),
+                    });
                     self.blocks.push(w);
                 }
             }
