@@ -191,7 +191,8 @@ fn node_follows_simulation_time() {
 
 /// The parameter services over the bus (`rotor-twin param`, ros2-client's rcl_interfaces
 /// client, as `ros2 param` would call them): a run-time parameter is set and reads back, a
-/// start-only one is refused with the node's reason, and so is a bad value.
+/// start-only one is refused with the node's reason, and so is a bad value. The node runs with
+/// ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST; an unknown range is refused, naming it.
 #[test]
 fn parameters_are_set_over_the_bus_where_safe() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -216,6 +217,8 @@ fn parameters_are_set_over_the_bus_where_safe() {
         "model:=linear: REFUSED: parameter model can only be set at start",
         "rc=1",
         "state_rate_hz:=-1: REFUSED: parameter state_rate_hz: -1 must be a rate above zero",
+        "rc=1",
+        "error: ROS_AUTOMATIC_DISCOVERY_RANGE 'NEARBY': must be SUBNET, LOCALHOST, OFF or SYSTEM_DEFAULT",
         "rc=1",
     ];
     let mut at = 0;

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The node's ROS 2 parameter services over the bus: set a run-time parameter, read it back, and
-# have a start-only one and a bad value refused. Call under `unshare -n`.
+# have a start-only one and a bad value refused; the node runs with discovery on this host only,
+# and an unknown discovery range is refused. Call under `unshare -n`.
 # Args: ROTOR_TWIN_BIN OUT_DIR
 set -u
 bin="$1"; out="$2"
 ip link set lo up
-"$bin" node > "$out/node.out" 2> "$out/node.err" &
+# discovery on this host only (the loopback-only participant)
+ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST "$bin" node > "$out/node.out" 2> "$out/node.err" &
 node=$!
 sleep 3
 {
@@ -13,6 +15,7 @@ sleep 3
   "$bin" param --timeout 10 get state_rate_hz model; echo "rc=$?"
   "$bin" param --timeout 10 set model:=linear; echo "rc=$?"
   "$bin" param --timeout 10 set state_rate_hz:=-1; echo "rc=$?"
+  ROS_AUTOMATIC_DISCOVERY_RANGE=NEARBY "$bin" node; echo "rc=$?"
 } > "$out/param.out" 2>&1
 kill -INT "$node"
 wait "$node"
