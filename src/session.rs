@@ -8,6 +8,9 @@ use crate::messages::*;
 use crate::monitor::{ClassifierSettings, Monitor, RevolutionReport, RotorState, PRESSURE_POINTS};
 use crate::rotor::Rotor;
 
+/// Revolutions a milder state must hold before the warning steps down to it.
+pub const DEESCALATION_REVOLUTIONS: u32 = 3;
+
 /// Output rates and warning thresholds of a session.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SessionSettings {
@@ -85,7 +88,10 @@ pub struct Session {
     step_index: u64,
     decimation: u64,
     map_decimation: u64,
+    /// the state last announced by a warning
     last_state: RotorState,
+    /// revolutions the monitor has reported a milder state than the announced one
+    milder_for: u32,
     last_warning_s: f64,
     /// probe displacements (m) and time (s) before the last step, for interpolation
     previous_probes: Vec<[f64; 2]>,
@@ -130,6 +136,7 @@ impl Session {
             decimation: 1,
             map_decimation: 1,
             last_state: RotorState::Stable,
+            milder_for: 0,
             last_warning_s: f64::NEG_INFINITY,
             previous_probes,
             previous_time_s,
@@ -316,13 +323,28 @@ impl Session {
             }));
         }
         let now = self.twin.time_s();
-        let reminder = rep.state != RotorState::Stable
+        // hysteresis: a worse state is announced at once, a milder one only once it has held
+        // for DEESCALATION_REVOLUTIONS revolutions (an orbit grazing a threshold would otherwise
+        // flip the warning every revolution)
+        let state = if rep.state >= self.last_state {
+            self.milder_for = 0;
+            rep.state
+        } else {
+            self.milder_for += 1;
+            if self.milder_for >= DEESCALATION_REVOLUTIONS {
+                self.milder_for = 0;
+                rep.state
+            } else {
+                self.last_state
+            }
+        };
+        let reminder = state != RotorState::Stable
             && now - self.last_warning_s >= self.settings.warning_repeat_s;
-        if rep.state == self.last_state && !reminder {
+        if state == self.last_state && !reminder {
             return;
         }
         self.last_warning_s = now;
-        self.last_state = rep.state;
+        self.last_state = state;
         let (k, b) = rep
             .bearings
             .iter()
@@ -330,7 +352,7 @@ impl Session {
             .max_by(|a, b| a.1.state.cmp(&b.1.state))
             .map(|(k, b)| (k, *b))
             .unwrap_or_default();
-        let (level, kind) = match rep.state {
+        let (level, kind) = match state {
             RotorState::Stable => (InstabilityWarning::OK, "none"),
             RotorState::Whirl => (InstabilityWarning::WARN, "whirl"),
             RotorState::Whip => (InstabilityWarning::ERROR, "whip"),
@@ -338,13 +360,12 @@ impl Session {
         };
         let amplitude = 0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m)
             / self.clearances.get(k).copied().unwrap_or(1.0);
-        let level = if rep.state == RotorState::Stable
-            && amplitude > self.settings.warning_amplitude_ratio
-        {
-            InstabilityWarning::WARN
-        } else {
-            level
-        };
+        let level =
+            if state == RotorState::Stable && amplitude > self.settings.warning_amplitude_ratio {
+                InstabilityWarning::WARN
+            } else {
+                level
+            };
         emit(Outgoing::Warning(InstabilityWarning {
             header: header(stamp, self.names.get(k).map_or("", String::as_str)),
             level,
