@@ -46,24 +46,20 @@ pub fn orbit_comparison_svg(
         ))?
         .label("bearing clearance circle")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
-    chart
-        .draw_series(LineSeries::new(
-            samples
-                .iter()
-                .map(|s| (s.measured_m[0] * 1e6, s.measured_m[1] * 1e6)),
-            MEASURED,
-        ))?
-        .label("measured")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], MEASURED));
-    chart
-        .draw_series(LineSeries::new(
-            samples
-                .iter()
-                .map(|s| (s.predicted_m[0] * 1e6, s.predicted_m[1] * 1e6)),
-            PREDICTED,
-        ))?
-        .label("predicted")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PREDICTED));
+    type Pick = fn(&Sample) -> [f64; 2];
+    let series: [(&str, Pick, RGBColor); 2] = [
+        ("measured", |s| s.measured_m, MEASURED),
+        ("predicted", |s| s.predicted_m, PREDICTED),
+    ];
+    for (label, pick, color) in series {
+        chart
+            .draw_series(LineSeries::new(
+                samples.iter().map(|s| (pick(s)[0] * 1e6, pick(s)[1] * 1e6)),
+                color,
+            ))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+    }
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
