@@ -8,6 +8,7 @@ use crate::rotor::{MachineDescription, Rotor};
 use crate::session::SessionSettings;
 use anyhow::Context;
 use clap::Args;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The bag shipped with the project (a synthetic run-up of the built-in microturbine).
@@ -235,13 +236,18 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
             &c.blocks,
         )?;
     }
-    if args.json {
-        println!("{json}");
+    // a closed standard output (e.g. piped into `head`) is not an error of the replay
+    let mut stdout = std::io::stdout().lock();
+    let printed = if args.json {
+        writeln!(stdout, "{json}")
     } else {
-        print!("{}", report.summary());
-        println!("output: {}", out_dir.display());
+        write!(stdout, "{}", report.summary())
+            .and_then(|()| writeln!(stdout, "output: {}", out_dir.display()))
+    };
+    match printed {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// Creates `dir`, or clears a previous replay's output in it (a directory holding anything

@@ -97,19 +97,36 @@ impl FilmModel for TabulatedFilm {
             let i0 = (i as i64).rem_euclid(nt) as usize;
             (i0, (i0 + 1) % t.n_theta, x - i)
         };
-        out.fill(0.0);
-        // node by node, so that each node's profile is read in one sweep
-        for (a, &r) in rows.iter().enumerate() {
-            for (b, &c) in cols.iter().enumerate() {
-                let w = wr[a] * wc[b];
-                if w == 0.0 {
-                    continue;
+        // blend the four nodes' profiles first (on the stack, for grids of up to 512 columns),
+        // then sample the blend; larger grids blend at each output angle
+        let mut blend = [0.0; 512];
+        // the four nodes: weight and the start of the profile
+        let nodes: [(f64, usize); 4] = std::array::from_fn(|n| {
+            let (a, b) = (n / 2, n % 2);
+            (wr[a] * wc[b], (rows[a] * N_PSI + cols[b]) * t.n_theta)
+        });
+        let profile = |start: usize| &t.profiles[start..start + t.n_theta];
+        if t.n_theta <= blend.len() {
+            let blend = &mut blend[..t.n_theta];
+            for &(w, start) in &nodes {
+                for (b, v) in blend.iter_mut().zip(profile(start)) {
+                    *b += w * v;
                 }
-                let profile = &t.profiles[(r * N_PSI + c) * t.n_theta..][..t.n_theta];
-                for (k, p) in out.iter_mut().enumerate() {
-                    let (i0, i1, f) = at(k);
-                    *p += w * (profile[i0] + f * (profile[i1] - profile[i0]));
-                }
+            }
+            for (k, p) in out.iter_mut().enumerate() {
+                let (i0, i1, f) = at(k);
+                *p = blend[i0] + f * (blend[i1] - blend[i0]);
+            }
+        } else {
+            for (k, p) in out.iter_mut().enumerate() {
+                let (i0, i1, f) = at(k);
+                *p = nodes
+                    .iter()
+                    .map(|&(w, start)| {
+                        let q = profile(start);
+                        w * (q[i0] + f * (q[i1] - q[i0]))
+                    })
+                    .sum();
             }
         }
         for p in out.iter_mut() {
