@@ -5,7 +5,7 @@
 
 use crate::dynamics::{StepInput, Twin, TwinConfig, TwinError};
 use crate::messages::*;
-use crate::monitor::{ClassifierSettings, Monitor, RevolutionReport, RotorState, PRESSURE_POINTS};
+use crate::monitor::{ClassifierSettings, Monitor, RotorState, PRESSURE_POINTS};
 use crate::rotor::Rotor;
 
 /// Revolutions a milder state must hold before the warning steps down to it.
@@ -164,11 +164,6 @@ impl Session {
         &mut self.twin
     }
 
-    /// The monitor's latest revolution report.
-    pub fn report(&self) -> &RevolutionReport {
-        self.monitor.report()
-    }
-
     /// Model time zero, ns since the epoch.
     pub fn epoch_ns(&self) -> i64 {
         self.epoch_ns
@@ -182,11 +177,6 @@ impl Session {
     /// The stamp (ns since the epoch) of the twin's present time.
     pub fn stamp_ns(&self) -> i64 {
         self.epoch_ns + (self.twin.time_s() * 1e9).round() as i64
-    }
-
-    /// Probe station names, in machine order.
-    pub fn stations(&self) -> &[String] {
-        &self.stations
     }
 
     /// Advances one step and hands its messages to `emit`. On an error the twin state is

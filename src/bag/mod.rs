@@ -248,15 +248,6 @@ impl Bag {
             self.messages.last()?.log_time_ns,
         ))
     }
-
-    /// Messages per topic index.
-    pub fn counts(&self) -> Vec<usize> {
-        let mut c = vec![0; self.topics.len()];
-        for m in &self.messages {
-            c[m.topic] += 1;
-        }
-        c
-    }
 }
 
 /// The .mcap files of a bag: the file itself, or those metadata.yaml lists (falling back to the

@@ -266,28 +266,13 @@ impl FilmTable {
         n
     }
 
-    /// Only the force along and across the line of centres, per unit V (N·s).
-    fn force_at(&self, eps: f64, psi: f64) -> [f64; 2] {
-        let (rows, cols, wr, wc) = self.stencil(eps, psi);
-        let mut f = [0.0; 2];
-        for (a, &r) in rows.iter().enumerate() {
-            for (b, &c) in cols.iter().enumerate() {
-                let w = wr[a] * wc[b];
-                let m = &self.nodes[r * N_PSI + c];
-                f[0] += w * m.force[0];
-                f[1] += w * m.force[1];
-            }
-        }
-        f
-    }
-
     /// The film force `[F_x, F_y]` (N) in the fixed frame for `kin` (no checks).
     pub fn force(&self, kin: &JournalKinematics) -> [f64; 2] {
         let s = LineOfCentres::of(kin, self.geometry.radial_clearance_m);
         if s.v == 0.0 {
             return [0.0, 0.0];
         }
-        let [fr, ft] = self.force_at(s.eps, s.psi);
+        let [fr, ft] = self.force_with_slopes(s.eps, s.psi)[0];
         s.rotate_to_fixed([s.v * fr, s.v * ft])
     }
 }
