@@ -6,15 +6,18 @@
 
 pub mod bag;
 pub mod cli;
+pub mod driver;
 pub mod dynamics;
 pub mod film;
 pub mod messages;
 pub mod monitor;
+pub mod plant;
 pub mod plot;
 pub mod record;
 pub mod replay;
 pub mod ros;
 pub mod rotor;
 pub mod session;
+pub mod topics;
 pub mod transient;
 pub mod units;

@@ -211,8 +211,8 @@ fn parameters_are_set_over_the_bus_where_safe() {
     let expect = [
         "state_rate_hz:=50: set",
         "rc=0",
-        "state_rate_hz: Double(50.0)",
-        "model: String(\"nonlinear\")",
+        "state_rate_hz: Double value is: 50.0",
+        "model: String value is: nonlinear",
         "rc=0",
         "model:=linear: REFUSED: parameter model can only be set at start",
         "rc=1",

@@ -1,25 +1,10 @@
-//! `rotor-twin synth-bag`: writes a SYNTHETIC bag for trying the replay. A "plant" (the machine
-//! with a finer film grid and a changed lubricant viscosity, i.e. a model that is not the twin)
-//! is run through a speed profile with the nonlinear film; its probe displacements, with
-//! Gaussian noise, are recorded as a rig would record them, with the speed and the unbalance.
-//! The bag says in its metadata that it is synthetic and how it was made.
+//! `rotor-twin synth-bag`: writes a SYNTHETIC bag for trying the replay (the plant model and the
+//! bag are [`crate::plant`]'s).
 
-use crate::dynamics::{Coupling, StepInput, TwinConfig};
-use crate::messages::{self, Header, Time};
-use crate::record::{Recorder, TopicQos};
-use crate::replay::{PROBE_TOPIC, SPEED_TOPIC, UNBALANCE_TOPIC};
-use crate::rotor::{BearingModel, MachineDescription, Rotor};
-use crate::session::{Session, SessionSettings};
-use anyhow::Context;
+use crate::plant::{write_bag, PlantSpec, SpeedProfile};
+use crate::rotor::{MachineDescription, Rotor};
 use clap::Args;
-use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
-use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
-
-/// The bag's time zero: 2026-01-01T00:00:00Z (ns since the epoch), fixed so the bag is
-/// reproducible.
-const EPOCH_NS: i64 = 1_767_225_600_000_000_000;
 
 /// Arguments of `rotor-twin synth-bag`.
 #[derive(Debug, Args)]
@@ -67,7 +52,7 @@ pub struct SynthArgs {
     pub seed: u64,
 }
 
-/// Runs `rotor-twin synth-bag`.
+/// Runs `rotor-twin synth-bag`: checks the arguments, writes the bag, prints what it holds.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     for (name, v) in [
         ("--from-rpm", args.from_rpm),
@@ -90,142 +75,26 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         "--samples-per-rev {}: must be 4 to 1024",
         args.samples_per_rev
     );
-    let desc = match &args.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
-    let twin_rotor = Rotor::from_description(&desc);
-    // the plant: not the twin's model
-    let mut plant = twin_rotor.clone();
-    for b in &mut plant.bearings {
-        if let BearingModel::Film(f) = &mut b.model {
-            f.grid.n_theta = (f.grid.n_theta as f64 * args.grid_factor).round() as usize;
-            f.grid.n_z = (f.grid.n_z as f64 * args.grid_factor).round() as usize;
-            f.lubricant.viscosity_pa_s *= args.viscosity_factor;
-        }
-    }
-    let rpm = |t: f64| {
-        if t <= args.hold_start {
-            args.from_rpm
-        } else if t <= args.hold_start + args.ramp {
-            args.from_rpm + (args.to_rpm - args.from_rpm) * (t - args.hold_start) / args.ramp
-        } else {
-            args.to_rpm
-        }
-    };
-    let accel = |t: f64| {
-        if t > args.hold_start && t <= args.hold_start + args.ramp && args.ramp > 0.0 {
-            (args.to_rpm - args.from_rpm) / args.ramp * PI / 30.0
-        } else {
-            0.0
-        }
-    };
-    let total = args.hold_start + args.ramp + args.hold_end;
-    let config = TwinConfig {
+    let rotor = Rotor::from_description(&MachineDescription::load(args.config.as_deref())?);
+    let spec = PlantSpec {
+        profile: SpeedProfile {
+            from_rpm: args.from_rpm,
+            to_rpm: args.to_rpm,
+            hold_start_s: args.hold_start,
+            ramp_s: args.ramp,
+            hold_end_s: args.hold_end,
+        },
+        samples_per_rev: args.samples_per_rev,
+        noise_m: args.noise_um * 1e-6,
+        viscosity_factor: args.viscosity_factor,
+        grid_factor: args.grid_factor,
         film: args.film.into(),
-        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, plant.rated_speed_rad_s, 128)
+        seed: args.seed,
     };
-    let w0 = args.from_rpm * PI / 30.0;
-    let mut session = Session::new(&plant, config, w0, SessionSettings::default(), EPOCH_NS)
-        .context("starting the plant model")?;
-    let mut rec = Recorder::create(&args.out)?;
-    rec.set_custom_data("synthetic", "true");
-    rec.set_custom_data(
-        "made_by",
-        &format!(
-            "rotor-twin synth-bag {} (nonlinear film, {:?} evaluation, plant = machine '{}' with film grid ×{} and viscosity ×{}; {} samples/rev; noise {} µm RMS; seed {})",
-            env!("CARGO_PKG_VERSION"),
-            args.film,
-            twin_rotor.name,
-            args.grid_factor,
-            args.viscosity_factor,
-            args.samples_per_rev,
-            args.noise_um,
-            args.seed
-        ),
-    );
-    rec.set_custom_data(
-        "speed_profile",
-        &format!(
-            "{} rpm for {} s, ramp to {} rpm over {} s, hold {} s",
-            args.from_rpm, args.hold_start, args.to_rpm, args.ramp, args.hold_end
-        ),
-    );
-    let h_speed = rec.add_topic::<messages::RotorSpeed>(SPEED_TOPIC, TopicQos::reliable(100))?;
-    let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE_TOPIC, TopicQos::reliable(10))?;
-    let h_probe =
-        rec.add_topic::<messages::ProbeDisplacement>(PROBE_TOPIC, TopicQos::sensor(1000))?;
-    let stamp = |t: f64| EPOCH_NS + (t * 1e9).round() as i64;
-    let header = |ns: i64, frame: &str| Header {
-        stamp: Time::from_nanos(ns),
-        frame_id: frame.into(),
-    };
-    // the unbalance as the machine description gives it, once at the start
-    for (plane, u) in plant.unbalance.iter().enumerate() {
-        let m = messages::Unbalance {
-            header: header(EPOCH_NS, "rotor"),
-            plane: plane as u32,
-            magnitude: u.magnitude_kg_m,
-            phase: u.phase_rad,
-        };
-        rec.write(h_unb, &m, EPOCH_NS as u64, EPOCH_NS as u64)?;
-    }
-    let noise = Normal::new(0.0, args.noise_um * 1e-6)?;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
-    let stations: Vec<String> = plant.probes.iter().map(|p| p.name.clone()).collect();
-    let speed_period = 0.01;
-    let (mut next_speed, mut next_probe) = (0.0, 0.0);
-    let mut last_print = std::time::Instant::now();
-    while session.twin().time_s() < total {
-        // speed messages at 100 Hz and probe samples every 1/samples_per_rev revolution, each at
-        // its own time, from the plant's state interpolated within the step just taken
-        let now = session.twin().time_s();
-        while next_speed <= now {
-            let ns = stamp(next_speed);
-            let m = messages::RotorSpeed {
-                header: header(ns, "rotor"),
-                speed: rpm(next_speed) * PI / 30.0,
-                acceleration: accel(next_speed),
-            };
-            rec.write(h_speed, &m, ns as u64, ns as u64)?;
-            next_speed += speed_period;
-        }
-        while next_probe <= now {
-            let ns = stamp(next_probe);
-            for (k, name) in stations.iter().enumerate() {
-                if let Some(([x, y], _)) = session.predicted_probe(k, next_probe) {
-                    let m = messages::ProbeDisplacement {
-                        header: header(ns, name),
-                        station: name.clone(),
-                        x: x + noise.sample(&mut rng),
-                        y: y + noise.sample(&mut rng),
-                    };
-                    rec.write(h_probe, &m, ns as u64, ns as u64)?;
-                }
-            }
-            next_probe += TAU / (rpm(next_probe) * PI / 30.0) / args.samples_per_rev as f64;
-        }
-        let t_mid = now + 0.5 * config.time_step_s;
-        session
-            .step(
-                &StepInput {
-                    speed_rad_s: rpm(t_mid) * PI / 30.0,
-                    accel_rad_s2: accel(t_mid),
-                },
-                &mut |_| {},
-            )
-            .context("the plant model failed")?;
-        if last_print.elapsed().as_secs() >= 5 {
-            last_print = std::time::Instant::now();
-            eprintln!(
-                "synth-bag: {:.2} of {total:.2} s, {:.0} rpm",
-                session.twin().time_s(),
-                rpm(session.twin().time_s())
-            );
-        }
-    }
-    let counts = rec.counts();
-    let dir = rec.finish()?;
+    let total = spec.profile.duration_s();
+    let (dir, counts) = write_bag(&rotor, &spec, &args.out, &mut |t| {
+        eprintln!("synth-bag: {t:.2} of {total:.2} s")
+    })?;
     println!("wrote SYNTHETIC bag {}", dir.display());
     for (topic, n) in counts {
         println!("  {topic}: {n} messages");

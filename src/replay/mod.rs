@@ -11,22 +11,18 @@ mod report;
 pub use report::{OnsetReport, ReplayReport, StateChange, StationReport};
 
 use crate::bag::{Bag, BagMessage};
-use crate::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
-use crate::messages::{self, from_cdr, InstabilityWarning, RosMessage};
-use crate::record::{Recorder, TopicQos};
-use crate::ros::{check_probe, check_unbalance, SpeedGate, SpeedUnit};
+use crate::driver::{settings, Driver, DriverSettings, Fed, Input, SpeedUnit};
+use crate::dynamics::{Coupling, FilmEvaluation, TwinConfig};
+use crate::messages::{self, from_cdr, RosMessage};
+use crate::record::Recorder;
 use crate::rotor::Rotor;
-use crate::session::{margin, warning, Outgoing, Session, SessionSettings};
+use crate::session::{Outgoing, SessionSettings};
 use compare::{Sample, StationComparison};
 use std::path::PathBuf;
 use thiserror::Error;
 
 /// The twin's input topics (before remapping, the names the node uses).
-pub const SPEED_TOPIC: &str = "/rotor_twin/speed";
-/// Unbalance topic.
-pub const UNBALANCE_TOPIC: &str = "/rotor_twin/unbalance";
-/// Probe displacement topic (rotor_twin_msgs/ProbeDisplacement).
-pub const PROBE_TOPIC: &str = "/rotor_twin/probe";
+pub use crate::topics::{PROBE as PROBE_TOPIC, SPEED as SPEED_TOPIC, UNBALANCE as UNBALANCE_TOPIC};
 
 /// How to replay.
 #[derive(Debug, Clone)]
@@ -62,10 +58,10 @@ impl Default for ReplayOptions {
     fn default() -> Self {
         Self {
             coupling: Coupling::Nonlinear,
-            steps_per_rev: 64,
+            steps_per_rev: settings::DEFAULT_STEPS_PER_REV,
             film: FilmEvaluation::Table,
             session: SessionSettings::default(),
-            min_speed_rad_s: 100.0 * std::f64::consts::PI / 30.0,
+            min_speed_rad_s: crate::units::rpm_to_rad_s(settings::DEFAULT_MIN_SPEED_RPM),
             remaps: Vec::new(),
             speed_unit: SpeedUnit::Rpm,
             probe_points: Vec::new(),
@@ -73,6 +69,30 @@ impl Default for ReplayOptions {
             duration_s: None,
             out_bag: None,
             max_gap_s: 5.0,
+        }
+    }
+}
+
+impl ReplayOptions {
+    /// The driver's settings for a twin of `rotor`: the node's defaults where the options say
+    /// nothing. Speed stamps are not checked (bags from other tools stamp on other clocks; the
+    /// receive time orders the samples); probe stamps off the bag's clock fall back to the
+    /// receive time.
+    pub fn driver_settings(&self, rotor: &Rotor) -> DriverSettings {
+        DriverSettings {
+            twin: TwinConfig {
+                film: self.film,
+                ..TwinConfig::with_steps_per_rev(
+                    self.coupling,
+                    rotor.rated_speed_rad_s,
+                    self.steps_per_rev,
+                )
+            },
+            session: self.session,
+            min_speed_rad_s: self.min_speed_rad_s,
+            max_gap_s: self.max_gap_s,
+            check_speed_stamps: false,
+            ..DriverSettings::new(Default::default(), self.film, rotor.rated_speed_rad_s)
         }
     }
 }
@@ -131,14 +151,6 @@ pub fn replay(
     let wall = std::time::Instant::now();
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
     let roles = map_topics(bag, options, &stations)?;
-    let config = TwinConfig {
-        film: options.film,
-        ..TwinConfig::with_steps_per_rev(
-            options.coupling,
-            rotor.rated_speed_rad_s,
-            options.steps_per_rev,
-        )
-    };
     let clearance = rotor
         .bearings
         .iter()
@@ -155,7 +167,6 @@ pub fn replay(
         Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
         None => None,
     };
-    let threshold = crate::session::linear_threshold(rotor);
     let Some((t0, t_last)) = bag.time_span_ns() else {
         return Ok((
             ReplayReport::empty(bag, wall.elapsed().as_secs_f64()),
@@ -168,165 +179,48 @@ pub fn replay(
     };
     let mut report = ReplayReport::empty(bag, 0.0);
     report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
-    let mut gate = SpeedGate::new(10.0 * rotor.rated_speed_rad_s, f64::INFINITY);
-    let mut speed: Option<(f64, f64)> = None;
-    // the latest accepted unbalance per plane (m·e kg·m, phase rad), applied to every (re)start
-    let mut unbalance: Vec<Option<(f64, f64)>> = vec![None; rotor.unbalance.len()];
-    let mut session: Option<Session> = None;
-    let mut next_margin_ns = t0;
+    let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
+    driver.set_threshold(crate::session::linear_threshold(rotor));
     let mut emitted: Vec<Outgoing> = Vec::new();
     let mut last_progress = std::time::Instant::now();
-    let mut last_ns = t0 as i64;
+    let since_t0 = |t_ns: i64| (t_ns - t0 as i64) as f64 * 1e-9;
     for m in &bag.messages {
         if m.log_time_ns > t_end {
             break;
         }
         let t_ns = m.log_time_ns.min(i64::MAX as u64) as i64;
-        if t_ns - last_ns > (options.max_gap_s * 1e9) as i64 && session.is_some() {
-            session = None;
-            emitted.push(warning(
-                t_ns,
-                InstabilityWarning::WARN,
-                "stale_input",
-                "",
-                format!(
-                    "a gap of {:.3} s in the bag (over {} s): the twin restarts at the next speed message",
-                    (t_ns - last_ns) as f64 * 1e-9,
-                    options.max_gap_s
-                ),
-            ));
-        }
-        last_ns = t_ns;
-        // the twin up to this message's time
-        if let (Some(s), Some((w, a))) = (session.as_mut(), speed) {
-            let input = StepInput {
-                speed_rad_s: w,
-                accel_rad_s2: a,
-            };
-            while s.stamp_ns() < t_ns {
-                if let Err(e) = s.step(&input, &mut |o| emitted.push(o)) {
-                    emitted.push(warning(
-                        s.stamp_ns(),
-                        InstabilityWarning::ERROR,
-                        "model_failure",
-                        "",
-                        format!("step failed: {e}; the twin restarts at the next speed message"),
-                    ));
-                    session = None;
-                    break;
-                }
-            }
-        }
         report.messages_in += 1;
-        let role = roles[m.topic];
-        let rejected = match role {
-            Role::SpeedRotor | Role::SpeedFloat => {
-                let decoded = if role == Role::SpeedRotor {
-                    from_cdr::<messages::RotorSpeed>(bag.payload(m))
-                        .map(|v| (v.speed, v.acceleration))
-                } else {
-                    from_cdr::<messages::Float64>(bag.payload(m))
-                        .map(|v| (options.speed_unit.to_rad_s(v.data), 0.0))
-                };
-                match decoded.and_then(|(w, a)| gate.check(w, a, 0, t_ns)) {
-                    Ok((w, a)) => {
-                        speed = Some((w, a));
-                        if w < options.min_speed_rad_s {
-                            session = None;
-                        } else if session.is_none() {
-                            match Session::new(rotor, config, w, options.session, t_ns) {
-                                Ok(mut s) => {
-                                    for (plane, u) in unbalance.iter().enumerate() {
-                                        if let Some((me, phase)) = *u {
-                                            let _ = s.twin_mut().set_unbalance(plane, me, phase);
-                                        }
-                                    }
-                                    report.note_start(
-                                        (t_ns - t0 as i64) as f64 * 1e-9,
-                                        w * 30.0 / std::f64::consts::PI,
-                                    );
-                                    session = Some(s);
-                                }
-                                Err(e) => emitted.push(warning(
-                                    t_ns,
-                                    InstabilityWarning::ERROR,
-                                    "bad_input",
-                                    "",
-                                    format!("cannot start the twin at {w:.1} rad/s: {e}"),
-                                )),
-                            }
-                        }
-                        None
+        let topic = &bag.topics[m.topic].name;
+        match decode(roles[m.topic], bag.payload(m), options.speed_unit) {
+            Ok(None) => driver.advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o)),
+            Ok(Some(input)) => {
+                match driver.feed(t_ns, input, &mut |o| emitted.push(o)) {
+                    Fed::Started { speed_rad_s } => {
+                        report.note_start(since_t0(t_ns), crate::units::rad_s_to_rpm(speed_rad_s))
                     }
-                    Err(why) => Some(why),
-                }
-            }
-            Role::Unbalance => match from_cdr::<messages::Unbalance>(bag.payload(m))
-                .and_then(|u| check_unbalance(u.plane, u.magnitude, u.phase, rotor.unbalance.len()))
-            {
-                Ok((plane, me, phase)) => {
-                    unbalance[plane] = Some((me, phase));
-                    if let Some(s) = session.as_mut() {
-                        let _ = s.twin_mut().set_unbalance(plane, me, phase);
-                    }
-                    None
-                }
-                Err(why) => Some(why),
-            },
-            Role::Probe | Role::ProbePoint(_) => {
-                let decoded = match role {
-                    Role::ProbePoint(k) => from_cdr::<messages::PointStamped>(bag.payload(m))
-                        .map(|p| (k, p.point.x, p.point.y)),
-                    _ => from_cdr::<messages::ProbeDisplacement>(bag.payload(m)).and_then(|p| {
-                        stations
-                            .iter()
-                            .position(|s| *s == p.station)
-                            .map(|k| (k, p.x, p.y))
-                            .ok_or_else(|| {
-                                format!("probe station '{}' is not in the machine", p.station)
-                            })
+                    Fed::Compared(c) => comparisons[c.station].push(Sample {
+                        time_s: since_t0(c.time_ns),
+                        angle_rad: c.angle_rad,
+                        speed_rad_s: c.speed_rad_s,
+                        measured_m: c.measured_m,
+                        predicted_m: c.predicted_m,
                     }),
-                };
-                match decoded.and_then(|(k, x, y)| check_probe(x, y).map(|(x, y)| (k, x, y))) {
-                    Ok((k, x, y)) => {
-                        if let Some(s) = session.as_ref() {
-                            if let Some(r) = s.residual(k, [x, y], t_ns) {
-                                let time_s = (t_ns - s.epoch_ns()) as f64 * 1e-9;
-                                let (_, angle) = s.predicted_probe(k, time_s).unwrap_or_default();
-                                comparisons[k].push(Sample {
-                                    time_s: (t_ns - t0 as i64) as f64 * 1e-9,
-                                    angle_rad: angle,
-                                    speed_rad_s: s.twin().output().speed_rad_s,
-                                    measured_m: [x, y],
-                                    predicted_m: [r.predicted_x, r.predicted_y],
-                                });
-                                emitted.push(Outgoing::Residual(r));
-                            }
-                        }
-                        None
-                    }
-                    Err(why) => Some(why),
+                    Fed::Refused(why) => report.note_rejection(topic, &why),
+                    Fed::Taken | Fed::Unused => {}
                 }
+                0
             }
-            Role::Other => None,
+            Err(why) => {
+                let why = format!("{topic}: {why}");
+                driver.advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o));
+                driver.refuse(t_ns, &why, &mut |o| emitted.push(o));
+                report.note_rejection(topic, &why);
+                0
+            }
         };
-        if let Some(why) = rejected {
-            report.note_rejection(&bag.topics[m.topic].name, &why);
-            emitted.push(warning(
-                t_ns,
-                InstabilityWarning::WARN,
-                "bad_input",
-                "",
-                format!("{}: {why}", bag.topics[m.topic].name),
-            ));
-        }
-        if let (Some((w, _)), true) = (speed, t_ns >= next_margin_ns as i64) {
-            emitted.push(Outgoing::Margin(margin(t_ns, w, threshold)));
-            next_margin_ns = t_ns as u64 + 1_000_000_000;
-        }
         // the report and the output bag
         for o in emitted.drain(..) {
-            report.note_output(&o, t0, &session);
+            report.note_output(&o, t0, driver.session_slot());
             if let Some(out) = out.as_mut() {
                 out.write_outgoing(&o)?;
             }
@@ -352,6 +246,19 @@ pub fn replay(
         report.messages_out = out.finish()?;
     }
     Ok((report, comparisons))
+}
+
+/// The twin's input in a bag message of role `role` (None: a topic the twin does not use), or
+/// why it cannot be decoded.
+fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, String> {
+    Ok(Some(match role {
+        Role::SpeedRotor => Input::from(&from_cdr::<messages::RotorSpeed>(payload)?),
+        Role::SpeedFloat => Input::speed_value(from_cdr::<messages::Float64>(payload)?.data, unit),
+        Role::Unbalance => Input::from(&from_cdr::<messages::Unbalance>(payload)?),
+        Role::Probe => Input::from(&from_cdr::<messages::ProbeDisplacement>(payload)?),
+        Role::ProbePoint(k) => Input::probe_point(&from_cdr::<messages::PointStamped>(payload)?, k),
+        Role::Other => return Ok(None),
+    }))
 }
 
 /// Checks, before anything is written, that `bag` can drive a twin of `rotor` with `options`:
@@ -482,24 +389,20 @@ impl OutputBag {
                     &t.type_name,
                     &t.schema_encoding,
                     &t.schema,
-                    TopicQos::reliable(100),
+                    crate::topics::INPUT_RECORDED,
                 )?)
             });
         }
-        let state = TopicQos::reliable(10);
+        use crate::topics;
         Ok(Self {
-            journal: rec.add_topic::<messages::JournalState>("/rotor_twin/journal_state", state)?,
-            film: rec.add_topic::<messages::FilmState>("/rotor_twin/film_state", state)?,
-            orbit: rec.add_topic::<messages::Orbit>("/rotor_twin/orbit", state)?,
-            warning: rec.add_topic::<messages::InstabilityWarning>(
-                "/rotor_twin/warning",
-                TopicQos::latched(10),
-            )?,
-            residual: rec.add_topic::<messages::OrbitResidual>("/rotor_twin/residual", state)?,
-            margin: rec.add_topic::<messages::StabilityMargin>(
-                "/rotor_twin/stability_margin",
-                TopicQos::latched(1),
-            )?,
+            journal: rec.add_topic::<messages::JournalState>(topics::JOURNAL, topics::STATE)?,
+            film: rec.add_topic::<messages::FilmState>(topics::FILM, topics::STATE)?,
+            orbit: rec.add_topic::<messages::Orbit>(topics::ORBIT, topics::STATE)?,
+            warning: rec
+                .add_topic::<messages::InstabilityWarning>(topics::WARNING, topics::WARNING_QOS)?,
+            residual: rec.add_topic::<messages::OrbitResidual>(topics::RESIDUAL, topics::STATE)?,
+            margin: rec
+                .add_topic::<messages::StabilityMargin>(topics::MARGIN, topics::MARGIN_QOS)?,
             rec,
             inputs,
         })

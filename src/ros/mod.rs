@@ -3,33 +3,38 @@
 //!
 //! Topics (names remappable with `-r from:=to`; QoS stated per topic):
 //! - in  `/rotor_twin/speed` rotor_twin_msgs/RotorSpeed, or std_msgs/Float64 with `speed_type:=float64`
-//!   (unit `speed_unit`), reliable, keep last 100;
-//! - in  `/rotor_twin/unbalance` rotor_twin_msgs/Unbalance, reliable, keep last 100;
-//! - in  `/rotor_twin/probe` rotor_twin_msgs/ProbeDisplacement (m), reliable, keep last 100;
+//!   (unit `speed_unit`), best effort (matches best-effort and reliable publishers);
+//! - in  `/rotor_twin/unbalance` rotor_twin_msgs/Unbalance, reliable;
+//! - in  `/rotor_twin/probe` rotor_twin_msgs/ProbeDisplacement (m), best effort;
 //!   out `/rotor_twin/residual` OrbitResidual: predicted minus measured at that station;
 //! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
 //!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz;
+//! (every QoS in [`crate::topics`]). The subscriptions only decode and queue, stamped with the
+//! receive time on the node's clock; the model thread feeds the queue to the shared
+//! [`crate::driver::Driver`], which checks and applies each input.
 //! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
 //!   outputs are stamped in simulation time.
 
-mod inputs;
-mod model;
+pub mod model;
 mod param_client;
 mod params;
 mod recording;
 
-pub use inputs::{check_probe, check_unbalance, SpeedGate};
 pub use param_client::{run as param_call, ParamCall};
-pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedUnit, RUNTIME_PARAMETERS};
+pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedType, SpeedUnit, RUNTIME_PARAMETERS};
 
+use crate::driver::Input;
 use crate::messages::{self, RosMessage};
 use crate::record::TopicQos;
 use crate::rotor::{MachineDescription, Rotor};
+use crate::topics::{
+    CLOCK, DIAGNOSTICS, FILM, JOURNAL, MARGIN, ORBIT, PROBE, RESIDUAL, SPEED, UNBALANCE, WARNING,
+};
 use anyhow::Context as _;
 use futures::StreamExt;
-use model::{now_ns, Inputs, Outgoing};
+use model::{now_ns, Inbox, NodeClock, Outgoing};
 use recording::ToRecord;
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, ParameterValue,
@@ -37,7 +42,6 @@ use ros2_client::{
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
-use std::time::Instant;
 
 /// Everything `rotor-twin node` needs.
 #[derive(Debug, Clone)]
@@ -49,17 +53,6 @@ pub struct NodeSetup {
     /// Arguments after `--ros-args`.
     pub ros_args: Vec<String>,
 }
-
-const SPEED: &str = "/rotor_twin/speed";
-const UNBALANCE: &str = "/rotor_twin/unbalance";
-const PROBE: &str = "/rotor_twin/probe";
-const RESIDUAL: &str = "/rotor_twin/residual";
-const MARGIN: &str = "/rotor_twin/stability_margin";
-const JOURNAL: &str = "/rotor_twin/journal_state";
-const FILM: &str = "/rotor_twin/film_state";
-const ORBIT: &str = "/rotor_twin/orbit";
-const WARNING: &str = "/rotor_twin/warning";
-const DIAGNOSTICS: &str = "/diagnostics";
 
 fn qos_profile(q: TopicQos) -> ros2_client::QosProfile {
     use ros2_client::qos::{Durability, History, Reliability, WhenFull};
@@ -121,6 +114,28 @@ fn discovery_localhost_only() -> anyhow::Result<bool> {
     })
 }
 
+/// Largest ROS domain id (REP 2000 / the ROS 2 docs: 0–232 with Fast DDS and Cyclone's port
+/// mapping; higher ids map to ports beyond 65535).
+pub const MAX_DOMAIN_ID: u16 = 232;
+
+/// ROS_DOMAIN_ID (default 0), checked against [`MAX_DOMAIN_ID`].
+fn domain_id() -> anyhow::Result<u16> {
+    match std::env::var("ROS_DOMAIN_ID") {
+        Ok(v) if !v.trim().is_empty() => {
+            let id: u16 = v
+                .trim()
+                .parse()
+                .with_context(|| format!("ROS_DOMAIN_ID '{v}' is not a domain number"))?;
+            anyhow::ensure!(
+                id <= MAX_DOMAIN_ID,
+                "ROS_DOMAIN_ID {id}: must be 0 to {MAX_DOMAIN_ID}"
+            );
+            Ok(id)
+        }
+        _ => Ok(0),
+    }
+}
+
 /// Runs the node until SIGINT or SIGTERM.
 pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
@@ -128,24 +143,17 @@ pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     for (k, v) in &ros.params {
         params.set(k, v).map_err(anyhow::Error::msg)?;
     }
-    let desc = match &setup.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
+    let desc = MachineDescription::load(setup.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
-    if params.film == "table" && params.model != "linear" {
+    if params.film == crate::dynamics::FilmEvaluation::Table
+        && params.model != crate::driver::ModelKind::Linear
+    {
         // the film tables are built before the node joins the bus, so that the first speed
         // starts the twin at once
         eprintln!("rotor_twin: tabulating the bearing films…");
         crate::dynamics::prepare_film_tables(&rotor)?;
     }
-    let domain: u16 = match std::env::var("ROS_DOMAIN_ID") {
-        Ok(v) if !v.trim().is_empty() => v
-            .trim()
-            .parse()
-            .with_context(|| format!("ROS_DOMAIN_ID '{v}' is not a domain number"))?,
-        _ => 0,
-    };
+    let domain = domain_id()?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
@@ -160,122 +168,19 @@ async fn run_async(
     rotor: Rotor,
     domain: u16,
 ) -> anyhow::Result<()> {
-    let context = if discovery_localhost_only()? {
-        // only the loopback interface for multicast and advertised locators
-        let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(domain)
-            .with_only_networks([std::net::IpAddr::from([127, 0, 0, 1])])
-            .build()
-            .map_err(|e| anyhow::anyhow!("DDS participant: {e:?}"))?;
-        Context::from_domain_participant(participant)
-    } else {
-        Context::with_options(ContextOptions::new().domain_id(domain))
-    }
-    .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))?;
+    let context = dds_context(domain)?;
     // parameters that may change at run time are shared with the model thread
-    let live_params = Arc::new(Mutex::new(params.clone()));
-    let params_version = Arc::new(std::sync::atomic::AtomicU64::new(0));
-    let text_of = |v: &ParameterValue| -> Option<String> {
-        match v {
-            ParameterValue::Double(d) => Some(d.to_string()),
-            ParameterValue::Integer(i) => Some(i.to_string()),
-            ParameterValue::Boolean(b) => Some(b.to_string()),
-            ParameterValue::String(s) => Some(s.clone()),
-            _ => None,
-        }
-    };
-    let validator_params = live_params.clone();
-    let action_params = live_params.clone();
-    let action_version = params_version.clone();
-    let mut options = NodeOptions::new()
-        .enable_rosout(false)
-        .parameter_validator(Box::new(move |name, value| {
-            let text =
-                text_of(value).ok_or_else(|| format!("parameter {name}: unsupported type"))?;
-            let mut trial = validator_params
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .clone();
-            trial.set_at_runtime(name, &text)
-        }))
-        .parameter_set_action(Box::new(move |name, value| {
-            let text =
-                text_of(value).ok_or_else(|| format!("parameter {name}: unsupported type"))?;
-            action_params
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .set_at_runtime(name, &text)?;
-            action_version.fetch_add(1, Ordering::SeqCst);
-            Ok(())
-        }));
-    for (name, value) in [
-        ("model", ParameterValue::String(params.model.clone())),
-        ("delta", ParameterValue::Double(params.delta)),
-        ("film", ParameterValue::String(params.film.clone())),
-        (
-            "steps_per_rev",
-            ParameterValue::Integer(params.steps_per_rev as i64),
-        ),
-        (
-            "state_rate_hz",
-            ParameterValue::Double(params.state_rate_hz),
-        ),
-        (
-            "pressure_map_rate_hz",
-            ParameterValue::Double(params.pressure_map_rate_hz),
-        ),
-        (
-            "input_timeout_s",
-            ParameterValue::Double(params.input_timeout_s),
-        ),
-        (
-            "min_speed_rpm",
-            ParameterValue::Double(params.min_speed_rpm),
-        ),
-        (
-            "speed_type",
-            ParameterValue::String(params.speed_type.clone()),
-        ),
-        ("use_sim_time", ParameterValue::Boolean(params.use_sim_time)),
-        (
-            "warning_amplitude_ratio",
-            ParameterValue::Double(params.warning_amplitude_ratio),
-        ),
-    ] {
-        options = options.declare_parameter(name, value);
-    }
+    let live: model::LiveParams = (
+        Arc::new(Mutex::new(params.clone())),
+        Arc::new(std::sync::atomic::AtomicU64::new(0)),
+    );
     let mut node = context
         .new_node(
             NodeName::new("/", "rotor_twin").map_err(|e| anyhow::anyhow!("{e:?}"))?,
-            options,
+            node_options(&params, &live),
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
-    let input_qos = TopicQos::reliable(100);
-    // subscriptions keep a deep history: RustDDS drops unread samples beyond it silently, and a
-    // burst of 10,000 messages must not lose any
-    let reader_qos = qos_profile(TopicQos::reliable(20_000));
-    let state_qos = TopicQos::reliable(10);
-    let warning_qos = TopicQos::latched(1);
-
-    macro_rules! publisher {
-        ($ty:ty, $name:expr, $qos:expr) => {{
-            let topic = node
-                .create_topic(
-                    &topic_name(&ros.remaps, $name)?,
-                    type_name::<$ty>(),
-                    &qos_profile($qos),
-                )
-                .map_err(|e| anyhow::anyhow!("topic {}: {e:?}", $name))?;
-            node.create_publisher::<$ty>(&topic, None)
-                .map_err(|e| anyhow::anyhow!("publisher {}: {e:?}", $name))?
-        }};
-    }
-    let pub_journal = publisher!(messages::JournalState, JOURNAL, state_qos);
-    let pub_film = publisher!(messages::FilmState, FILM, state_qos);
-    let pub_orbit = publisher!(messages::Orbit, ORBIT, state_qos);
-    let pub_warning = publisher!(messages::InstabilityWarning, WARNING, warning_qos);
-    let pub_diag = publisher!(messages::DiagnosticArray, DIAGNOSTICS, state_qos);
-    let pub_residual = publisher!(messages::OrbitResidual, RESIDUAL, state_qos);
-    let pub_margin = publisher!(messages::StabilityMargin, MARGIN, TopicQos::latched(1));
+    let publishers = Publishers::create(&mut node, &ros)?;
 
     // recording
     let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
@@ -283,12 +188,8 @@ async fn run_async(
     let recorder_thread = match &setup.record {
         Some(dir) => Some(recording::spawn(
             dir,
-            params.speed_type == "float64",
-            recording::Qos {
-                input: input_qos,
-                state: state_qos,
-                warning: warning_qos,
-            },
+            params.speed_type == SpeedType::Float64,
+            &params.probe_point_topics,
             rec_rx,
             stop.clone(),
         )?),
@@ -297,285 +198,32 @@ async fn run_async(
             None
         }
     };
-    let recording = setup.record.is_some();
+    let rec = setup.record.is_some().then(|| rec_tx.clone());
+    drop(rec_tx);
 
     // the model thread and the publishing thread
-    let inputs = Arc::new(Mutex::new(Inputs::default()));
+    let inbox = Arc::new(Mutex::new(Inbox::default()));
+    let clock = Arc::new(NodeClock {
+        sim: params.use_sim_time,
+        ..NodeClock::default()
+    });
     let (out_tx, out_rx) = mpsc::sync_channel::<Outgoing>(4096);
-    let model_thread = {
-        let (inputs, stop) = (inputs.clone(), stop.clone());
-        let params = params.clone();
-        let live = (live_params.clone(), params_version.clone());
-        std::thread::Builder::new()
-            .name("rotor_twin model".into())
-            .spawn(move || model::run(rotor.clone(), params, live, inputs, out_tx, stop))?
-    };
-    let rec_out = rec_tx.clone();
-    let publish_thread = std::thread::Builder::new()
-        .name("rotor_twin publish".into())
-        .spawn(move || {
-            for item in out_rx {
-                let t = now_ns();
-                let _sent = match &item {
-                    // a full send window drops the sample (never block the model)
-                    Outgoing::Journal(m) => pub_journal.publish(m.clone()).is_ok(),
-                    Outgoing::Film(m) => pub_film.publish(m.clone()).is_ok(),
-                    Outgoing::Orbit(m) => pub_orbit.publish(m.clone()).is_ok(),
-                    Outgoing::Warning(m) => pub_warning.publish(m.clone()).is_ok(),
-                    Outgoing::Diagnostics(m) => pub_diag.publish(m.clone()).is_ok(),
-                    Outgoing::Residual(m) => pub_residual.publish(m.clone()).is_ok(),
-                    Outgoing::Margin(m) => pub_margin.publish(m.clone()).is_ok(),
-                };
-                if recording {
-                    let _ = rec_out.try_send(ToRecord::Out(item, t));
-                }
-            }
-        })?;
+    let model = model::ModelLoop::new(
+        rotor.clone(),
+        params.clone(),
+        live,
+        inbox.clone(),
+        clock.clone(),
+    );
+    let model_stop = stop.clone();
+    let model_thread = std::thread::Builder::new()
+        .name("rotor_twin model".into())
+        .spawn(move || model.run(out_tx, model_stop))?;
+    let publish_thread = publishers.spawn(out_rx, rec.clone())?;
 
-    // subscriptions
-    let max_speed = 10.0
-        * crate::units::rpm_to_rad_s(MachineDescription::builtin_default().rated_speed_rpm)
-            .max(1.0);
-    let gate = Arc::new(Mutex::new(SpeedGate::new(
-        max_speed,
-        params.input_timeout_s,
-    )));
-    let reject = |inputs: &Arc<Mutex<Inputs>>, why: String| {
-        let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
-        g.rejected += 1;
-        g.last_rejection = why;
-    };
-    let speed_topic = topic_name(&ros.remaps, SPEED)?;
-    if params.speed_type == "float64" {
-        let topic = node
-            .create_topic(
-                &speed_topic,
-                type_name::<messages::Float64>(),
-                &qos_profile(input_qos),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::Float64>(&topic, Some(reader_qos.clone()))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let (inputs, gate, rec, unit) = (
-            inputs.clone(),
-            gate.clone(),
-            rec_tx.clone(),
-            params.speed_unit,
-        );
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                let now = now_ns();
-                if recording {
-                    let _ = rec.try_send(ToRecord::Speed64(m, now));
-                }
-                let checked = gate.lock().unwrap_or_else(|e| e.into_inner()).check(
-                    unit.to_rad_s(m.data),
-                    0.0,
-                    0,
-                    now,
-                );
-                match checked {
-                    Ok((w, a)) => {
-                        inputs.lock().unwrap_or_else(|e| e.into_inner()).speed =
-                            Some((w, a, Instant::now()))
-                    }
-                    Err(why) => reject(&inputs, why),
-                }
-            }
-        });
-    } else {
-        let topic = node
-            .create_topic(
-                &speed_topic,
-                type_name::<messages::RotorSpeed>(),
-                &qos_profile(input_qos),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::RotorSpeed>(&topic, Some(reader_qos.clone()))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let (inputs, gate, rec) = (inputs.clone(), gate.clone(), rec_tx.clone());
-        let sim_time = params.use_sim_time;
-        let live = live_params.clone();
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                let now = now_ns();
-                // stamps are judged against the clock the node follows
-                let clock_now = if sim_time {
-                    let sim = inputs.lock().unwrap_or_else(|e| e.into_inner()).sim_time_ns;
-                    sim.unwrap_or(m.header.stamp.as_nanos())
-                } else {
-                    now
-                };
-                let timeout_s = live
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .input_timeout_s;
-                let mut g = gate.lock().unwrap_or_else(|e| e.into_inner());
-                g.timeout_ns = (timeout_s * 1e9) as i64;
-                let checked = g.check(
-                    m.speed,
-                    m.acceleration,
-                    m.header.stamp.as_nanos(),
-                    clock_now,
-                );
-                drop(g);
-                if recording {
-                    let _ = rec.try_send(ToRecord::Speed(m, now));
-                }
-                match checked {
-                    Ok((w, a)) => {
-                        inputs.lock().unwrap_or_else(|e| e.into_inner()).speed =
-                            Some((w, a, Instant::now()))
-                    }
-                    Err(why) => reject(&inputs, why),
-                }
-            }
-        });
-    }
-    {
-        let topic = node
-            .create_topic(
-                &topic_name(&ros.remaps, UNBALANCE)?,
-                type_name::<messages::Unbalance>(),
-                &qos_profile(input_qos),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::Unbalance>(&topic, Some(reader_qos.clone()))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let (inputs, rec) = (inputs.clone(), rec_tx.clone());
-        let planes = desc_planes(&setup)?;
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                if recording {
-                    let _ = rec.try_send(ToRecord::Unbalance(m.clone(), now_ns()));
-                }
-                match check_unbalance(m.plane, m.magnitude, m.phase, planes) {
-                    Ok(u) => inputs
-                        .lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .unbalance
-                        .push(u),
-                    Err(why) => reject(&inputs, why),
-                }
-            }
-        });
-    }
-    {
-        let topic = node
-            .create_topic(
-                &topic_name(&ros.remaps, PROBE)?,
-                type_name::<messages::ProbeDisplacement>(),
-                &qos_profile(input_qos),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::ProbeDisplacement>(&topic, Some(reader_qos.clone()))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let (inputs, rec) = (inputs.clone(), rec_tx.clone());
-        let stations = desc_stations(&setup)?;
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                let now = now_ns();
-                if recording {
-                    let _ = rec.try_send(ToRecord::Probe(m.clone(), now));
-                }
-                let station = stations.iter().position(|s| *s == m.station);
-                match (station, check_probe(m.x, m.y)) {
-                    (Some(k), Ok((x, y))) => {
-                        let stamp = m.header.stamp.as_nanos();
-                        inputs
-                            .lock()
-                            .unwrap_or_else(|e| e.into_inner())
-                            .push_probe(k, x, y, stamp, now);
-                    }
-                    (None, _) => reject(
-                        &inputs,
-                        format!(
-                            "probe station '{}' is not in the machine description",
-                            m.station
-                        ),
-                    ),
-                    (_, Err(why)) => reject(&inputs, why),
-                }
-            }
-        });
-    }
-    // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
-    let stations = desc_stations(&setup)?;
-    for (station, topic_text) in &params.probe_point_topics {
-        let k = stations
-            .iter()
-            .position(|s| s == station)
-            .ok_or_else(|| anyhow::anyhow!("parameter probe_point_topics: station '{station}' is not in the machine description"))?;
-        let name = Name::parse(topic_text)
-            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
-        let topic = node
-            .create_topic(
-                &name,
-                type_name::<messages::PointStamped>(),
-                &qos_profile(input_qos),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::PointStamped>(&topic, Some(reader_qos.clone()))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let inputs = inputs.clone();
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                match check_probe(m.point.x, m.point.y) {
-                    Ok((x, y)) => {
-                        let stamp = m.header.stamp.as_nanos();
-                        inputs.lock().unwrap_or_else(|e| e.into_inner()).push_probe(
-                            k,
-                            x,
-                            y,
-                            stamp,
-                            now_ns(),
-                        );
-                    }
-                    Err(why) => reject(&inputs, why),
-                }
-            }
-        });
-    }
-    if params.use_sim_time {
-        // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
-        let topic = node
-            .create_topic(
-                &topic_name(&ros.remaps, "/clock")?,
-                type_name::<messages::Clock>(),
-                &qos_profile(TopicQos::sensor(1)),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let sub = node
-            .create_subscription::<messages::Clock>(&topic, Some(qos_profile(TopicQos::sensor(10))))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        let inputs = inputs.clone();
-        tokio::spawn(async move {
-            let mut stream = Box::pin(sub.async_stream());
-            while let Some(Ok((m, _info))) = stream.next().await {
-                let ns = m.clock.as_nanos();
-                let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
-                // simulation time never runs backwards
-                if g.sim_time_ns.is_none_or(|t| ns >= t) {
-                    g.sim_time_ns = Some(ns);
-                } else {
-                    g.rejected += 1;
-                    g.last_rejection =
-                        format!("/clock went backwards to {:.6} s", ns as f64 * 1e-9);
-                }
-            }
-        });
-    }
-    drop(rec_tx);
+    let route = InputRoute { inbox, clock, rec };
+    subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
+    drop(route);
     let spinner = node
         .spinner()
         .map_err(|e| anyhow::anyhow!("spinner: {e:?}"))?;
@@ -610,6 +258,242 @@ async fn run_async(
     Ok(())
 }
 
+/// The DDS context on `domain`: on the loopback interface only when the environment asks for
+/// discovery on this host.
+fn dds_context(domain: u16) -> anyhow::Result<Context> {
+    if discovery_localhost_only()? {
+        // only the loopback interface for multicast and advertised locators
+        let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(domain)
+            .with_only_networks([std::net::IpAddr::from([127, 0, 0, 1])])
+            .build()
+            .map_err(|e| anyhow::anyhow!("DDS participant: {e:?}"))?;
+        Context::from_domain_participant(participant)
+    } else {
+        Context::with_options(ContextOptions::new().domain_id(domain))
+    }
+    .map_err(|e| anyhow::anyhow!("DDS context: {e:?}"))
+}
+
+/// A parameter value as the text [`NodeParams::set`] reads.
+fn parameter_text(v: &ParameterValue) -> Option<String> {
+    match v {
+        ParameterValue::Double(d) => Some(d.to_string()),
+        ParameterValue::Integer(i) => Some(i.to_string()),
+        ParameterValue::Boolean(b) => Some(b.to_string()),
+        ParameterValue::String(s) => Some(s.clone()),
+        _ => None,
+    }
+}
+
+/// The node's options: every parameter declared with its value, changes at run time checked
+/// by [`NodeParams::set_at_runtime`] and handed to the model thread through `live`.
+fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
+    let validator_params = live.0.clone();
+    let (action_params, action_version) = (live.0.clone(), live.1.clone());
+    let mut options = NodeOptions::new()
+        .enable_rosout(false)
+        .parameter_validator(Box::new(move |name, value| {
+            let text = parameter_text(value)
+                .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
+            let mut trial = validator_params
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .clone();
+            trial.set_at_runtime(name, &text)
+        }))
+        .parameter_set_action(Box::new(move |name, value| {
+            let text = parameter_text(value)
+                .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
+            action_params
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .set_at_runtime(name, &text)?;
+            action_version.fetch_add(1, Ordering::SeqCst);
+            Ok(())
+        }));
+    let probe_points = params
+        .probe_point_topics
+        .iter()
+        .map(|(s, t)| format!("{s}={t}"))
+        .collect::<Vec<_>>()
+        .join(",");
+    let text = |s: String| ParameterValue::String(s);
+    for (name, value) in [
+        ("model", text(params.model.to_string())),
+        ("delta", ParameterValue::Double(params.delta)),
+        ("film", text(params.film_text().into())),
+        (
+            "steps_per_rev",
+            ParameterValue::Integer(params.steps_per_rev as i64),
+        ),
+        (
+            "state_rate_hz",
+            ParameterValue::Double(params.state_rate_hz),
+        ),
+        (
+            "pressure_map_rate_hz",
+            ParameterValue::Double(params.pressure_map_rate_hz),
+        ),
+        (
+            "input_timeout_s",
+            ParameterValue::Double(params.input_timeout_s),
+        ),
+        (
+            "min_speed_rpm",
+            ParameterValue::Double(params.min_speed_rpm),
+        ),
+        ("speed_type", text(params.speed_type.to_string())),
+        ("speed_unit", text(params.speed_unit.to_string())),
+        ("probe_point_topics", text(probe_points)),
+        ("use_sim_time", ParameterValue::Boolean(params.use_sim_time)),
+        (
+            "warning_amplitude_ratio",
+            ParameterValue::Double(params.warning_amplitude_ratio),
+        ),
+    ] {
+        options = options.declare_parameter(name, value);
+    }
+    options
+}
+
+/// The node's publishers, one per output topic (QoS from [`crate::topics`]).
+struct Publishers {
+    journal: ros2_client::Publisher<messages::JournalState>,
+    film: ros2_client::Publisher<messages::FilmState>,
+    orbit: ros2_client::Publisher<messages::Orbit>,
+    warning: ros2_client::Publisher<messages::InstabilityWarning>,
+    diagnostics: ros2_client::Publisher<messages::DiagnosticArray>,
+    residual: ros2_client::Publisher<messages::OrbitResidual>,
+    margin: ros2_client::Publisher<messages::StabilityMargin>,
+}
+
+fn publisher<M: RosMessage>(
+    node: &mut ros2_client::Node,
+    ros: &RosArgs,
+    name: &str,
+    qos: TopicQos,
+) -> anyhow::Result<ros2_client::Publisher<M>> {
+    let topic = node
+        .create_topic(
+            &topic_name(&ros.remaps, name)?,
+            type_name::<M>(),
+            &qos_profile(qos),
+        )
+        .map_err(|e| anyhow::anyhow!("topic {name}: {e:?}"))?;
+    node.create_publisher::<M>(&topic, None)
+        .map_err(|e| anyhow::anyhow!("publisher {name}: {e:?}"))
+}
+
+impl Publishers {
+    fn create(node: &mut ros2_client::Node, ros: &RosArgs) -> anyhow::Result<Self> {
+        use crate::topics as qos;
+        Ok(Self {
+            journal: publisher(node, ros, JOURNAL, qos::STATE)?,
+            film: publisher(node, ros, FILM, qos::STATE)?,
+            orbit: publisher(node, ros, ORBIT, qos::STATE)?,
+            warning: publisher(node, ros, WARNING, qos::WARNING_QOS)?,
+            diagnostics: publisher(node, ros, DIAGNOSTICS, qos::STATE)?,
+            residual: publisher(node, ros, RESIDUAL, qos::STATE)?,
+            margin: publisher(node, ros, MARGIN, qos::MARGIN_QOS)?,
+        })
+    }
+
+    /// The publishing thread: publishes what the model sends (a full send window drops the
+    /// sample: the model is never blocked) and hands it to the recorder.
+    fn spawn(
+        self,
+        out: mpsc::Receiver<Outgoing>,
+        rec: Option<mpsc::SyncSender<ToRecord>>,
+    ) -> std::io::Result<std::thread::JoinHandle<()>> {
+        std::thread::Builder::new()
+            .name("rotor_twin publish".into())
+            .spawn(move || {
+                for item in out {
+                    let t = now_ns();
+                    let _sent = match &item {
+                        Outgoing::Journal(m) => self.journal.publish(m.clone()).is_ok(),
+                        Outgoing::Film(m) => self.film.publish(m.clone()).is_ok(),
+                        Outgoing::Orbit(m) => self.orbit.publish(m.clone()).is_ok(),
+                        Outgoing::Warning(m) => self.warning.publish(m.clone()).is_ok(),
+                        Outgoing::Diagnostics(m) => self.diagnostics.publish(m.clone()).is_ok(),
+                        Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
+                        Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
+                    };
+                    if let Some(rec) = &rec {
+                        let _ = rec.try_send(ToRecord::Out(item, t));
+                    }
+                }
+            })
+    }
+}
+
+/// Every input subscription: the speed (of the configured type), the unbalance, the probes and
+/// the PointStamped probe pairs; /clock under use_sim_time.
+fn subscribe_inputs(
+    node: &mut ros2_client::Node,
+    ros: &RosArgs,
+    params: &NodeParams,
+    rotor: &Rotor,
+    route: &InputRoute,
+) -> anyhow::Result<()> {
+    use crate::topics as qos;
+    let speed_topic = topic_name(&ros.remaps, SPEED)?;
+    if params.speed_type == SpeedType::Float64 {
+        let unit = params.speed_unit;
+        route.subscribe::<messages::Float64>(
+            node,
+            &speed_topic,
+            qos::SENSOR_READER,
+            move |m| Ok(Input::speed_value(m.data, unit)),
+            ToRecord::Speed64,
+        )?;
+    } else {
+        route.subscribe::<messages::RotorSpeed>(
+            node,
+            &speed_topic,
+            qos::SENSOR_READER,
+            |m| Ok(Input::from(m)),
+            ToRecord::Speed,
+        )?;
+    }
+    route.subscribe::<messages::Unbalance>(
+        node,
+        &topic_name(&ros.remaps, UNBALANCE)?,
+        qos::COMMAND_READER,
+        |m| Ok(Input::from(m)),
+        ToRecord::Unbalance,
+    )?;
+    route.subscribe::<messages::ProbeDisplacement>(
+        node,
+        &topic_name(&ros.remaps, PROBE)?,
+        qos::SENSOR_READER,
+        |m| Ok(Input::from(m)),
+        ToRecord::Probe,
+    )?;
+    // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
+    for (i, (station, topic_text)) in params.probe_point_topics.iter().enumerate() {
+        let k = rotor
+            .probes
+            .iter()
+            .position(|p| p.name == *station)
+            .ok_or_else(|| anyhow::anyhow!("parameter probe_point_topics: station '{station}' is not in the machine description"))?;
+        let name = Name::parse(topic_text)
+            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+        route.subscribe::<messages::PointStamped>(
+            node,
+            &name,
+            qos::SENSOR_READER,
+            move |m| Ok(Input::probe_point(m, k)),
+            move |m, t| ToRecord::Point(i, m, t),
+        )?;
+    }
+    if params.use_sim_time {
+        // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
+        subscribe_clock(node, &topic_name(&ros.remaps, CLOCK)?, route.clock.clone())?;
+    }
+    Ok(())
+}
+
 fn speed_topic_label(ros: &RosArgs) -> String {
     ros.remaps
         .get(SPEED)
@@ -617,18 +501,83 @@ fn speed_topic_label(ros: &RosArgs) -> String {
         .unwrap_or_else(|| SPEED.to_string())
 }
 
-fn desc_stations(setup: &NodeSetup) -> anyhow::Result<Vec<String>> {
-    let desc = match &setup.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
-    Ok(desc.probes.iter().map(|p| p.name.clone()).collect())
+/// Where a subscription's samples go: decoded, recorded as received, queued with the receive
+/// time on the node's clock for the model thread. A sample that does not decode is queued as a
+/// refusal (counted and warned about by the driver) and the subscription lives on.
+struct InputRoute {
+    inbox: Arc<Mutex<Inbox>>,
+    clock: Arc<NodeClock>,
+    rec: Option<mpsc::SyncSender<ToRecord>>,
 }
 
-fn desc_planes(setup: &NodeSetup) -> anyhow::Result<usize> {
-    let desc = match &setup.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
-    Ok(desc.unbalance.len())
+impl InputRoute {
+    fn subscribe<M>(
+        &self,
+        node: &mut ros2_client::Node,
+        name: &Name,
+        qos: TopicQos,
+        to_input: impl Fn(&M) -> Result<Input, String> + Send + 'static,
+        to_record: impl Fn(M, i64) -> ToRecord + Send + 'static,
+    ) -> anyhow::Result<()>
+    where
+        M: RosMessage + Send + Sync + 'static,
+    {
+        let topic = node
+            .create_topic(name, type_name::<M>(), &qos_profile(qos))
+            .map_err(|e| anyhow::anyhow!("topic {name:?}: {e:?}"))?;
+        let sub = node
+            .create_subscription::<M>(&topic, Some(qos_profile(qos)))
+            .map_err(|e| anyhow::anyhow!("subscription {name:?}: {e:?}"))?;
+        let (inbox, clock, rec) = (self.inbox.clone(), self.clock.clone(), self.rec.clone());
+        let label = format!("{name:?}");
+        tokio::spawn(async move {
+            let mut stream = Box::pin(sub.async_stream());
+            while let Some(item) = stream.next().await {
+                let at = clock.now_ns();
+                let queued = match item {
+                    Ok((m, _info)) => {
+                        let input = to_input(&m);
+                        if let Some(rec) = &rec {
+                            // a full recorder queue is counted by the recorder's drop count
+                            let _ = rec.try_send(to_record(m, now_ns()));
+                        }
+                        input
+                    }
+                    Err(e) => Err(format!("{label}: a sample that does not decode ({e:?})")),
+                };
+                inbox
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push((at, queued));
+            }
+        });
+        Ok(())
+    }
+}
+
+/// The /clock subscription under use_sim_time: the node's clock follows it, never backwards.
+fn subscribe_clock(
+    node: &mut ros2_client::Node,
+    name: &Name,
+    clock: Arc<NodeClock>,
+) -> anyhow::Result<()> {
+    let qos = crate::topics::CLOCK_READER;
+    let topic = node
+        .create_topic(name, type_name::<messages::Clock>(), &qos_profile(qos))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let sub = node
+        .create_subscription::<messages::Clock>(&topic, Some(qos_profile(qos)))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    tokio::spawn(async move {
+        let mut stream = Box::pin(sub.async_stream());
+        while let Some(item) = stream.next().await {
+            let Ok((m, _info)) = item else { continue };
+            let ns = m.clock.as_nanos();
+            let mut now = clock.sim_now_ns.lock().unwrap_or_else(|e| e.into_inner());
+            if now.is_none_or(|t| ns >= t) {
+                *now = Some(ns);
+            }
+        }
+    });
+    Ok(())
 }

@@ -1,50 +1,70 @@
-//! The model thread: the twin core at real-time pace (wall clock), fed by the latest valid inputs,
-//! producing messages for the bus and the recording. It never runs on the async executor, and when
-//! it falls behind it says so.
+//! The model thread: the shared [`Driver`] at real-time pace, fed in order by the inputs the
+//! subscriptions queue with their receive time on the node's clock (the wall clock, or `/clock`
+//! under use_sim_time). It never runs on the async executor, never waits for the bus, and when it
+//! falls behind it says so.
 
 use super::params::NodeParams;
-use crate::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
+use crate::driver::{Driver, DriverSettings, Input};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
-use crate::session::{warning, Session, SessionSettings};
-use std::sync::atomic::{AtomicBool, Ordering};
+use crate::session::{warning, SessionSettings};
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
-/// The latest accepted inputs, shared with the subscription side.
+/// Inputs waiting for the model thread beyond this many are dropped, oldest first, and counted.
+pub const INBOX_CAPACITY: usize = 65_536;
+
+/// Steps one wake of the model thread may take before it looks at its inputs again (at 9,000 rpm
+/// and 64 steps a revolution, 256 steps are 27 ms of model time).
+pub const MAX_STEPS_PER_WAKE: usize = 256;
+
+/// A queued input: its receive time on the node's clock (None: under use_sim_time before the
+/// first `/clock`) and the input, or why it could not be decoded.
+pub type Queued = (Option<i64>, Result<Input, String>);
+
+/// What the subscriptions hand to the model thread.
 #[derive(Debug, Default)]
-pub struct Inputs {
-    /// Speed (rad/s), acceleration (rad/s²) and when it arrived.
-    pub speed: Option<(f64, f64, Instant)>,
-    /// Unbalance changes not yet applied: (plane, m·e kg·m, phase rad).
-    pub unbalance: Vec<(usize, f64, f64)>,
-    /// Measured probe displacements not yet compared: (station index, x m, y m, stamp ns).
-    pub probes: Vec<(usize, f64, f64, i64)>,
-    /// Rejected inputs since the last report, with the last reason.
-    pub rejected: u64,
-    /// The last rejection's reason.
-    pub last_rejection: String,
-    /// With use_sim_time: the latest `/clock` time (ns).
-    pub sim_time_ns: Option<i64>,
+pub struct Inbox {
+    /// Inputs in order of arrival.
+    pub queue: VecDeque<Queued>,
+    /// Inputs dropped because the queue was full.
+    pub dropped: u64,
 }
 
-impl Inputs {
-    /// Queues a checked probe displacement (m) of station `station`, stamped `stamp_ns` (0:
-    /// unstamped, then `now_ns`). The queue is bounded: a burst keeps its newest 1,000 samples.
-    pub fn push_probe(&mut self, station: usize, x: f64, y: f64, stamp_ns: i64, now_ns: i64) {
-        if self.probes.len() >= 1000 {
-            self.probes.remove(0);
+impl Inbox {
+    /// Queues one input; a full queue drops its oldest and counts it.
+    pub fn push(&mut self, item: Queued) {
+        if self.queue.len() >= INBOX_CAPACITY {
+            self.queue.pop_front();
+            self.dropped += 1;
         }
-        let stamp = if stamp_ns != 0 { stamp_ns } else { now_ns };
-        self.probes.push((station, x, y, stamp));
+        self.queue.push_back(item);
     }
 }
 
-/// The linear threshold once computed: Some(Some((speed rad/s, whirl ratio))), Some(None) if
-/// stable over the range, None while computing.
-type ThresholdSlot = Option<Option<(f64, f64)>>;
+/// The node's clock: the wall clock, or the latest `/clock` time under use_sim_time.
+#[derive(Debug, Default)]
+pub struct NodeClock {
+    /// Follow `/clock`.
+    pub sim: bool,
+    /// The latest `/clock` time (ns).
+    pub sim_now_ns: Mutex<Option<i64>>,
+}
+
+impl NodeClock {
+    /// Now on this clock (ns since the epoch); None before the first `/clock` in sim time.
+    pub fn now_ns(&self) -> Option<i64> {
+        if self.sim {
+            *self.sim_now_ns.lock().unwrap_or_else(|e| e.into_inner())
+        } else {
+            Some(now_ns())
+        }
+    }
+}
 
 /// Wall-clock time (ns since the epoch).
 pub fn now_ns() -> i64 {
@@ -63,291 +83,259 @@ fn session_settings(p: &NodeParams) -> SessionSettings {
     }
 }
 
-/// Runs the model until `stop` is set. Messages go to `out`; when `out` is full a message is
-/// dropped and counted (the model never waits for the bus).
-pub fn run(
-    rotor: Rotor,
-    mut params: NodeParams,
-    live: (Arc<Mutex<NodeParams>>, Arc<std::sync::atomic::AtomicU64>),
-    inputs: Arc<Mutex<Inputs>>,
-    out: SyncSender<Outgoing>,
-    stop: Arc<AtomicBool>,
-) {
-    let coupling = match params.model.as_str() {
-        "linear" => Coupling::Linear,
-        "prehistory" => Coupling::Prehistory {
-            delta: params.delta,
-        },
-        _ => Coupling::Nonlinear,
+/// The driver's settings from the node's parameters.
+pub fn driver_settings(p: &NodeParams, rotor: &Rotor) -> DriverSettings {
+    let mut s = DriverSettings::new(p.model, p.film, rotor.rated_speed_rad_s);
+    s.twin = crate::dynamics::TwinConfig {
+        film: p.film,
+        ..crate::dynamics::TwinConfig::with_steps_per_rev(
+            p.model.coupling(p.delta),
+            rotor.rated_speed_rad_s,
+            p.steps_per_rev,
+        )
     };
-    let rated = rotor.rated_speed_rad_s;
-    let config = TwinConfig {
-        film: if params.film == "direct" {
-            FilmEvaluation::Direct
-        } else {
-            FilmEvaluation::Table
-        },
-        ..TwinConfig::with_steps_per_rev(coupling, rated, params.steps_per_rev)
-    };
-    let h = config.time_step_s;
-    let mut min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
-    let mut seen_version = 0u64;
-    let mut dropped = 0u64;
-    let send = |m: Outgoing, dropped: &mut u64| {
-        if out.try_send(m).is_err() {
-            *dropped += 1;
+    s.session = session_settings(p);
+    s.min_speed_rad_s = crate::units::rpm_to_rad_s(p.min_speed_rpm);
+    s.input_timeout_s = p.input_timeout_s;
+    s
+}
+
+/// Parameters changed at run time, as the parameter services share them.
+pub type LiveParams = (Arc<Mutex<NodeParams>>, Arc<AtomicU64>);
+
+/// Timing of the model thread over the current diagnostics interval.
+#[derive(Debug, Clone, Copy)]
+struct Timing {
+    since: Instant,
+    steps: u64,
+    overruns: u64,
+    worst_step_us: f64,
+    lag_s: f64,
+    last_behind_warning: Option<Instant>,
+}
+
+impl Timing {
+    fn new() -> Self {
+        Self {
+            since: Instant::now(),
+            steps: 0,
+            overruns: 0,
+            worst_step_us: 0.0,
+            lag_s: 0.0,
+            last_behind_warning: None,
         }
-    };
-    let mut session: Option<Session> = None;
-    let mut wall_start = Instant::now();
-    let mut sim_started = false;
-    let mut last_report = Instant::now();
-    let (mut steps_since, mut overruns, mut worst_step_us) = (0u64, 0u64, 0.0f64);
-    let mut last_stale_warning = Instant::now() - Duration::from_secs(3600);
-    let mut last_behind_warning = Instant::now() - Duration::from_secs(3600);
-    // the linear threshold depends on the static loads, not on the present speed: compute it once,
-    // on a helper thread, and report the margin to it every second
-    let threshold: Arc<Mutex<ThresholdSlot>> = Arc::new(Mutex::new(None));
-    {
-        let (rotor, threshold) = (rotor.clone(), threshold.clone());
-        std::thread::spawn(move || {
-            let value = crate::session::linear_threshold(&rotor);
-            *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
-        });
     }
-    while !stop.load(Ordering::Relaxed) {
-        // parameters changed at run time (rates, thresholds, timeouts)
-        let version = live.1.load(Ordering::Relaxed);
-        if version != seen_version {
-            seen_version = version;
-            let p = live.0.lock().unwrap_or_else(|e| e.into_inner()).clone();
-            params.state_rate_hz = p.state_rate_hz;
-            params.pressure_map_rate_hz = p.pressure_map_rate_hz;
-            params.input_timeout_s = p.input_timeout_s;
-            params.min_speed_rpm = p.min_speed_rpm;
-            params.warning_amplitude_ratio = p.warning_amplitude_ratio;
-            min_speed = params.min_speed_rpm * std::f64::consts::PI / 30.0;
-            if let Some(s) = session.as_mut() {
-                s.set_settings(session_settings(&params));
-            }
-        }
-        let (speed, unbalance, probes, age, rejected, last_rejection) = {
-            let mut g = inputs.lock().unwrap_or_else(|e| e.into_inner());
-            let r = (
-                g.speed,
-                std::mem::take(&mut g.unbalance),
-                std::mem::take(&mut g.probes),
-                g.speed.map(|s| s.2.elapsed()),
-                g.rejected,
-                g.last_rejection.clone(),
-            );
-            g.rejected = 0;
-            r
-        };
-        if rejected > 0 {
-            send(
-                warning(
-                    now_ns(),
-                    InstabilityWarning::WARN,
-                    "bad_input",
-                    "",
-                    format!("{rejected} input(s) rejected; last: {last_rejection}"),
-                ),
-                &mut dropped,
-            );
-        }
-        let Some((w, accel, _)) = speed else {
-            std::thread::sleep(Duration::from_millis(5));
-            continue;
-        };
-        if age.is_some_and(|a| a.as_secs_f64() > params.input_timeout_s)
-            && last_stale_warning.elapsed().as_secs_f64() > params.input_timeout_s
+}
+
+/// The model loop of the node: owns the driver, reads the inbox, paces the twin by the clock.
+pub struct ModelLoop {
+    driver: Driver,
+    params: NodeParams,
+    live: LiveParams,
+    seen_version: u64,
+    inbox: Arc<Mutex<Inbox>>,
+    clock: Arc<NodeClock>,
+    threshold: Arc<Mutex<Option<Option<(f64, f64)>>>>,
+    timing: Timing,
+    dropped_out: u64,
+    last_fed_ns: i64,
+}
+
+impl ModelLoop {
+    /// A loop for a twin of `rotor` with the node's parameters `params`. The linear stability
+    /// threshold is computed on a helper thread (it takes a while) and the margin follows once
+    /// it is known.
+    pub fn new(
+        rotor: Rotor,
+        params: NodeParams,
+        live: LiveParams,
+        inbox: Arc<Mutex<Inbox>>,
+        clock: Arc<NodeClock>,
+    ) -> Self {
+        let threshold = Arc::new(Mutex::new(None));
         {
-            last_stale_warning = Instant::now();
-            send(
-                warning(
-                    now_ns(),
-                    InstabilityWarning::WARN,
-                    "stale_input",
-                    "",
-                    format!(
-                        "no speed for {:.2} s; holding {:.1} rad/s",
-                        age.unwrap_or_default().as_secs_f64(),
-                        w
-                    ),
-                ),
-                &mut dropped,
-            );
+            let (rotor, threshold) = (rotor.clone(), threshold.clone());
+            std::thread::spawn(move || {
+                let value = crate::session::linear_threshold(&rotor);
+                *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
+            });
         }
-        if w < min_speed {
-            // below the model's range: pause, and start afresh when the speed is back
-            session = None;
-            std::thread::sleep(Duration::from_millis(5));
-            continue;
+        Self {
+            driver: Driver::new(rotor.clone(), driver_settings(&params, &rotor)),
+            params,
+            live,
+            seen_version: 0,
+            inbox,
+            clock,
+            threshold,
+            timing: Timing::new(),
+            dropped_out: 0,
+            last_fed_ns: i64::MIN,
         }
-        if session.is_none() {
-            match Session::new(&rotor, config, w, session_settings(&params), now_ns()) {
-                Ok(s) => {
-                    session = Some(s);
-                    wall_start = Instant::now();
-                    sim_started = false;
+    }
+
+    /// Runs until `stop` is set. Messages go to `out`; when `out` is full a message is dropped
+    /// and counted (the model never waits for the bus).
+    pub fn run(mut self, out: SyncSender<Outgoing>, stop: Arc<AtomicBool>) {
+        let mut dropped = 0u64;
+        while !stop.load(Ordering::Relaxed) {
+            let mut emit = |m: Outgoing| {
+                if out.try_send(m).is_err() {
+                    dropped += 1;
                 }
-                Err(e) => {
-                    send(
-                        warning(
-                            now_ns(),
-                            InstabilityWarning::ERROR,
-                            "bad_input",
-                            "",
-                            format!("cannot start the twin at {w:.1} rad/s: {e}"),
-                        ),
-                        &mut dropped,
-                    );
-                    std::thread::sleep(Duration::from_millis(100));
-                    continue;
-                }
+            };
+            if !self.wake(&mut emit) {
+                std::thread::sleep(Duration::from_millis(1));
             }
+            self.dropped_out = dropped;
         }
-        let Some(s) = session.as_mut() else {
-            continue;
+    }
+
+    /// One wake: parameter changes, the queued inputs, the steps now due, the reports. False
+    /// when there was nothing to do (the caller sleeps).
+    pub fn wake(&mut self, emit: &mut impl FnMut(Outgoing)) -> bool {
+        self.take_parameters();
+        if let Some(found) = *self.threshold.lock().unwrap_or_else(|e| e.into_inner()) {
+            self.driver.set_threshold(found);
+        }
+        let Some(now) = self.clock.now_ns() else {
+            return false;
         };
-        for (plane, m, p) in unbalance {
-            let _ = s.twin_mut().set_unbalance(plane, m, p);
+        let fed = self.feed_inputs(now, emit);
+        let steps = self.step_until(now, emit);
+        self.report(now, emit);
+        fed || steps > 0
+    }
+
+    /// The driver (read only), e.g. for tests.
+    pub fn driver(&self) -> &Driver {
+        &self.driver
+    }
+
+    fn take_parameters(&mut self) {
+        let version = self.live.1.load(Ordering::Relaxed);
+        if version == self.seen_version {
+            return;
         }
-        // pacing: step k is due at k·h after the start, on the wall clock or on /clock
-        let model_elapsed = s.twin().time_s();
-        let clock_elapsed = if params.use_sim_time {
-            let sim_now = inputs.lock().unwrap_or_else(|e| e.into_inner()).sim_time_ns;
-            match sim_now {
-                Some(now) if sim_started => (now - s.epoch_ns()) as f64 * 1e-9,
-                Some(now) => {
-                    // model time zero is the first /clock time seen
-                    s.set_epoch_ns(now - (model_elapsed * 1e9) as i64);
-                    sim_started = true;
-                    model_elapsed
+        self.seen_version = version;
+        let p = self
+            .live
+            .0
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        self.params = p;
+        self.driver.set_runtime(
+            session_settings(&self.params),
+            crate::units::rpm_to_rad_s(self.params.min_speed_rpm),
+            self.params.input_timeout_s,
+        );
+    }
+
+    /// Feeds the queued inputs in order, each at its receive time (never before the one fed
+    /// last, nor after now).
+    fn feed_inputs(&mut self, now: i64, emit: &mut impl FnMut(Outgoing)) -> bool {
+        let batch = std::mem::take(&mut self.inbox.lock().unwrap_or_else(|e| e.into_inner()).queue);
+        let any = !batch.is_empty();
+        for (at, input) in batch {
+            let t = at.unwrap_or(now).clamp(self.last_fed_ns, now);
+            self.last_fed_ns = t;
+            match input {
+                Ok(input) => {
+                    self.driver.feed(t, input, emit);
                 }
-                None => {
-                    std::thread::sleep(Duration::from_millis(1));
-                    continue;
+                Err(why) => {
+                    self.driver.advance_to(t, usize::MAX, emit);
+                    self.driver.refuse(t, &why, emit);
                 }
             }
-        } else {
-            wall_start.elapsed().as_secs_f64()
-        };
-        let ahead = model_elapsed - clock_elapsed;
-        if ahead > 0.0 {
-            // ahead of the clock: sleep in short slices (spinning here starves the bus threads
-            // of CPU and delays the next input), and look at the inputs again
-            std::thread::sleep(Duration::from_secs_f64(ahead.min(0.0005)));
-            continue;
         }
-        let lag = -ahead;
-        let started = Instant::now();
-        let input = StepInput {
-            speed_rad_s: w,
-            accel_rad_s2: accel,
-        };
-        let result = s.step(&input, &mut |m| send(m, &mut dropped));
-        let cost = started.elapsed().as_secs_f64() * 1e6;
-        worst_step_us = worst_step_us.max(cost);
-        steps_since += 1;
-        if cost > h * 1e6 {
-            overruns += 1;
-        }
-        if let Err(e) = result {
-            send(
-                warning(
-                    now_ns(),
-                    InstabilityWarning::ERROR,
-                    "model_failure",
-                    "",
-                    format!("step failed: {e}; the twin restarts"),
-                ),
-                &mut dropped,
-            );
-            session = None;
-            continue;
-        }
-        // measured against predicted at each probe station
-        for (station, mx, my, stamp_ns) in probes {
-            if let Some(r) = s.residual(station, [mx, my], stamp_ns) {
-                send(Outgoing::Residual(r), &mut dropped);
+        any
+    }
+
+    /// Steps up to `now`, one at a time to time each, at most [`MAX_STEPS_PER_WAKE`].
+    fn step_until(&mut self, now: i64, emit: &mut impl FnMut(Outgoing)) -> usize {
+        let h_us = self.driver.settings().twin.time_step_s * 1e6;
+        let mut steps = 0;
+        while steps < MAX_STEPS_PER_WAKE {
+            let started = Instant::now();
+            if self.driver.advance_to(now, 1, emit) == 0 {
+                break;
             }
+            let cost = started.elapsed().as_secs_f64() * 1e6;
+            self.timing.worst_step_us = self.timing.worst_step_us.max(cost);
+            self.timing.overruns += u64::from(cost > h_us);
+            steps += 1;
         }
-        if lag > 0.1 && last_behind_warning.elapsed() > Duration::from_secs(1) {
-            last_behind_warning = Instant::now();
-            send(
-                warning(
-                    now_ns(),
-                    InstabilityWarning::WARN,
-                    "falling_behind",
-                    "",
-                    format!("the model runs {lag:.3} s behind the wall clock"),
-                ),
-                &mut dropped,
-            );
+        self.timing.steps += steps as u64;
+        if let Some(s) = self.driver.session() {
+            self.timing.lag_s = ((now - s.stamp_ns()) as f64 * 1e-9).max(0.0);
         }
-        if last_report.elapsed() >= Duration::from_secs(1) {
-            if let Some(found) = *threshold.lock().unwrap_or_else(|e| e.into_inner()) {
-                send(
-                    Outgoing::Margin(crate::session::margin(now_ns(), w, found)),
-                    &mut dropped,
-                );
-            }
-            let wall = last_report.elapsed().as_secs_f64();
-            let rtf = steps_since as f64 * h / wall;
-            let values = vec![
-                KeyValue {
-                    key: "real_time_factor".into(),
-                    value: format!("{rtf:.3}"),
+        steps
+    }
+
+    /// Falling-behind warnings and, every second of wall time, the diagnostics.
+    fn report(&mut self, now: i64, emit: &mut impl FnMut(Outgoing)) {
+        let lag = self.timing.lag_s;
+        let warned = self.timing.last_behind_warning;
+        if lag > 0.1 && warned.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) {
+            self.timing.last_behind_warning = Some(Instant::now());
+            emit(warning(
+                now,
+                InstabilityWarning::WARN,
+                "falling_behind",
+                "",
+                format!("the model runs {lag:.3} s behind the clock"),
+            ));
+        }
+        if self.timing.since.elapsed() < Duration::from_secs(1) {
+            return;
+        }
+        emit(Outgoing::Diagnostics(self.diagnostics(now)));
+        self.timing = Timing {
+            last_behind_warning: self.timing.last_behind_warning,
+            lag_s: self.timing.lag_s,
+            ..Timing::new()
+        };
+    }
+
+    fn diagnostics(&self, now: i64) -> DiagnosticArray {
+        let t = &self.timing;
+        let h = self.driver.settings().twin.time_step_s;
+        let rtf = t.steps as f64 * h / t.since.elapsed().as_secs_f64();
+        let counts = self.driver.counts();
+        let dropped_in = self.inbox.lock().unwrap_or_else(|e| e.into_inner()).dropped;
+        let kv = |key: &str, value: String| KeyValue {
+            key: key.into(),
+            value,
+        };
+        let age = self.driver.speed_age_s(now).unwrap_or_default();
+        let values = vec![
+            kv("real_time_factor", format!("{rtf:.3}")),
+            kv("lag_s", format!("{:.4}", t.lag_s)),
+            kv("step_overruns", t.overruns.to_string()),
+            kv("worst_step_us", format!("{:.1}", t.worst_step_us)),
+            kv("speed_input_age_s", format!("{age:.3}")),
+            kv("dropped_messages", self.dropped_out.to_string()),
+            kv("dropped_inputs", dropped_in.to_string()),
+            kv("refused_inputs", counts.refused.to_string()),
+            kv("step_failures", counts.step_failures.to_string()),
+            kv("time_step_us", format!("{:.2}", h * 1e6)),
+        ];
+        let level = u8::from(t.lag_s > 0.1);
+        DiagnosticArray {
+            header: crate::session::header(now, ""),
+            status: vec![DiagnosticStatus {
+                level,
+                name: "rotor_twin: model".into(),
+                message: if level == 0 {
+                    "keeping up".into()
+                } else {
+                    format!("{:.3} s behind real time", t.lag_s)
                 },
-                KeyValue {
-                    key: "lag_s".into(),
-                    value: format!("{lag:.4}"),
-                },
-                KeyValue {
-                    key: "step_overruns".into(),
-                    value: overruns.to_string(),
-                },
-                KeyValue {
-                    key: "worst_step_us".into(),
-                    value: format!("{worst_step_us:.1}"),
-                },
-                KeyValue {
-                    key: "speed_input_age_s".into(),
-                    value: format!("{:.3}", age.unwrap_or_default().as_secs_f64()),
-                },
-                KeyValue {
-                    key: "dropped_messages".into(),
-                    value: dropped.to_string(),
-                },
-                KeyValue {
-                    key: "time_step_us".into(),
-                    value: format!("{:.2}", h * 1e6),
-                },
-            ];
-            let level = if lag > 0.1 { 1 } else { 0 };
-            send(
-                Outgoing::Diagnostics(DiagnosticArray {
-                    header: crate::session::header(now_ns(), ""),
-                    status: vec![DiagnosticStatus {
-                        level,
-                        name: "rotor_twin: model".into(),
-                        message: if level == 0 {
-                            "keeping up".into()
-                        } else {
-                            format!("{lag:.3} s behind real time")
-                        },
-                        hardware_id: "rotor_twin".into(),
-                        values,
-                    }],
-                }),
-                &mut dropped,
-            );
-            last_report = Instant::now();
-            steps_since = 0;
-            overruns = 0;
-            worst_step_us = 0.0;
+                hardware_id: "rotor_twin".into(),
+                values,
+            }],
         }
     }
 }

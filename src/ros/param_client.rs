@@ -91,7 +91,7 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
             ParamCall::Get(names) => {
                 let values = get(names.clone()).await?;
                 for (name, value) in names.iter().zip(values) {
-                    println!("{name}: {value:?}");
+                    println!("{name}: {}", shown(&value));
                 }
                 Ok(())
             }
@@ -151,4 +151,16 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
             }
         }
     })
+}
+
+/// A parameter value as `ros2 param get` shows it: the type, then the value.
+fn shown(v: &ParameterValue) -> String {
+    match v {
+        ParameterValue::NotSet => "not set".into(),
+        ParameterValue::Boolean(b) => format!("Boolean value is: {b}"),
+        ParameterValue::Integer(i) => format!("Integer value is: {i}"),
+        ParameterValue::Double(d) => format!("Double value is: {d:?}"),
+        ParameterValue::String(s) => format!("String value is: {s}"),
+        other => format!("{other:?}"),
+    }
 }

@@ -4,25 +4,39 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Unit of a bare speed value (std_msgs/Float64 on a plant bus).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SpeedUnit {
-    /// Revolutions per minute.
-    Rpm,
-    /// Radians per second.
-    RadPerS,
-    /// Revolutions per second.
-    Hz,
+pub use crate::driver::SpeedUnit;
+use crate::driver::{film_name, parse_film, settings as defaults, ModelKind};
+use crate::dynamics::FilmEvaluation;
+use std::fmt;
+use std::str::FromStr;
+
+/// The type of the speed topic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpeedType {
+    /// rotor_twin_msgs/RotorSpeed (rad/s, rad/s², stamped).
+    #[default]
+    RotorSpeed,
+    /// std_msgs/Float64, a bare value in `speed_unit`.
+    Float64,
 }
 
-impl SpeedUnit {
-    /// Converts a value in this unit to rad/s.
-    pub fn to_rad_s(self, v: f64) -> f64 {
-        match self {
-            SpeedUnit::Rpm => v * std::f64::consts::PI / 30.0,
-            SpeedUnit::RadPerS => v,
-            SpeedUnit::Hz => v * std::f64::consts::TAU,
+impl FromStr for SpeedType {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "rotor_speed" => Ok(SpeedType::RotorSpeed),
+            "float64" => Ok(SpeedType::Float64),
+            other => Err(format!("'{other}' must be rotor_speed or float64")),
         }
+    }
+}
+
+impl fmt::Display for SpeedType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SpeedType::RotorSpeed => "rotor_speed",
+            SpeedType::Float64 => "float64",
+        })
     }
 }
 
@@ -30,12 +44,12 @@ impl SpeedUnit {
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeParams {
     /// `model`: linear | nonlinear | prehistory.
-    pub model: String,
+    pub model: ModelKind,
     /// `delta`: prehistory relaxation factor δ in (0, 1].
     pub delta: f64,
     /// `film`: table (the finite-length solutions tabulated and interpolated, fast enough for
     /// real time) | direct (the finite solver at every evaluation, the reference).
-    pub film: String,
+    pub film: FilmEvaluation,
     /// `steps_per_rev`: time steps per revolution at rated speed.
     pub steps_per_rev: usize,
     /// `state_rate_hz`: rate of journal and film states (Hz), decimated from the step rate.
@@ -47,7 +61,7 @@ pub struct NodeParams {
     /// `min_speed_rpm`: below this speed the model pauses (rpm).
     pub min_speed_rpm: f64,
     /// `speed_type`: rotor_speed (rotor_twin_msgs/RotorSpeed) | float64 (std_msgs/Float64).
-    pub speed_type: String,
+    pub speed_type: SpeedType,
     /// `speed_unit`: rpm | rad_s | hz, for `speed_type` float64.
     pub speed_unit: SpeedUnit,
     /// `use_sim_time`: follow `/clock` (rosgraph_msgs/Clock) instead of the wall clock.
@@ -59,22 +73,22 @@ pub struct NodeParams {
 }
 
 impl Default for NodeParams {
+    /// The defaults of the driver and the session, where each is documented.
     fn default() -> Self {
+        let session = crate::session::SessionSettings::default();
         Self {
-            model: "nonlinear".into(),
-            delta: 0.5,
-            film: "table".into(),
-            // 64 steps a revolution at rated speed: the whip's sub-synchronous amplitude within
-            // 0.07 % of 128 steps (tests/transient_orc.rs), at half the cost
-            steps_per_rev: 64,
-            state_rate_hz: 200.0,
-            pressure_map_rate_hz: 2.0,
+            model: ModelKind::default(),
+            delta: defaults::DEFAULT_DELTA,
+            film: FilmEvaluation::Table,
+            steps_per_rev: defaults::DEFAULT_STEPS_PER_REV,
+            state_rate_hz: session.state_rate_hz,
+            pressure_map_rate_hz: session.pressure_map_rate_hz,
             input_timeout_s: 1.0,
-            min_speed_rpm: 1000.0,
-            speed_type: "rotor_speed".into(),
+            min_speed_rpm: defaults::DEFAULT_MIN_SPEED_RPM,
+            speed_type: SpeedType::default(),
             speed_unit: SpeedUnit::Rpm,
             use_sim_time: false,
-            warning_amplitude_ratio: 0.5,
+            warning_amplitude_ratio: session.warning_amplitude_ratio,
             probe_point_topics: Vec::new(),
         }
     }
@@ -97,18 +111,8 @@ impl NodeParams {
             }
         };
         match name {
-            "model" => match value {
-                "linear" | "nonlinear" | "prehistory" => self.model = value.into(),
-                _ => {
-                    return Err(format!(
-                        "parameter model: '{value}' must be linear, nonlinear or prehistory"
-                    ))
-                }
-            },
-            "film" => match value {
-                "table" | "direct" => self.film = value.into(),
-                _ => return Err(format!("parameter film: '{value}' must be table or direct")),
-            },
+            "model" => self.model = value.parse().map_err(|e| format!("parameter model: {e}"))?,
+            "film" => self.film = parse_film(value).map_err(|e| format!("parameter film: {e}"))?,
             "delta" => {
                 let d = num(value)?;
                 if !(d > 0.0 && d <= 1.0) {
@@ -155,25 +159,15 @@ impl NodeParams {
                 }
                 self.probe_point_topics = pairs;
             }
-            "speed_type" => match value {
-                "rotor_speed" | "float64" => self.speed_type = value.into(),
-                _ => {
-                    return Err(format!(
-                        "parameter speed_type: '{value}' must be rotor_speed or float64"
-                    ))
-                }
-            },
+            "speed_type" => {
+                self.speed_type = value
+                    .parse()
+                    .map_err(|e| format!("parameter speed_type: {e}"))?
+            }
             "speed_unit" => {
-                self.speed_unit = match value {
-                    "rpm" => SpeedUnit::Rpm,
-                    "rad_s" => SpeedUnit::RadPerS,
-                    "hz" => SpeedUnit::Hz,
-                    _ => {
-                        return Err(format!(
-                            "parameter speed_unit: '{value}' must be rpm, rad_s or hz"
-                        ))
-                    }
-                }
+                self.speed_unit = value
+                    .parse()
+                    .map_err(|e| format!("parameter speed_unit: {e}"))?
             }
             "use_sim_time" => {
                 self.use_sim_time = match value {
@@ -327,7 +321,7 @@ mod tests {
         for (k, v) in &r.params {
             p.set(k, v).unwrap();
         }
-        assert_eq!(p.model, "linear");
+        assert_eq!(p.model, ModelKind::Linear);
         assert_eq!(p.speed_unit, SpeedUnit::Hz);
         assert_eq!(r.remaps["/rotor_twin/speed"], "/plant/speed");
         assert!(p.set("delta", "0").unwrap_err().contains("delta"));
@@ -360,5 +354,12 @@ mod tests {
         assert!(p.set_at_runtime("state_rate_hz", "-1").is_err());
         assert_eq!(p.state_rate_hz, 50.0, "a refused change leaves the value");
         assert!((SpeedUnit::Rpm.to_rad_s(9000.0) - 942.477_796).abs() < 1e-5);
+    }
+}
+
+impl NodeParams {
+    /// The film evaluation's parameter text.
+    pub fn film_text(&self) -> &'static str {
+        film_name(self.film)
     }
 }

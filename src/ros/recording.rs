@@ -2,11 +2,12 @@
 //! rosbag2 MCAP bag flushed every second and finished when the node stops.
 
 use super::model::Outgoing;
-use super::{
-    DIAGNOSTICS, FILM, JOURNAL, MARGIN, ORBIT, PROBE, RESIDUAL, SPEED, UNBALANCE, WARNING,
-};
 use crate::messages;
-use crate::record::{Recorder, TopicQos};
+use crate::record::Recorder;
+use crate::topics::{
+    self as qos, DIAGNOSTICS, FILM, JOURNAL, MARGIN, ORBIT, PROBE, RESIDUAL, SPEED, UNBALANCE,
+    WARNING,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
@@ -20,39 +21,40 @@ pub(super) enum ToRecord {
     Speed64(messages::Float64, i64),
     Unbalance(messages::Unbalance, i64),
     Probe(messages::ProbeDisplacement, i64),
-}
-
-/// The QoS the node offers, as recorded.
-pub(super) struct Qos {
-    pub input: TopicQos,
-    pub state: TopicQos,
-    pub warning: TopicQos,
+    /// A PointStamped probe pair of the `usize`-th `probe_point_topics` entry.
+    Point(usize, messages::PointStamped, i64),
 }
 
 /// Starts recording to bag directory `dir` what arrives on `rx` (the speed as std_msgs/Float64
-/// if `speed_float64`), until `stop` is set and a quiet moment follows or the senders are gone.
+/// if `speed_float64`; the PointStamped probe topics `points` as `(station, topic)`), until `stop`
+/// is set and a quiet moment follows or the senders are gone.
 pub(super) fn spawn(
     dir: &Path,
     speed_float64: bool,
-    qos: Qos,
+    points: &[(String, String)],
     rx: mpsc::Receiver<ToRecord>,
     stop: Arc<AtomicBool>,
 ) -> anyhow::Result<JoinHandle<anyhow::Result<PathBuf>>> {
     let mut rec = Recorder::create(dir)?;
+    let input = qos::INPUT_RECORDED;
     let h_speed = if speed_float64 {
-        rec.add_topic::<messages::Float64>(SPEED, qos.input)?
+        rec.add_topic::<messages::Float64>(SPEED, input)?
     } else {
-        rec.add_topic::<messages::RotorSpeed>(SPEED, qos.input)?
+        rec.add_topic::<messages::RotorSpeed>(SPEED, input)?
     };
-    let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE, qos.input)?;
-    let h_journal = rec.add_topic::<messages::JournalState>(JOURNAL, qos.state)?;
-    let h_film = rec.add_topic::<messages::FilmState>(FILM, qos.state)?;
-    let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, qos.state)?;
-    let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, qos.warning)?;
-    let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, qos.state)?;
-    let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, qos.input)?;
-    let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos.state)?;
-    let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, TopicQos::latched(1))?;
+    let h_unb = rec.add_topic::<messages::Unbalance>(UNBALANCE, input)?;
+    let h_journal = rec.add_topic::<messages::JournalState>(JOURNAL, qos::STATE)?;
+    let h_film = rec.add_topic::<messages::FilmState>(FILM, qos::STATE)?;
+    let h_orbit = rec.add_topic::<messages::Orbit>(ORBIT, qos::STATE)?;
+    let h_warning = rec.add_topic::<messages::InstabilityWarning>(WARNING, qos::WARNING_QOS)?;
+    let h_diag = rec.add_topic::<messages::DiagnosticArray>(DIAGNOSTICS, qos::STATE)?;
+    let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input)?;
+    let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos::STATE)?;
+    let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, qos::MARGIN_QOS)?;
+    let h_points = points
+        .iter()
+        .map(|(_, topic)| rec.add_topic::<messages::PointStamped>(topic, input))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
         loop {
             match rx.recv_timeout(Duration::from_millis(200)) {
@@ -63,6 +65,7 @@ pub(super) fn spawn(
                         ToRecord::Speed64(m, ns) => rec.write(h_speed, m, t(ns), t(ns))?,
                         ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
                         ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
+                        ToRecord::Point(i, m, ns) => rec.write(h_points[*i], m, t(ns), t(ns))?,
                         ToRecord::Out(o, ns) => match o {
                             Outgoing::Journal(m) => rec.write(h_journal, m, t(ns), t(ns))?,
                             Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,

@@ -229,6 +229,15 @@ impl MachineDescription {
         Self::from_yaml(&text, &file)
     }
 
+    /// The machine in `path`, or the built-in default machine without one: the one way every
+    /// command and the node load a machine.
+    pub fn load(path: Option<&Path>) -> Result<Self, ConfigError> {
+        match path {
+            Some(p) => Self::from_file(p),
+            None => Ok(Self::builtin_default()),
+        }
+    }
+
     /// The built-in default machine.
     pub fn builtin_default() -> Self {
         Self::from_yaml(DEFAULT_MACHINE_YAML, DEFAULT_MACHINE_NAME)

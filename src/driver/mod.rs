@@ -1,0 +1,476 @@
+//! The driver: the one loop around a [`Session`] that the live node and the replay share. It
+//! takes timed inputs (speed, unbalance, probe samples) in any time base — the wall clock or
+//! `/clock` for the node, bag time for the replay — checks them against the running machine's
+//! limits, starts, pauses and restarts the twin, keeps the unbalance across restarts, steps the
+//! twin up to each input's time, compares probes with the prediction, and emits the warnings
+//! (bad, stale or missing input; model failures) and the stability margin. It knows no bus, file
+//! or clock: the same inputs at the same times give the same outputs, whoever feeds them.
+
+pub mod inputs;
+pub mod settings;
+
+pub use inputs::{
+    check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, SpeedGate, SpeedUnit,
+    StationRef,
+};
+pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
+
+use crate::dynamics::StepInput;
+use crate::messages::InstabilityWarning;
+use crate::rotor::Rotor;
+use crate::session::{margin, warning, Outgoing, Session, SessionSettings};
+
+/// Interval between stability-margin messages (s of driver time): 1 Hz, the diagnostics rate.
+pub const MARGIN_INTERVAL_S: f64 = 1.0;
+
+/// Shortest interval between two `bad_input` warnings (s of driver time); every refusal is
+/// counted, and the next warning carries the count.
+pub const REFUSAL_WARNING_INTERVAL_S: f64 = 1.0;
+
+/// What became of one input.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Fed {
+    /// Taken (a speed or an unbalance), nothing else to tell.
+    Taken,
+    /// A speed that (re)started the twin from the static equilibrium.
+    Started {
+        /// The speed it started at (rad/s).
+        speed_rad_s: f64,
+    },
+    /// A probe sample compared with the prediction.
+    Compared(ProbeComparison),
+    /// A probe sample that arrived while no twin was running.
+    Unused,
+    /// Refused, with the reason (counted, and warned about).
+    Refused(String),
+}
+
+/// A measured probe sample beside the prediction at its time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeComparison {
+    /// Probe station index.
+    pub station: usize,
+    /// The sample's time (ns, the driver's time base).
+    pub time_ns: i64,
+    /// Shaft angle of the twin there (rad).
+    pub angle_rad: f64,
+    /// Speed of the twin there (rad/s).
+    pub speed_rad_s: f64,
+    /// Measured displacement (m).
+    pub measured_m: [f64; 2],
+    /// Predicted displacement (m).
+    pub predicted_m: [f64; 2],
+}
+
+/// What the driver counted since it was made.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct DriverCounts {
+    /// Inputs refused (bad value, bad stamp, undecodable).
+    pub refused: u64,
+    /// Starts of the twin from the static equilibrium.
+    pub starts: u64,
+    /// Steps that failed (each stops the twin until the next speed).
+    pub step_failures: u64,
+    /// Steps taken.
+    pub steps: u64,
+}
+
+/// The twin of one machine, driven by timed inputs.
+pub struct Driver {
+    rotor: Rotor,
+    settings: DriverSettings,
+    limits: InputLimits,
+    gate: SpeedGate,
+    session: Option<Session>,
+    /// the latest accepted speed (rad/s, rad/s²) and when it came (ns)
+    speed: Option<(f64, f64, i64)>,
+    /// the latest accepted unbalance per plane (m·e kg·m, phase rad), applied at every start
+    unbalance: Vec<Option<(f64, f64)>>,
+    /// the linear stability threshold once known: Some((rad/s, whirl ratio)) or None
+    threshold: Option<Option<(f64, f64)>>,
+    last_input_ns: Option<i64>,
+    next_margin_ns: i64,
+    last_stale_warning_ns: Option<i64>,
+    /// refusals not yet warned about, and when the last bad_input warning went out (ns)
+    refused_unwarned: u64,
+    last_refusal_warning_ns: Option<i64>,
+    last_refusal: String,
+    counts: DriverCounts,
+}
+
+impl Driver {
+    /// A driver for `rotor`; no twin runs until the first speed at or above the minimum.
+    pub fn new(rotor: Rotor, settings: DriverSettings) -> Self {
+        let limits = InputLimits::of(&rotor);
+        let gate = SpeedGate::new(limits.max_speed_rad_s, settings.input_timeout_s);
+        Self {
+            unbalance: vec![None; rotor.unbalance.len()],
+            rotor,
+            settings,
+            limits,
+            gate,
+            session: None,
+            speed: None,
+            threshold: None,
+            last_input_ns: None,
+            next_margin_ns: i64::MIN,
+            last_stale_warning_ns: None,
+            refused_unwarned: 0,
+            last_refusal_warning_ns: None,
+            last_refusal: String::new(),
+            counts: DriverCounts::default(),
+        }
+    }
+
+    /// The machine the twin models.
+    pub fn rotor(&self) -> &Rotor {
+        &self.rotor
+    }
+
+    /// The settings in force.
+    pub fn settings(&self) -> &DriverSettings {
+        &self.settings
+    }
+
+    /// The limits inputs are checked against (from this machine).
+    pub fn limits(&self) -> &InputLimits {
+        &self.limits
+    }
+
+    /// The running session, if a twin runs.
+    pub fn session(&self) -> Option<&Session> {
+        self.session.as_ref()
+    }
+
+    /// The running session as an Option (for code that takes `&Option<Session>`).
+    pub fn session_slot(&self) -> &Option<Session> {
+        &self.session
+    }
+
+    /// What was counted so far.
+    pub fn counts(&self) -> DriverCounts {
+        self.counts
+    }
+
+    /// The latest accepted speed (rad/s).
+    pub fn speed_rad_s(&self) -> Option<f64> {
+        self.speed.map(|s| s.0)
+    }
+
+    /// Age (s) of the latest accepted speed at `now_ns`.
+    pub fn speed_age_s(&self, now_ns: i64) -> Option<f64> {
+        self.speed.map(|s| (now_ns - s.2) as f64 * 1e-9)
+    }
+
+    /// The linear stability threshold (as [`crate::session::linear_threshold`] gives it), once
+    /// known; the margin is published from then on.
+    pub fn set_threshold(&mut self, threshold: Option<(f64, f64)>) {
+        self.threshold = Some(threshold);
+    }
+
+    /// True once the linear threshold has been given.
+    pub fn threshold_known(&self) -> bool {
+        self.threshold.is_some()
+    }
+
+    /// Changes the settings that may change while running: output rates and thresholds, the
+    /// minimum speed, the input timeout. The twin's configuration stays.
+    pub fn set_runtime(&mut self, session: SessionSettings, min_speed_rad_s: f64, timeout_s: f64) {
+        self.settings.session = session;
+        self.settings.min_speed_rad_s = min_speed_rad_s;
+        self.settings.input_timeout_s = timeout_s;
+        self.gate.timeout_ns = seconds_to_ns(timeout_s);
+        if let Some(s) = self.session.as_mut() {
+            s.set_settings(session);
+        }
+    }
+
+    /// One input received at `now_ns`: the twin is first stepped up to `now_ns`, then the input
+    /// is checked and applied.
+    pub fn feed(&mut self, now_ns: i64, input: Input, emit: &mut impl FnMut(Outgoing)) -> Fed {
+        self.advance_to(now_ns, usize::MAX, emit);
+        self.last_input_ns = Some(now_ns);
+        let fed = match input {
+            Input::Speed {
+                speed_rad_s,
+                accel_rad_s2,
+                stamp_ns,
+            } => self.take_speed(now_ns, speed_rad_s, accel_rad_s2, stamp_ns, emit),
+            Input::Unbalance {
+                plane,
+                magnitude_kg_m,
+                phase_rad,
+            } => self.take_unbalance(plane, magnitude_kg_m, phase_rad),
+            Input::Probe {
+                station,
+                x_m,
+                y_m,
+                stamp_ns,
+            } => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+        };
+        if let Fed::Refused(why) = &fed {
+            self.note_refused(now_ns, why, emit);
+        }
+        self.emit_margin(now_ns, emit);
+        fed
+    }
+
+    /// Counts an input refused before it became an [`Input`] (e.g. a sample that does not
+    /// decode) and warns, as for any refused input.
+    pub fn refuse(&mut self, now_ns: i64, why: &str, emit: &mut impl FnMut(Outgoing)) {
+        self.last_input_ns = Some(now_ns);
+        self.note_refused(now_ns, why, emit);
+    }
+
+    /// Steps the twin while its time is before `now_ns`, at most `max_steps` steps (the node
+    /// bounds the work of one wake); stops it after a gap without input, warns of a stale speed
+    /// and publishes the margin. Returns the steps taken.
+    pub fn advance_to(
+        &mut self,
+        now_ns: i64,
+        max_steps: usize,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> usize {
+        self.check_gap(now_ns, emit);
+        self.check_stale(now_ns, emit);
+        self.warn_refusals(now_ns, emit);
+        let mut taken = 0;
+        if let (Some(s), Some((w, a, _))) = (self.session.as_mut(), self.speed) {
+            let input = StepInput {
+                speed_rad_s: w,
+                accel_rad_s2: a,
+            };
+            while taken < max_steps && s.stamp_ns() < now_ns {
+                if let Err(e) = s.step(&input, emit) {
+                    emit(warning(
+                        s.stamp_ns(),
+                        InstabilityWarning::ERROR,
+                        "model_failure",
+                        "",
+                        format!("step failed: {e}; the twin restarts at the next speed"),
+                    ));
+                    self.session = None;
+                    self.counts.step_failures += 1;
+                    break;
+                }
+                taken += 1;
+            }
+        }
+        self.counts.steps += taken as u64;
+        self.emit_margin(now_ns, emit);
+        taken
+    }
+
+    fn take_speed(
+        &mut self,
+        now_ns: i64,
+        w: f64,
+        a: f64,
+        stamp_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let stamp_ns = if self.settings.check_speed_stamps {
+            stamp_ns
+        } else {
+            0
+        };
+        let (w, a) = match self.gate.check(w, a, stamp_ns, now_ns) {
+            Ok(v) => v,
+            Err(why) => return Fed::Refused(why),
+        };
+        self.speed = Some((w, a, now_ns));
+        self.last_stale_warning_ns = None;
+        if w < self.settings.min_speed_rad_s {
+            // below the model's range: pause, and start afresh when the speed is back
+            self.session = None;
+            return Fed::Taken;
+        }
+        if self.session.is_some() {
+            return Fed::Taken;
+        }
+        self.start(now_ns, w, emit)
+    }
+
+    /// A twin from the static equilibrium at `w` (rad/s), its time zero at `now_ns`, with every
+    /// unbalance received so far.
+    fn start(&mut self, now_ns: i64, w: f64, emit: &mut impl FnMut(Outgoing)) -> Fed {
+        let s = Session::new(
+            &self.rotor,
+            self.settings.twin,
+            w,
+            self.settings.session,
+            now_ns,
+        );
+        let mut s = match s {
+            Ok(s) => s,
+            Err(e) => {
+                emit(warning(
+                    now_ns,
+                    InstabilityWarning::ERROR,
+                    "bad_input",
+                    "",
+                    format!("cannot start the twin at {w:.1} rad/s: {e}"),
+                ));
+                return Fed::Taken;
+            }
+        };
+        for (plane, u) in self.unbalance.iter().enumerate() {
+            if let Some((me, phase)) = *u {
+                // checked when received: the plane exists and the values are finite
+                let _ = s.twin_mut().set_unbalance(plane, me, phase);
+            }
+        }
+        self.session = Some(s);
+        self.counts.starts += 1;
+        Fed::Started { speed_rad_s: w }
+    }
+
+    fn take_unbalance(&mut self, plane: u32, me: f64, phase: f64) -> Fed {
+        match check_unbalance(plane, me, phase, self.limits.planes) {
+            Ok((p, me, phase)) => {
+                self.unbalance[p] = Some((me, phase));
+                if let Some(s) = self.session.as_mut() {
+                    if let Err(e) = s.twin_mut().set_unbalance(p, me, phase) {
+                        return Fed::Refused(format!("unbalance: {e}"));
+                    }
+                }
+                Fed::Taken
+            }
+            Err(why) => Fed::Refused(why),
+        }
+    }
+
+    fn compare_probe(
+        &mut self,
+        now_ns: i64,
+        station: &StationRef,
+        measured: [f64; 2],
+        stamp_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let k = match self.limits.station(station) {
+            Ok(k) => k,
+            Err(why) => return Fed::Refused(why),
+        };
+        if let Err(why) = check_probe(measured[0], measured[1]) {
+            return Fed::Refused(why);
+        }
+        // the sample's own stamp where it is on the driver's clock, else its receive time
+        let tolerance = seconds_to_ns(self.settings.input_timeout_s);
+        let time_ns = if stamp_ns != 0 && (stamp_ns - now_ns).abs() <= tolerance {
+            stamp_ns
+        } else {
+            now_ns
+        };
+        let Some(s) = self.session.as_ref() else {
+            return Fed::Unused;
+        };
+        let Some(r) = s.residual(k, measured, time_ns) else {
+            return Fed::Unused;
+        };
+        let t = (time_ns - s.epoch_ns()) as f64 * 1e-9;
+        let (_, angle_rad) = s.predicted_probe(k, t).unwrap_or_default();
+        let comparison = ProbeComparison {
+            station: k,
+            time_ns,
+            angle_rad,
+            speed_rad_s: s.twin().output().speed_rad_s,
+            measured_m: measured,
+            predicted_m: [r.predicted_x, r.predicted_y],
+        };
+        emit(Outgoing::Residual(r));
+        Fed::Compared(comparison)
+    }
+
+    /// Counts a refusal; the `bad_input` warning goes out at once, then at most once per
+    /// [`REFUSAL_WARNING_INTERVAL_S`] with the count since the last one (a flood of bad samples
+    /// must not flood the warning topic).
+    fn note_refused(&mut self, now_ns: i64, why: &str, emit: &mut impl FnMut(Outgoing)) {
+        self.counts.refused += 1;
+        self.refused_unwarned += 1;
+        self.last_refusal.clear();
+        self.last_refusal.push_str(why);
+        self.warn_refusals(now_ns, emit);
+    }
+
+    fn warn_refusals(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        let interval = seconds_to_ns(REFUSAL_WARNING_INTERVAL_S);
+        let due = self
+            .last_refusal_warning_ns
+            .is_none_or(|t| now_ns >= t.saturating_add(interval));
+        if self.refused_unwarned == 0 || !due {
+            return;
+        }
+        emit(warning(
+            now_ns,
+            InstabilityWarning::WARN,
+            "bad_input",
+            "",
+            format!(
+                "{} input(s) rejected ({} in all); last: {}",
+                self.refused_unwarned, self.counts.refused, self.last_refusal
+            ),
+        ));
+        self.refused_unwarned = 0;
+        self.last_refusal_warning_ns = Some(now_ns);
+    }
+
+    /// After `max_gap_s` without any input the twin stops (a recording that spans a pause is
+    /// not modelled through it).
+    fn check_gap(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        let Some(last) = self.last_input_ns else {
+            return;
+        };
+        let gap = now_ns.saturating_sub(last);
+        if self.session.is_some() && gap > seconds_to_ns(self.settings.max_gap_s) {
+            self.session = None;
+            emit(warning(
+                now_ns,
+                InstabilityWarning::WARN,
+                "stale_input",
+                "",
+                format!(
+                    "no input for {:.3} s (over {} s): the twin stops and restarts at the next speed",
+                    gap as f64 * 1e-9,
+                    self.settings.max_gap_s
+                ),
+            ));
+        }
+    }
+
+    /// A speed older than the timeout is warned about, once per timeout interval, and held.
+    fn check_stale(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        let (Some((w, _, at)), true) = (self.speed, self.session.is_some()) else {
+            return;
+        };
+        let timeout = seconds_to_ns(self.settings.input_timeout_s);
+        let due = self
+            .last_stale_warning_ns
+            .map_or(at.saturating_add(timeout), |t| t.saturating_add(timeout));
+        if now_ns <= due {
+            return;
+        }
+        self.last_stale_warning_ns = Some(now_ns);
+        emit(warning(
+            now_ns,
+            InstabilityWarning::WARN,
+            "stale_input",
+            "",
+            format!(
+                "no speed for {:.2} s; holding {w:.1} rad/s",
+                (now_ns - at) as f64 * 1e-9
+            ),
+        ));
+    }
+
+    fn emit_margin(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        let (Some(threshold), Some((w, _, _))) = (self.threshold, self.speed) else {
+            return;
+        };
+        if now_ns < self.next_margin_ns {
+            return;
+        }
+        emit(Outgoing::Margin(margin(now_ns, w, threshold)));
+        self.next_margin_ns = now_ns.saturating_add(seconds_to_ns(MARGIN_INTERVAL_S));
+    }
+}

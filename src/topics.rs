@@ -1,0 +1,55 @@
+//! The twin's topics and their QoS: one table for the node, its recording and the replay's
+//! output bag.
+
+use crate::record::TopicQos;
+
+/// Rotor speed in (rotor_twin_msgs/RotorSpeed, or std_msgs/Float64 in a stated unit).
+pub const SPEED: &str = "/rotor_twin/speed";
+/// Residual unbalance in (rotor_twin_msgs/Unbalance).
+pub const UNBALANCE: &str = "/rotor_twin/unbalance";
+/// Measured probe displacements in (rotor_twin_msgs/ProbeDisplacement).
+pub const PROBE: &str = "/rotor_twin/probe";
+/// Predicted minus measured at a probe station, out.
+pub const RESIDUAL: &str = "/rotor_twin/residual";
+/// Distance from the linear stability threshold, out.
+pub const MARGIN: &str = "/rotor_twin/stability_margin";
+/// Journal state of each bearing, out.
+pub const JOURNAL: &str = "/rotor_twin/journal_state";
+/// Film state of each bearing, out.
+pub const FILM: &str = "/rotor_twin/film_state";
+/// One revolution's orbit of each bearing, out.
+pub const ORBIT: &str = "/rotor_twin/orbit";
+/// Instability and input warnings, out.
+pub const WARNING: &str = "/rotor_twin/warning";
+/// diagnostic_msgs/DiagnosticArray, out.
+pub const DIAGNOSTICS: &str = "/diagnostics";
+/// rosgraph_msgs/Clock, in with use_sim_time.
+pub const CLOCK: &str = "/clock";
+
+/// QoS the node's sensor subscriptions ask for (speed, probes): best effort, so that a
+/// best-effort sensor publisher (REP 2003 SensorDataQoS, what drivers use) is matched as well as
+/// a reliable one; a deep history (20,000 samples) because RustDDS drops unread samples beyond
+/// it silently, and a burst of 10,000 messages must not lose any.
+pub const SENSOR_READER: TopicQos = TopicQos::sensor(20_000);
+
+/// QoS of the unbalance subscription: reliable (a setting, sent rarely, that must arrive), with
+/// the same deep history.
+pub const COMMAND_READER: TopicQos = TopicQos::reliable(20_000);
+
+/// QoS recorded for every input topic (what `ros2 bag play` then offers): reliable, keep last
+/// 100, which every reader matches.
+pub const INPUT_RECORDED: TopicQos = TopicQos::reliable(100);
+
+/// QoS of the streamed outputs (journal and film states, orbits, residuals, diagnostics):
+/// reliable, keep last 10.
+pub const STATE: TopicQos = TopicQos::reliable(10);
+
+/// QoS of the warning topic: reliable, transient local, keep last 1, so that a late subscriber
+/// sees the warning in force.
+pub const WARNING_QOS: TopicQos = TopicQos::latched(1);
+
+/// QoS of the stability margin: latched, keep last 1.
+pub const MARGIN_QOS: TopicQos = TopicQos::latched(1);
+
+/// QoS of the /clock subscription: best effort, keep last 10 (as rclcpp's clock subscription).
+pub const CLOCK_READER: TopicQos = TopicQos::sensor(10);
