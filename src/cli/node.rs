@@ -1,10 +1,9 @@
 //! `rotor-twin node`: the live ROS 2 node.
 
-use clap::Args;
 use std::path::PathBuf;
 
 /// The live ROS 2 node (run it inside a private network namespace on shared machines).
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, clap::Parser)]
 pub struct NodeArgs {
     /// Machine description (YAML); the built-in ORC microturbine if absent.
     #[arg(long)]
@@ -18,16 +17,66 @@ pub struct NodeArgs {
 }
 
 pub(crate) fn run(args: NodeArgs) -> anyhow::Result<()> {
-    crate::ros::run(crate::ros::NodeSetup {
+    crate::ros::run(setup(args)?)
+}
+
+/// The node's setup; the node's own options may also follow the ROS arguments after `--`, as
+/// `ros2 run` passes them (`node --ros-args -p a:=b -- --record DIR`).
+fn setup(mut args: NodeArgs) -> anyhow::Result<crate::ros::NodeSetup> {
+    if let Some(end) = args.ros_args.iter().position(|a| a == "--") {
+        let rest: Vec<String> = args.ros_args.split_off(end).into_iter().skip(1).collect();
+        let tail = <NodeArgs as clap::Parser>::try_parse_from(
+            std::iter::once("node".to_string()).chain(rest),
+        )?;
+        anyhow::ensure!(
+            !(tail.config.is_some() && args.config.is_some()
+                || tail.record.is_some() && args.record.is_some()),
+            "--config or --record given twice (before --ros-args and after --)"
+        );
+        args.config = args.config.or(tail.config);
+        args.record = args.record.or(tail.record);
+        args.ros_args.extend(tail.ros_args);
+    }
+    Ok(crate::ros::NodeSetup {
         config: args.config,
         record: args.record,
         ros_args: args.ros_args,
     })
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Top {
+        #[command(flatten)]
+        node: NodeArgs,
+    }
+
+    #[test]
+    fn node_options_after_the_ros_arguments_are_kept() {
+        // `node --ros-args … -- --record DIR` used to drop --record silently
+        let top = Top::try_parse_from([
+            "node",
+            "--ros-args",
+            "-p",
+            "model:=linear",
+            "--",
+            "--record",
+            "run1",
+        ])
+        .unwrap();
+        let s = setup(top.node).unwrap();
+        assert_eq!(s.record, Some(PathBuf::from("run1")));
+        assert_eq!(s.ros_args, ["-p", "model:=linear"]);
+    }
+}
+
 /// `rotor-twin param`: a running node's parameters, through its ROS 2 parameter services (run
 /// it in the node's network namespace).
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct ParamArgs {
     /// The node.
     #[arg(long, default_value = "/rotor_twin")]

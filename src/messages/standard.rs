@@ -76,6 +76,17 @@ pub struct KeyValue {
     pub value: String,
 }
 
+impl DiagnosticStatus {
+    /// Level OK.
+    pub const OK: u8 = 0;
+    /// Level WARN.
+    pub const WARN: u8 = 1;
+    /// Level ERROR.
+    pub const ERROR: u8 = 2;
+    /// Level STALE.
+    pub const STALE: u8 = 3;
+}
+
 /// diagnostic_msgs/DiagnosticStatus.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct DiagnosticStatus {

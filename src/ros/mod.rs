@@ -11,7 +11,8 @@
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
 //!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz;
-//! (every QoS in [`crate::topics`]). The subscriptions only decode and queue, stamped with the
+//!
+//! Every QoS is in [`crate::topics`]. The subscriptions only decode and queue, stamped with the
 //! receive time on the node's clock; the model thread feeds the queue to the shared
 //! [`crate::driver::Driver`], which checks and applies each input.
 //! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
@@ -23,7 +24,9 @@ mod params;
 mod recording;
 
 pub use param_client::{run as param_call, ParamCall};
-pub use params::{parse_ros_args, NodeParams, RosArgs, SpeedType, SpeedUnit, RUNTIME_PARAMETERS};
+pub use params::{
+    parse_ros_args, LogLevel, NodeParams, RosArgs, SpeedType, SpeedUnit, RUNTIME_PARAMETERS,
+};
 
 use crate::driver::Input;
 use crate::messages::{self, RosMessage};
@@ -77,13 +80,17 @@ fn qos_profile(q: TopicQos) -> ros2_client::QosProfile {
     }
 }
 
-/// A topic name after remapping, as a ros2-client Name.
-fn topic_name(
-    remaps: &std::collections::BTreeMap<String, String>,
-    default: &str,
-) -> anyhow::Result<Name> {
-    let name = remaps.get(default).map_or(default, String::as_str);
-    Name::parse(name).map_err(|e| anyhow::anyhow!("topic name '{name}': {e:?}"))
+/// A topic of the node, as a ros2-client Name: the twin's own topics (`/rotor_twin/…` in
+/// [`crate::topics`]) live in the node's namespace, `<ns>/rotor_twin/…` (so two twins in two
+/// namespaces do not share a speed); /diagnostics and /clock are global, as ROS 2 tools expect.
+/// Remaps apply after expansion ([`RosArgs::topic`]).
+fn topic_name(ros: &RosArgs, default: &str) -> anyhow::Result<Name> {
+    let relative = default
+        .strip_prefix('/')
+        .filter(|r| r.starts_with("rotor_twin/"))
+        .unwrap_or(default);
+    let name = ros.topic(relative);
+    Name::parse(&name).map_err(|e| anyhow::anyhow!("topic name '{name}': {e:?}"))
 }
 
 fn type_name<T: RosMessage>() -> MessageTypeName {
@@ -150,7 +157,9 @@ pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     {
         // the film tables are built before the node joins the bus, so that the first speed
         // starts the twin at once
-        eprintln!("rotor_twin: tabulating the bearing films…");
+        if ros.log_level <= LogLevel::Info {
+            eprintln!("rotor_twin: tabulating the bearing films…");
+        }
         crate::dynamics::prepare_film_tables(&rotor)?;
     }
     let domain = domain_id()?;
@@ -176,7 +185,8 @@ async fn run_async(
     );
     let mut node = context
         .new_node(
-            NodeName::new("/", "rotor_twin").map_err(|e| anyhow::anyhow!("{e:?}"))?,
+            NodeName::new(&ros.namespace, &ros.node_name)
+                .map_err(|e| anyhow::anyhow!("node name {}: {e:?}", ros.fully_qualified_name()))?,
             node_options(&params, &live),
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
@@ -208,13 +218,14 @@ async fn run_async(
         ..NodeClock::default()
     });
     let (out_tx, out_rx) = mpsc::sync_channel::<Outgoing>(4096);
-    let model = model::ModelLoop::new(
+    let mut model = model::ModelLoop::new(
         rotor.clone(),
         params.clone(),
         live,
         inbox.clone(),
         clock.clone(),
     );
+    model.set_node_name(&ros.fully_qualified_name());
     let model_stop = stop.clone();
     let model_thread = std::thread::Builder::new()
         .name("rotor_twin model".into())
@@ -230,10 +241,19 @@ async fn run_async(
     tokio::spawn(async move {
         let _ = spinner.spin().await;
     });
-    eprintln!(
-        "rotor_twin: node up on ROS domain {domain}; waiting for {}",
-        speed_topic_label(&ros)
-    );
+    if ros.log_level <= LogLevel::Info {
+        eprintln!(
+            "rotor_twin: node {} up on ROS domain {domain}; waiting for {}",
+            ros.fully_qualified_name(),
+            speed_topic_label(&ros)
+        );
+    }
+    if !ros.ignored.is_empty() {
+        eprintln!(
+            "rotor_twin: ROS argument(s) without effect here, ignored: {}",
+            ros.ignored.join(", ")
+        );
+    }
 
     // until SIGINT or SIGTERM
     let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
@@ -241,7 +261,9 @@ async fn run_async(
         _ = tokio::signal::ctrl_c() => {},
         _ = term.recv() => {},
     }
-    eprintln!("rotor_twin: shutting down");
+    if ros.log_level <= LogLevel::Info {
+        eprintln!("rotor_twin: shutting down");
+    }
     stop.store(true, Ordering::Relaxed);
     let _ = model_thread.join();
     let _ = publish_thread.join();
@@ -250,7 +272,10 @@ async fn run_async(
         // the subscription tasks hold senders: end the runtime's tasks by leaving; the recorder
         // stops when every sender is gone or after its last flush
         match t.join() {
-            Ok(Ok(dir)) => eprintln!("rotor_twin: recording finished in {}", dir.display()),
+            Ok(Ok(dir)) if ros.log_level <= LogLevel::Info => {
+                eprintln!("rotor_twin: recording finished in {}", dir.display())
+            }
+            Ok(Ok(_)) => {}
             Ok(Err(e)) => eprintln!("rotor_twin: recording failed: {e:#}"),
             Err(_) => eprintln!("rotor_twin: recorder thread panicked"),
         }
@@ -374,11 +399,7 @@ fn publisher<M: RosMessage>(
     qos: TopicQos,
 ) -> anyhow::Result<ros2_client::Publisher<M>> {
     let topic = node
-        .create_topic(
-            &topic_name(&ros.remaps, name)?,
-            type_name::<M>(),
-            &qos_profile(qos),
-        )
+        .create_topic(&topic_name(ros, name)?, type_name::<M>(), &qos_profile(qos))
         .map_err(|e| anyhow::anyhow!("topic {name}: {e:?}"))?;
     node.create_publisher::<M>(&topic, None)
         .map_err(|e| anyhow::anyhow!("publisher {name}: {e:?}"))
@@ -437,7 +458,7 @@ fn subscribe_inputs(
     route: &InputRoute,
 ) -> anyhow::Result<()> {
     use crate::topics as qos;
-    let speed_topic = topic_name(&ros.remaps, SPEED)?;
+    let speed_topic = topic_name(ros, SPEED)?;
     if params.speed_type == SpeedType::Float64 {
         let unit = params.speed_unit;
         route.subscribe::<messages::Float64>(
@@ -458,14 +479,14 @@ fn subscribe_inputs(
     }
     route.subscribe::<messages::Unbalance>(
         node,
-        &topic_name(&ros.remaps, UNBALANCE)?,
+        &topic_name(ros, UNBALANCE)?,
         qos::COMMAND_READER,
         |m| Ok(Input::from(m)),
         ToRecord::Unbalance,
     )?;
     route.subscribe::<messages::ProbeDisplacement>(
         node,
-        &topic_name(&ros.remaps, PROBE)?,
+        &topic_name(ros, PROBE)?,
         qos::SENSOR_READER,
         |m| Ok(Input::from(m)),
         ToRecord::Probe,
@@ -489,16 +510,13 @@ fn subscribe_inputs(
     }
     if params.use_sim_time {
         // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
-        subscribe_clock(node, &topic_name(&ros.remaps, CLOCK)?, route.clock.clone())?;
+        subscribe_clock(node, &topic_name(ros, CLOCK)?, route.clock.clone())?;
     }
     Ok(())
 }
 
 fn speed_topic_label(ros: &RosArgs) -> String {
-    ros.remaps
-        .get(SPEED)
-        .cloned()
-        .unwrap_or_else(|| SPEED.to_string())
+    topic_name(ros, SPEED).map_or_else(|_| SPEED.to_string(), |n| n.to_string())
 }
 
 /// Where a subscription's samples go: decoded, recorded as received, queued with the receive

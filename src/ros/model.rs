@@ -100,6 +100,10 @@ pub fn driver_settings(p: &NodeParams, rotor: &Rotor) -> DriverSettings {
     s
 }
 
+/// The linear threshold once computed: Some(Some((speed rad/s, whirl ratio))), Some(None) if
+/// stable over the range, None while computing.
+type ThresholdSlot = Option<Option<(f64, f64)>>;
+
 /// Parameters changed at run time, as the parameter services share them.
 pub type LiveParams = (Arc<Mutex<NodeParams>>, Arc<AtomicU64>);
 
@@ -135,10 +139,14 @@ pub struct ModelLoop {
     seen_version: u64,
     inbox: Arc<Mutex<Inbox>>,
     clock: Arc<NodeClock>,
-    threshold: Arc<Mutex<Option<Option<(f64, f64)>>>>,
+    threshold: Arc<Mutex<ThresholdSlot>>,
     timing: Timing,
     dropped_out: u64,
     last_fed_ns: i64,
+    /// the node's name, for the diagnostic status names (`<name>: model`)
+    node_name: String,
+    /// counts at the last diagnostics, to tell what happened in the interval
+    counts_before: crate::driver::DriverCounts,
 }
 
 impl ModelLoop {
@@ -171,6 +179,8 @@ impl ModelLoop {
             timing: Timing::new(),
             dropped_out: 0,
             last_fed_ns: i64::MIN,
+            node_name: "rotor_twin".into(),
+            counts_before: Default::default(),
         }
     }
 
@@ -205,6 +215,11 @@ impl ModelLoop {
         let steps = self.step_until(now, emit);
         self.report(now, emit);
         fed || steps > 0
+    }
+
+    /// The node's name as the diagnostics show it (default `rotor_twin`).
+    pub fn set_node_name(&mut self, name: &str) {
+        self.node_name = name.trim_start_matches('/').to_string();
     }
 
     /// The driver (read only), e.g. for tests.
@@ -299,43 +314,104 @@ impl ModelLoop {
         };
     }
 
-    fn diagnostics(&self, now: i64) -> DiagnosticArray {
+    /// The diagnostics as diagnostic_updater publishes them: one status per concern (the model's
+    /// timing, the inputs), named `<node>: …`, hardware_id the machine's name, levels OK / WARN /
+    /// ERROR / STALE.
+    fn diagnostics(&mut self, now: i64) -> DiagnosticArray {
+        let counts = self.driver.counts();
+        let before = std::mem::replace(&mut self.counts_before, counts);
+        let status = vec![
+            self.model_status(counts.step_failures - before.step_failures),
+            self.input_status(now, counts.refused - before.refused),
+        ];
+        DiagnosticArray {
+            header: crate::session::header(now, ""),
+            status,
+        }
+    }
+
+    fn status(
+        &self,
+        concern: &str,
+        level: u8,
+        message: String,
+        values: Vec<KeyValue>,
+    ) -> DiagnosticStatus {
+        DiagnosticStatus {
+            level,
+            name: format!("{}: {concern}", self.node_name),
+            message,
+            hardware_id: self.driver.rotor().name.clone(),
+            values,
+        }
+    }
+
+    fn model_status(&self, failures: u64) -> DiagnosticStatus {
         let t = &self.timing;
         let h = self.driver.settings().twin.time_step_s;
         let rtf = t.steps as f64 * h / t.since.elapsed().as_secs_f64();
-        let counts = self.driver.counts();
-        let dropped_in = self.inbox.lock().unwrap_or_else(|e| e.into_inner()).dropped;
-        let kv = |key: &str, value: String| KeyValue {
-            key: key.into(),
-            value,
-        };
-        let age = self.driver.speed_age_s(now).unwrap_or_default();
         let values = vec![
             kv("real_time_factor", format!("{rtf:.3}")),
             kv("lag_s", format!("{:.4}", t.lag_s)),
             kv("step_overruns", t.overruns.to_string()),
             kv("worst_step_us", format!("{:.1}", t.worst_step_us)),
-            kv("speed_input_age_s", format!("{age:.3}")),
             kv("dropped_messages", self.dropped_out.to_string()),
-            kv("dropped_inputs", dropped_in.to_string()),
-            kv("refused_inputs", counts.refused.to_string()),
-            kv("step_failures", counts.step_failures.to_string()),
+            kv(
+                "step_failures",
+                self.driver.counts().step_failures.to_string(),
+            ),
             kv("time_step_us", format!("{:.2}", h * 1e6)),
         ];
-        let level = u8::from(t.lag_s > 0.1);
-        DiagnosticArray {
-            header: crate::session::header(now, ""),
-            status: vec![DiagnosticStatus {
-                level,
-                name: "rotor_twin: model".into(),
-                message: if level == 0 {
-                    "keeping up".into()
-                } else {
-                    format!("{:.3} s behind real time", t.lag_s)
-                },
-                hardware_id: "rotor_twin".into(),
-                values,
-            }],
-        }
+        let (level, message) = if failures > 0 {
+            (
+                DiagnosticStatus::ERROR,
+                format!("{failures} step(s) failed; the twin restarts"),
+            )
+        } else if t.lag_s > 0.1 {
+            (
+                DiagnosticStatus::WARN,
+                format!("{:.3} s behind real time", t.lag_s),
+            )
+        } else if self.driver.session().is_none() {
+            (
+                DiagnosticStatus::OK,
+                "waiting for a speed at or above the minimum".into(),
+            )
+        } else {
+            (DiagnosticStatus::OK, "keeping up".into())
+        };
+        self.status("model", level, message, values)
+    }
+
+    fn input_status(&self, now: i64, refused: u64) -> DiagnosticStatus {
+        let counts = self.driver.counts();
+        let dropped_in = self.inbox.lock().unwrap_or_else(|e| e.into_inner()).dropped;
+        let age = self.driver.speed_age_s(now);
+        let values = vec![
+            kv(
+                "speed_input_age_s",
+                age.map_or("none".into(), |a| format!("{a:.3}")),
+            ),
+            kv("refused_inputs", counts.refused.to_string()),
+            kv("dropped_inputs", dropped_in.to_string()),
+        ];
+        let timeout = self.driver.settings().input_timeout_s;
+        let (level, message) = match age {
+            None => (DiagnosticStatus::STALE, "no speed received yet".into()),
+            Some(a) if a > timeout => (DiagnosticStatus::STALE, format!("no speed for {a:.2} s")),
+            Some(_) if refused > 0 => (
+                DiagnosticStatus::WARN,
+                format!("{refused} input(s) refused in the last second"),
+            ),
+            Some(_) => (DiagnosticStatus::OK, "speed fresh".into()),
+        };
+        self.status("inputs", level, message, values)
+    }
+}
+
+fn kv(key: &str, value: String) -> KeyValue {
+    KeyValue {
+        key: key.into(),
+        value,
     }
 }

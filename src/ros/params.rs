@@ -214,12 +214,131 @@ impl NodeParams {
 }
 
 /// What `--ros-args` said.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RosArgs {
     /// Parameters in order of appearance (files first, then -p).
     pub params: Vec<(String, String)>,
-    /// Topic remappings from → to.
+    /// Topic remappings from → to, as given (expanded against the namespace when used).
     pub remaps: BTreeMap<String, String>,
+    /// Node name (`-r __node:=NAME`, as launch_ros passes it); default `rotor_twin`.
+    pub node_name: String,
+    /// Node namespace (`-r __ns:=/NS`); default `/`.
+    pub namespace: String,
+    /// `--log-level` (debug, info, warn, error, fatal); default info.
+    pub log_level: LogLevel,
+    /// rcl arguments accepted but without effect here, as given (each noted at start).
+    pub ignored: Vec<String>,
+}
+
+impl Default for RosArgs {
+    fn default() -> Self {
+        Self {
+            params: Vec::new(),
+            remaps: BTreeMap::new(),
+            node_name: "rotor_twin".into(),
+            namespace: "/".into(),
+            log_level: LogLevel::Info,
+            ignored: Vec::new(),
+        }
+    }
+}
+
+/// Severity of the node's own log lines (rcutils' levels).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum LogLevel {
+    /// Everything.
+    Debug,
+    /// Start-up and shutdown notes (the default).
+    Info,
+    /// Only what went wrong or may have.
+    Warn,
+    /// Only errors.
+    Error,
+    /// Only fatal errors.
+    Fatal,
+}
+
+impl FromStr for LogLevel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        // `--log-level NAME:=LEVEL` sets one logger's level: ours when NAME is the node
+        let level = s.rsplit_once(":=").map_or(s, |(_, l)| l);
+        match level.trim().to_ascii_lowercase().as_str() {
+            "debug" => Ok(LogLevel::Debug),
+            "info" => Ok(LogLevel::Info),
+            "warn" => Ok(LogLevel::Warn),
+            "error" => Ok(LogLevel::Error),
+            "fatal" => Ok(LogLevel::Fatal),
+            _ => Err(format!(
+                "--log-level '{s}': must be debug, info, warn, error or fatal"
+            )),
+        }
+    }
+}
+
+impl RosArgs {
+    /// The node's fully qualified name, e.g. `/line1/twin_a`.
+    pub fn fully_qualified_name(&self) -> String {
+        if self.namespace == "/" {
+            format!("/{}", self.node_name)
+        } else {
+            format!("{}/{}", self.namespace, self.node_name)
+        }
+    }
+
+    /// A topic name expanded as rcl does (a relative name is put in the node's namespace, `~/`
+    /// in the node's own), then remapped: a rule applies when its `from`, expanded the same
+    /// way, is the expanded name.
+    pub fn topic(&self, name: &str) -> String {
+        let expanded = self.expand(name);
+        self.remaps
+            .iter()
+            .filter(|(from, _)| !from.starts_with("__"))
+            .find(|(from, _)| self.expand(from) == expanded)
+            .map_or(expanded, |(_, to)| self.expand(to))
+    }
+
+    fn expand(&self, name: &str) -> String {
+        let ns = self.namespace.trim_end_matches('/');
+        if name.starts_with('/') {
+            name.to_string()
+        } else if let Some(private) = name.strip_prefix("~/") {
+            format!("{}/{private}", self.fully_qualified_name())
+        } else {
+            format!("{ns}/{name}")
+        }
+    }
+}
+
+/// rcl arguments that take a value and have no effect on this node.
+const IGNORED_WITH_VALUE: &[&str] = &["--enclave", "-e", "--log-config-file", "--log-file-name"];
+/// rcl flags without a value that have no effect on this node.
+const IGNORED_FLAGS: &[&str] = &[
+    "--enable-rosout-logs",
+    "--disable-rosout-logs",
+    "--enable-stdout-logs",
+    "--disable-stdout-logs",
+    "--enable-external-lib-logs",
+    "--disable-external-lib-logs",
+];
+
+/// Checks a node name or namespace set by `-r __node:=` / `-r __ns:=`.
+fn check_name(kind: &str, value: &str) -> Result<(), String> {
+    let ok = |part: &str| {
+        part.chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && part.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+    };
+    let good = match kind {
+        "__node" => ok(value),
+        _ => value == "/" || (value.starts_with('/') && value[1..].split('/').all(ok)),
+    };
+    if good {
+        Ok(())
+    } else {
+        Err(format!("-r {kind}:={value}: not a valid ROS 2 name"))
+    }
 }
 
 /// Parses the arguments after `--ros-args` (up to an optional `--`).
@@ -227,29 +346,51 @@ pub fn parse_ros_args(args: &[String]) -> Result<RosArgs, String> {
     let mut out = RosArgs::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
+        let mut value = |what: &str| it.next().ok_or(format!("{a} needs {what}")).cloned();
         match a.as_str() {
             "--" => break,
+            "--ros-args" => {}
             "-p" | "--param" => {
-                let kv = it.next().ok_or("-p needs name:=value")?;
+                let kv = value("name:=value")?;
                 let (k, v) = kv
                     .split_once(":=")
                     .ok_or_else(|| format!("-p {kv}: expected name:=value"))?;
                 out.params.push((k.to_string(), v.to_string()));
             }
             "-r" | "--remap" => {
-                let kv = it.next().ok_or("-r needs from:=to")?;
+                let kv = value("from:=to")?;
                 let (k, v) = kv
                     .split_once(":=")
                     .ok_or_else(|| format!("-r {kv}: expected from:=to"))?;
-                out.remaps.insert(k.to_string(), v.to_string());
+                // `node:__ns:=…` applies to one node; this process has one
+                let k = k.rsplit_once(':').map_or(k, |(_, k)| k);
+                match k {
+                    "__node" | "__name" => {
+                        check_name("__node", v)?;
+                        out.node_name = v.to_string();
+                    }
+                    "__ns" => {
+                        check_name("__ns", v)?;
+                        out.namespace = v.to_string();
+                    }
+                    _ => {
+                        out.remaps.insert(k.to_string(), v.to_string());
+                    }
+                }
             }
             "--params-file" => {
-                let f = it.next().ok_or("--params-file needs a file")?;
-                out.params.extend(read_params_file(Path::new(f))?);
+                let f = value("a file")?;
+                out.params.extend(read_params_file(Path::new(&f))?);
             }
+            "--log-level" => out.log_level = value("a level")?.parse()?,
+            other if IGNORED_WITH_VALUE.contains(&other) => {
+                let v = value("a value")?;
+                out.ignored.push(format!("{other} {v}"));
+            }
+            other if IGNORED_FLAGS.contains(&other) => out.ignored.push(other.to_string()),
             other => {
                 return Err(format!(
-                    "unsupported ROS argument '{other}' (supported: -p, -r, --params-file)"
+                    "unsupported ROS argument '{other}' (supported: -p, -r, --params-file, --log-level, and the rcl logging/enclave flags, which are accepted and ignored)"
                 ))
             }
         }
@@ -297,6 +438,13 @@ fn read_params_file(path: &Path) -> Result<Vec<(String, String)>, String> {
         }
     }
     Ok(out)
+}
+
+impl NodeParams {
+    /// The film evaluation's parameter text.
+    pub fn film_text(&self) -> &'static str {
+        film_name(self.film)
+    }
 }
 
 #[cfg(test)]
@@ -355,11 +503,61 @@ mod tests {
         assert_eq!(p.state_rate_hz, 50.0, "a refused change leaves the value");
         assert!((SpeedUnit::Rpm.to_rad_s(9000.0) - 942.477_796).abs() < 1e-5);
     }
-}
 
-impl NodeParams {
-    /// The film evaluation's parameter text.
-    pub fn film_text(&self) -> &'static str {
-        film_name(self.film)
+    fn args(list: &[&str]) -> Result<RosArgs, String> {
+        parse_ros_args(&list.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn node_name_namespace_and_topic_names_as_rcl_expands_them() {
+        let r = args(&["-r", "__node:=twin_a", "-r", "__ns:=/line1"]).unwrap();
+        assert_eq!(r.fully_qualified_name(), "/line1/twin_a");
+        // the twin's topics are relative: in the namespace; /diagnostics and /clock absolute
+        assert_eq!(r.topic("rotor_twin/speed"), "/line1/rotor_twin/speed");
+        assert_eq!(r.topic("/diagnostics"), "/diagnostics");
+        assert_eq!(r.topic("~/state"), "/line1/twin_a/state");
+        // remaps apply after expansion, their `from` expanded the same way
+        let r = args(&[
+            "-r",
+            "__ns:=/line1",
+            "-r",
+            "rotor_twin/speed:=/plant/rpm",
+            "-r",
+            "/line1/rotor_twin/probe:=probes",
+        ])
+        .unwrap();
+        assert_eq!(r.topic("rotor_twin/speed"), "/plant/rpm");
+        assert_eq!(r.topic("rotor_twin/probe"), "/line1/probes");
+        // without a namespace everything reads as before
+        let r = args(&["-r", "/rotor_twin/speed:=/plant/rpm"]).unwrap();
+        assert_eq!(r.topic("rotor_twin/speed"), "/plant/rpm");
+        assert_eq!(r.topic("rotor_twin/orbit"), "/rotor_twin/orbit");
+        assert!(
+            args(&["-r", "__ns:=line1"]).is_err(),
+            "a namespace is absolute"
+        );
+        assert!(args(&["-r", "__node:=9lives"]).is_err());
+    }
+
+    #[test]
+    fn other_rcl_arguments_are_accepted() {
+        let r = args(&[
+            "--log-level",
+            "warn",
+            "--enclave",
+            "/secure",
+            "--disable-rosout-logs",
+        ])
+        .unwrap();
+        assert_eq!(r.log_level, LogLevel::Warn);
+        assert_eq!(r.ignored, ["--enclave /secure", "--disable-rosout-logs"]);
+        assert_eq!(
+            args(&["--log-level", "rotor_twin:=DEBUG"])
+                .unwrap()
+                .log_level,
+            LogLevel::Debug
+        );
+        assert!(args(&["--log-level", "loud"]).unwrap_err().contains("loud"));
+        assert!(args(&["--bogus"]).unwrap_err().contains("--bogus"));
     }
 }

@@ -1,6 +1,9 @@
 """An independent DDS peer (Cyclone DDS) speaking the ROS 2 conventions to the rotor-twin node.
 
 Usage: peer.py SECONDS SPEED_RAD_S [--domain N] [--bad] [--warnings-only] [--sim-clock RATE]
+               [--ns /NAMESPACE] [--best-effort]
+  --ns: the node's namespace (its topics are NAMESPACE/rotor_twin/...)
+  --best-effort: publish the speed and probes best effort (REP 2003 SensorDataQoS), as sensor drivers do
   --sim-clock RATE: publish /clock from 1000 s at RATE × real time, stamp speeds with it
   --bad: first send NaN, infinite, negative and absurd speeds (the node must refuse them)
   --warnings-only: only listen for the latched warning (a late subscriber)
@@ -136,12 +139,17 @@ def main():
                    Policy.DataRepresentation(use_cdrv0_representation=True))
     latched = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(1),
                   Policy.Durability.TransientLocal, Policy.DataRepresentation(use_cdrv0_representation=True))
-    w = DataWriter(dp, Topic(dp, "rt/rotor_twin/speed", RotorSpeed), qos=reliable)
-    journal = DataReader(dp, Topic(dp, "rt/rotor_twin/journal_state", JournalState), qos=reliable)
-    warnings = DataReader(dp, Topic(dp, "rt/rotor_twin/warning", InstabilityWarning), qos=latched)
-    probe = DataWriter(dp, Topic(dp, "rt/rotor_twin/probe", ProbeDisplacement), qos=reliable)
-    residuals = DataReader(dp, Topic(dp, "rt/rotor_twin/residual", OrbitResidual), qos=reliable)
-    margins = DataReader(dp, Topic(dp, "rt/rotor_twin/stability_margin", StabilityMargin), qos=latched)
+    ns = sys.argv[sys.argv.index("--ns") + 1].strip("/") + "/" if "--ns" in sys.argv else ""
+    t = lambda name: f"rt/{ns}rotor_twin/{name}"
+    sensor = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(5),
+                 Policy.DataRepresentation(use_cdrv0_representation=True))
+    inputs = sensor if "--best-effort" in sys.argv else reliable
+    w = DataWriter(dp, Topic(dp, t("speed"), RotorSpeed), qos=inputs)
+    journal = DataReader(dp, Topic(dp, t("journal_state"), JournalState), qos=reliable)
+    warnings = DataReader(dp, Topic(dp, t("warning"), InstabilityWarning), qos=latched)
+    probe = DataWriter(dp, Topic(dp, t("probe"), ProbeDisplacement), qos=inputs)
+    residuals = DataReader(dp, Topic(dp, t("residual"), OrbitResidual), qos=reliable)
+    margins = DataReader(dp, Topic(dp, t("stability_margin"), StabilityMargin), qos=latched)
     plant_probe = DataWriter(dp, Topic(dp, "rt/plant/probe_b", PointStamped), qos=reliable)
     out = {"sent": 0, "residuals": 0, "residual_ok": True, "journal": 0, "stations": [], "margin": None, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
     start = time.time()
