@@ -67,12 +67,38 @@ pub fn header(ns: i64, frame: &str) -> Header {
     }
 }
 
+/// What a warning about the twin's inputs or its own running is about (the classification's
+/// kinds, none | whirl | whip | contact, come from the monitor's state).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WarningKind {
+    /// An input was refused (bad value, bad stamp, undecodable sample).
+    BadInput,
+    /// An input is overdue (no speed for longer than the timeout, or a gap without input).
+    StaleInput,
+    /// A step of the model failed; the twin restarts.
+    ModelFailure,
+    /// The model runs behind the clock.
+    FallingBehind,
+}
+
+impl WarningKind {
+    /// The `kind` field of the message.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            WarningKind::BadInput => "bad_input",
+            WarningKind::StaleInput => "stale_input",
+            WarningKind::ModelFailure => "model_failure",
+            WarningKind::FallingBehind => "falling_behind",
+        }
+    }
+}
+
 /// A warning message of `level` and `kind`.
-pub fn warning(ns: i64, level: u8, kind: &str, bearing: &str, evidence: String) -> Outgoing {
+pub fn warning(ns: i64, level: u8, kind: WarningKind, bearing: &str, evidence: String) -> Outgoing {
     Outgoing::Warning(InstabilityWarning {
         header: header(ns, bearing),
         level,
-        kind: kind.into(),
+        kind: kind.as_str().into(),
         bearing: bearing.into(),
         evidence,
         ..Default::default()

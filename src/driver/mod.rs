@@ -18,7 +18,7 @@ pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 use crate::dynamics::StepInput;
 use crate::messages::InstabilityWarning;
 use crate::rotor::Rotor;
-use crate::session::{margin, warning, Outgoing, Session, SessionSettings};
+use crate::session::{margin, warning, Outgoing, Session, SessionSettings, WarningKind};
 
 /// Interval between stability-margin messages (s of driver time): 1 Hz, the diagnostics rate.
 pub const MARGIN_INTERVAL_S: f64 = 1.0;
@@ -245,7 +245,7 @@ impl Driver {
                     emit(warning(
                         s.stamp_ns(),
                         InstabilityWarning::ERROR,
-                        "model_failure",
+                        WarningKind::ModelFailure,
                         "",
                         format!("step failed: {e}; the twin restarts at the next speed"),
                     ));
@@ -307,7 +307,7 @@ impl Driver {
                 emit(warning(
                     now_ns,
                     InstabilityWarning::ERROR,
-                    "bad_input",
+                    WarningKind::BadInput,
                     "",
                     format!("cannot start the twin at {w:.1} rad/s: {e}"),
                 ));
@@ -404,7 +404,7 @@ impl Driver {
         emit(warning(
             now_ns,
             InstabilityWarning::WARN,
-            "bad_input",
+            WarningKind::BadInput,
             "",
             format!(
                 "{} input(s) rejected ({} in all); last: {}",
@@ -427,7 +427,7 @@ impl Driver {
             emit(warning(
                 now_ns,
                 InstabilityWarning::WARN,
-                "stale_input",
+                WarningKind::StaleInput,
                 "",
                 format!(
                     "no input for {:.3} s (over {} s): the twin stops and restarts at the next speed",
@@ -454,7 +454,7 @@ impl Driver {
         emit(warning(
             now_ns,
             InstabilityWarning::WARN,
-            "stale_input",
+            WarningKind::StaleInput,
             "",
             format!(
                 "no speed for {:.2} s; holding {w:.1} rad/s",

@@ -159,7 +159,7 @@ pub fn replay(
             _ => None,
         })
         .fold(f64::INFINITY, f64::min);
-    let mut comparisons: Vec<StationComparison> = stations
+    let comparisons: Vec<StationComparison> = stations
         .iter()
         .map(|s| StationComparison::new(s, clearance))
         .collect();
@@ -181,46 +181,22 @@ pub fn replay(
     report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
     let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
     driver.set_threshold(crate::session::linear_threshold(rotor));
-    let mut emitted: Vec<Outgoing> = Vec::new();
+    let mut run = Replaying {
+        driver,
+        report,
+        comparisons,
+        emitted: Vec::new(),
+        t0_ns: t0 as i64,
+    };
     let mut last_progress = std::time::Instant::now();
-    let since_t0 = |t_ns: i64| (t_ns - t0 as i64) as f64 * 1e-9;
     for m in &bag.messages {
         if m.log_time_ns > t_end {
             break;
         }
-        let t_ns = m.log_time_ns.min(i64::MAX as u64) as i64;
-        report.messages_in += 1;
-        let topic = &bag.topics[m.topic].name;
-        match decode(roles[m.topic], bag.payload(m), options.speed_unit) {
-            Ok(None) => driver.advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o)),
-            Ok(Some(input)) => {
-                match driver.feed(t_ns, input, &mut |o| emitted.push(o)) {
-                    Fed::Started { speed_rad_s } => {
-                        report.note_start(since_t0(t_ns), crate::units::rad_s_to_rpm(speed_rad_s))
-                    }
-                    Fed::Compared(c) => comparisons[c.station].push(Sample {
-                        time_s: since_t0(c.time_ns),
-                        angle_rad: c.angle_rad,
-                        speed_rad_s: c.speed_rad_s,
-                        measured_m: c.measured_m,
-                        predicted_m: c.predicted_m,
-                    }),
-                    Fed::Refused(why) => report.note_rejection(topic, &why),
-                    Fed::Taken | Fed::Unused => {}
-                }
-                0
-            }
-            Err(why) => {
-                let why = format!("{topic}: {why}");
-                driver.advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o));
-                driver.refuse(t_ns, &why, &mut |o| emitted.push(o));
-                report.note_rejection(topic, &why);
-                0
-            }
-        };
+        run.message(bag, m, roles[m.topic], options.speed_unit);
         // the report and the output bag
-        for o in emitted.drain(..) {
-            report.note_output(&o, t0, driver.session_slot());
+        for o in run.emitted.drain(..) {
+            run.report.note_output(&o, t0, run.driver.session_slot());
             if let Some(out) = out.as_mut() {
                 out.write_outgoing(&o)?;
             }
@@ -241,11 +217,66 @@ pub fn replay(
         }
     }
     progress(1.0);
+    let Replaying {
+        mut report,
+        comparisons,
+        ..
+    } = run;
     report.finish(&comparisons, wall.elapsed().as_secs_f64());
     if let Some(out) = out {
         report.messages_out = out.finish()?;
     }
     Ok((report, comparisons))
+}
+
+/// A replay under way: the driver, what it emitted for the message at hand, and the report and
+/// comparisons being filled.
+struct Replaying {
+    driver: Driver,
+    report: ReplayReport,
+    comparisons: Vec<StationComparison>,
+    emitted: Vec<Outgoing>,
+    t0_ns: i64,
+}
+
+impl Replaying {
+    /// One bag message of role `role` through the driver, at its receive time.
+    fn message(&mut self, bag: &Bag, m: &BagMessage, role: Role, unit: SpeedUnit) {
+        let t_ns = m.log_time_ns.min(i64::MAX as u64) as i64;
+        let since_t0 = |t_ns: i64| (t_ns - self.t0_ns) as f64 * 1e-9;
+        self.report.messages_in += 1;
+        let topic = &bag.topics[m.topic].name;
+        let emitted = &mut self.emitted;
+        let fed = match decode(role, bag.payload(m), unit) {
+            Ok(None) => {
+                self.driver
+                    .advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o));
+                return;
+            }
+            Ok(Some(input)) => self.driver.feed(t_ns, input, &mut |o| emitted.push(o)),
+            Err(why) => {
+                let why = format!("{topic}: {why}");
+                self.driver
+                    .advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o));
+                self.driver.refuse(t_ns, &why, &mut |o| emitted.push(o));
+                Fed::Refused(why)
+            }
+        };
+        match fed {
+            Fed::Started { speed_rad_s } => self
+                .report
+                .note_start(since_t0(t_ns), crate::units::rad_s_to_rpm(speed_rad_s)),
+            Fed::Compared(c) => self.comparisons[c.station].push(Sample {
+                time_s: since_t0(c.time_ns),
+                angle_rad: c.angle_rad,
+                speed_rad_s: c.speed_rad_s,
+                measured_m: c.measured_m,
+                predicted_m: c.predicted_m,
+            }),
+            Fed::Refused(why) => self.report.note_rejection(topic, &why),
+            Fed::Taken | Fed::Unused => {}
+        }
+    }
 }
 
 /// The twin's input in a bag message of role `role` (None: a topic the twin does not use), or

@@ -192,24 +192,8 @@ async fn run_async(
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
     let publishers = Publishers::create(&mut node, &ros)?;
 
-    // recording
-    let (rec_tx, rec_rx) = mpsc::sync_channel::<ToRecord>(65_536);
     let stop = Arc::new(AtomicBool::new(false));
-    let recorder_thread = match &setup.record {
-        Some(dir) => Some(recording::spawn(
-            dir,
-            params.speed_type == SpeedType::Float64,
-            &params.probe_point_topics,
-            rec_rx,
-            stop.clone(),
-        )?),
-        None => {
-            drop(rec_rx);
-            None
-        }
-    };
-    let rec = setup.record.is_some().then(|| rec_tx.clone());
-    drop(rec_tx);
+    let (recorder_thread, rec) = start_recorder(&setup, &params, &stop)?;
 
     // the model thread and the publishing thread
     let inbox = Arc::new(Mutex::new(Inbox::default()));
@@ -226,13 +210,20 @@ async fn run_async(
         clock.clone(),
     );
     model.set_node_name(&ros.fully_qualified_name());
+    let counters = Arc::new(model::NodeCounters::default());
+    model.set_counters(counters.clone());
     let model_stop = stop.clone();
     let model_thread = std::thread::Builder::new()
         .name("rotor_twin model".into())
         .spawn(move || model.run(out_tx, model_stop))?;
-    let publish_thread = publishers.spawn(out_rx, rec.clone())?;
+    let publish_thread = publishers.spawn(out_rx, rec.clone(), counters.clone())?;
 
-    let route = InputRoute { inbox, clock, rec };
+    let route = InputRoute {
+        inbox,
+        clock,
+        rec,
+        counters,
+    };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
     let spinner = node
@@ -269,18 +260,47 @@ async fn run_async(
     let _ = publish_thread.join();
     drop(node);
     if let Some(t) = recorder_thread {
-        // the subscription tasks hold senders: end the runtime's tasks by leaving; the recorder
-        // stops when every sender is gone or after its last flush
-        match t.join() {
-            Ok(Ok(dir)) if ros.log_level <= LogLevel::Info => {
-                eprintln!("rotor_twin: recording finished in {}", dir.display())
-            }
-            Ok(Ok(_)) => {}
-            Ok(Err(e)) => eprintln!("rotor_twin: recording failed: {e:#}"),
-            Err(_) => eprintln!("rotor_twin: recorder thread panicked"),
-        }
+        finish_recording(t, &ros);
     }
     Ok(())
+}
+
+/// The recorder thread and its queue, when `--record` asks for one.
+type Recording = (
+    Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
+    Option<mpsc::SyncSender<ToRecord>>,
+);
+
+fn start_recorder(
+    setup: &NodeSetup,
+    params: &NodeParams,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<Recording> {
+    let Some(dir) = &setup.record else {
+        return Ok((None, None));
+    };
+    let (tx, rx) = mpsc::sync_channel::<ToRecord>(65_536);
+    let thread = recording::spawn(
+        dir,
+        params.speed_type == SpeedType::Float64,
+        &params.probe_point_topics,
+        rx,
+        stop.clone(),
+    )?;
+    Ok((Some(thread), Some(tx)))
+}
+
+/// Waits for the recorder: the subscription tasks hold senders, so it stops after its last
+/// flush once the runtime's tasks are gone.
+fn finish_recording(t: std::thread::JoinHandle<anyhow::Result<PathBuf>>, ros: &RosArgs) {
+    match t.join() {
+        Ok(Ok(dir)) if ros.log_level <= LogLevel::Info => {
+            eprintln!("rotor_twin: recording finished in {}", dir.display())
+        }
+        Ok(Ok(_)) => {}
+        Ok(Err(e)) => eprintln!("rotor_twin: recording failed: {e:#}"),
+        Err(_) => eprintln!("rotor_twin: recorder thread panicked"),
+    }
 }
 
 /// The DDS context on `domain`: on the loopback interface only when the environment asks for
@@ -425,6 +445,7 @@ impl Publishers {
         self,
         out: mpsc::Receiver<Outgoing>,
         rec: Option<mpsc::SyncSender<ToRecord>>,
+        counters: Arc<model::NodeCounters>,
     ) -> std::io::Result<std::thread::JoinHandle<()>> {
         std::thread::Builder::new()
             .name("rotor_twin publish".into())
@@ -441,7 +462,7 @@ impl Publishers {
                         Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
                     };
                     if let Some(rec) = &rec {
-                        let _ = rec.try_send(ToRecord::Out(item, t));
+                        counters.record(rec, ToRecord::Out(item, t));
                     }
                 }
             })
@@ -526,6 +547,7 @@ struct InputRoute {
     inbox: Arc<Mutex<Inbox>>,
     clock: Arc<NodeClock>,
     rec: Option<mpsc::SyncSender<ToRecord>>,
+    counters: Arc<model::NodeCounters>,
 }
 
 impl InputRoute {
@@ -547,6 +569,7 @@ impl InputRoute {
             .create_subscription::<M>(&topic, Some(qos_profile(qos)))
             .map_err(|e| anyhow::anyhow!("subscription {name:?}: {e:?}"))?;
         let (inbox, clock, rec) = (self.inbox.clone(), self.clock.clone(), self.rec.clone());
+        let counters = self.counters.clone();
         let label = format!("{name:?}");
         tokio::spawn(async move {
             let mut stream = Box::pin(sub.async_stream());
@@ -556,8 +579,7 @@ impl InputRoute {
                     Ok((m, _info)) => {
                         let input = to_input(&m);
                         if let Some(rec) = &rec {
-                            // a full recorder queue is counted by the recorder's drop count
-                            let _ = rec.try_send(to_record(m, now_ns()));
+                            counters.record(rec, to_record(m, now_ns()));
                         }
                         input
                     }

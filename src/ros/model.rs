@@ -8,7 +8,7 @@ use crate::driver::{Driver, DriverSettings, Input};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
-use crate::session::{warning, SessionSettings};
+use crate::session::{warning, SessionSettings, WarningKind};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::SyncSender;
@@ -43,6 +43,22 @@ impl Inbox {
             self.dropped += 1;
         }
         self.queue.push_back(item);
+    }
+}
+
+/// Counts kept outside the model thread, reported in its diagnostics.
+#[derive(Debug, Default)]
+pub struct NodeCounters {
+    /// Messages the recorder could not take (its queue was full): lost from the recording.
+    pub recording_dropped: AtomicU64,
+}
+
+impl NodeCounters {
+    /// Hands `item` to the recorder; a full queue loses it, counted.
+    pub fn record<T>(&self, rec: &std::sync::mpsc::SyncSender<T>, item: T) {
+        if rec.try_send(item).is_err() {
+            self.recording_dropped.fetch_add(1, Ordering::Relaxed);
+        }
     }
 }
 
@@ -145,6 +161,7 @@ pub struct ModelLoop {
     last_fed_ns: i64,
     /// the node's name, for the diagnostic status names (`<name>: model`)
     node_name: String,
+    counters: Arc<NodeCounters>,
     /// counts at the last diagnostics, to tell what happened in the interval
     counts_before: crate::driver::DriverCounts,
 }
@@ -180,6 +197,7 @@ impl ModelLoop {
             dropped_out: 0,
             last_fed_ns: i64::MIN,
             node_name: "rotor_twin".into(),
+            counters: Arc::default(),
             counts_before: Default::default(),
         }
     }
@@ -220,6 +238,11 @@ impl ModelLoop {
     /// The node's name as the diagnostics show it (default `rotor_twin`).
     pub fn set_node_name(&mut self, name: &str) {
         self.node_name = name.trim_start_matches('/').to_string();
+    }
+
+    /// The counters the node's other threads keep, for the diagnostics.
+    pub fn set_counters(&mut self, counters: Arc<NodeCounters>) {
+        self.counters = counters;
     }
 
     /// The driver (read only), e.g. for tests.
@@ -298,7 +321,7 @@ impl ModelLoop {
             emit(warning(
                 now,
                 InstabilityWarning::WARN,
-                "falling_behind",
+                WarningKind::FallingBehind,
                 "",
                 format!("the model runs {lag:.3} s behind the clock"),
             ));
@@ -356,6 +379,13 @@ impl ModelLoop {
             kv("step_overruns", t.overruns.to_string()),
             kv("worst_step_us", format!("{:.1}", t.worst_step_us)),
             kv("dropped_messages", self.dropped_out.to_string()),
+            kv(
+                "recording_dropped",
+                self.counters
+                    .recording_dropped
+                    .load(Ordering::Relaxed)
+                    .to_string(),
+            ),
             kv(
                 "step_failures",
                 self.driver.counts().step_failures.to_string(),
