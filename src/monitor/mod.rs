@@ -5,7 +5,9 @@
 
 pub mod spectrum;
 
-pub use spectrum::{order_spectrum, OrderComponent};
+pub use spectrum::{
+    interpolate_peak, one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
+};
 
 use crate::dynamics::{StepOutput, Twin};
 use serde::Serialize;
@@ -40,6 +42,15 @@ pub struct ClassifierSettings {
     pub subsync_min_one_x_share: f64,
     /// Largest eccentricity ratio in the revolution above which a whirl is a whip.
     pub whip_eccentricity_ratio: f64,
+}
+
+impl ClassifierSettings {
+    /// A sub-synchronous semi-major axis `subsync_m` counts (is dominant) beside a 1X one of
+    /// `one_x_m` in a bearing of radial clearance `clearance_m` (all m).
+    pub fn subsync_counts(&self, subsync_m: f64, one_x_m: f64, clearance_m: f64) -> bool {
+        subsync_m > self.subsync_min_clearance_share * clearance_m
+            && subsync_m > self.subsync_min_one_x_share * one_x_m
+    }
 }
 
 impl Default for ClassifierSettings {
@@ -403,41 +414,13 @@ impl Monitor {
                 SPECTRUM_REVOLUTIONS,
                 &mut self.spectrum,
             );
-            let one_x = self.spectrum[SPECTRUM_REVOLUTIONS - 1];
-            // dominant sub-synchronous order, k < R − 1: the Hann window leaks half of the 1X
-            // component into its neighbour bin (R−1)/R, so that bin is left out; refined by a
-            // parabola through the log amplitudes
-            let (mut kbest, mut abest) = (0, 0.0);
-            for (k, comp) in self
-                .spectrum
-                .iter()
-                .enumerate()
-                .take(SPECTRUM_REVOLUTIONS - 2)
-            {
-                if comp.semi_major_m() > abest {
-                    abest = comp.semi_major_m();
-                    kbest = k;
-                }
-            }
-            let mut ratio = self.spectrum[kbest].order;
-            if kbest > 0 && kbest + 1 < SPECTRUM_REVOLUTIONS - 2 {
-                let (a, b, cc) = (
-                    self.spectrum[kbest - 1].semi_major_m().max(1e-30).ln(),
-                    abest.max(1e-30).ln(),
-                    self.spectrum[kbest + 1].semi_major_m().max(1e-30).ln(),
-                );
-                let denom = a - 2.0 * b + cc;
-                if denom < 0.0 {
-                    ratio +=
-                        (0.5 * (a - cc) / denom).clamp(-0.5, 0.5) / SPECTRUM_REVOLUTIONS as f64;
-                }
-            }
+            let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
+            let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
+            let (abest, ratio) = (peak.semi_major_m(), peak.order);
             // a window shorter than its resolution cannot resolve orders: no verdict on
             // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
             let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
-            let dominant = full_window
-                && abest > s.subsync_min_clearance_share * c
-                && abest > s.subsync_min_one_x_share * one_x.semi_major_m();
+            let dominant = full_window && s.subsync_counts(abest, one_x.semi_major_m(), c);
             let b_state = if contact {
                 RotorState::Contact
             } else if dominant && e > s.whip_eccentricity_ratio {
@@ -462,7 +445,7 @@ impl Monitor {
                 one_x_phase_rad: one_x.forward_phase_rad,
                 subsync_ratio: if dominant { ratio } else { 0.0 },
                 subsync_amplitude_m: abest,
-                subsync_forward: self.spectrum[kbest].forward_m >= self.spectrum[kbest].backward_m,
+                subsync_forward: peak.forward_m >= peak.backward_m,
                 max_pressure_pa: p,
                 // not comparable (speed changed within a revolution): keep the last value
                 orbit_path_diff: path_diff,

@@ -4,7 +4,9 @@
 //! are sampled at the same instants, so they are aligned by shaft angle by construction; the
 //! shaft angle is the twin's, integrated from the bag's speed.
 
-use crate::monitor::spectrum::{order_spectrum, OrderComponent};
+use crate::monitor::spectrum::{
+    one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
+};
 use crate::monitor::ClassifierSettings;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -37,10 +39,11 @@ pub struct OrbitFeatures {
     pub one_x_amplitude_m: f64,
     /// Phase of the forward 1X component against the shaft angle (degrees).
     pub one_x_phase_deg: f64,
-    /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−2)/R.
+    /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−3)/R, corrected between
+    /// bins ([`subsynchronous_peak`], the monitor's detector).
     pub subsync_amplitude_m: f64,
-    /// Its order, refined between bins (Gaussian interpolation); None unless it counts by the
-    /// monitor's rule (≥ 2 % of the clearance and ≥ half the 1X amplitude).
+    /// Its order, refined between bins; None unless it counts by the monitor's rule (≥ 2 % of
+    /// the clearance and ≥ half the 1X amplitude).
     pub subsync_ratio: Option<f64>,
     /// Mean position `[x, y]` (m).
     pub mean_m: [f64; 2],
@@ -147,7 +150,7 @@ impl StationComparison {
         while self
             .recent
             .front()
-            .is_some_and(|f| s.angle_rad - f.angle_rad > SUMMARY_REVS as f64 * TAU)
+            .is_some_and(|f| s.angle_rad - f.angle_rad > (SUMMARY_REVS + 1) as f64 * TAU)
         {
             self.recent.pop_front();
         }
@@ -164,7 +167,7 @@ impl StationComparison {
         }
         let start = recent
             .iter()
-            .position(|s| last.angle_rad - s.angle_rad <= revs as f64 * TAU)
+            .position(|s| last.angle_rad - s.angle_rad < revs as f64 * TAU)
             .unwrap_or(0);
         self.compare(&recent[start..], revs)
     }
@@ -254,28 +257,14 @@ impl StationComparison {
             samples.iter().map(|s| pick(s)[0]).sum::<f64>() / n,
             samples.iter().map(|s| pick(s)[1]).sum::<f64>() / n,
         ];
-        let one_x = spec[revs - 1];
-        // the Hann window leaks 1X into the bin next to it: sub-synchronous bins are 2 … R−2
-        let (mut kbest, mut abest) = (0, 0.0);
-        for k in 2..revs.saturating_sub(1) {
-            let a = spec[k - 1].semi_major_m();
-            if a > abest {
-                (kbest, abest) = (k, a);
-            }
-        }
-        let counts = abest > self.settings.subsync_min_clearance_share * self.clearance_m
-            && abest > self.settings.subsync_min_one_x_share * one_x.semi_major_m();
-        let ratio = counts.then(|| {
-            let mag = |k: usize| spec[k - 1].semi_major_m().max(1e-30).ln();
-            let (a, b, c) = (mag(kbest - 1), mag(kbest), mag(kbest + 1));
-            let den = a - 2.0 * b + c;
-            let shift = if den.abs() > 1e-12 {
-                (0.5 * (a - c) / den).clamp(-0.5, 0.5)
-            } else {
-                0.0
-            };
-            (kbest as f64 + shift) / revs as f64
-        });
+        let one_x = one_x_component(&spec, revs);
+        // the monitor's detector (bins 2 … R−3, interpolated between bins)
+        let peak = subsynchronous_peak(&spec, revs);
+        let abest = peak.semi_major_m();
+        let counts = self
+            .settings
+            .subsync_counts(abest, one_x.semi_major_m(), self.clearance_m);
+        let ratio = counts.then_some(peak.order);
         OrbitFeatures {
             one_x_amplitude_m: one_x.semi_major_m(),
             one_x_phase_deg: one_x.forward_phase_rad.to_degrees(),
@@ -368,9 +357,10 @@ mod tests {
         assert!((dphi - 20.0).abs() < 1.0, "phase error {dphi}°");
         let r = w.measured.subsync_ratio.expect("0.45X found");
         assert!((r - 0.45).abs() < 0.01, "ratio {r}");
-        // an off-bin component loses up to ~15 % to the Hann window's scalloping
+        // off-bin (14.4 bins of 1/32 order): the interpolation undoes the Hann window's
+        // scalloping loss (13 % here), so to 1 %
         assert!(
-            (w.measured.subsync_amplitude_m / 2e-6 - 1.0).abs() < 0.2,
+            (w.measured.subsync_amplitude_m / 2e-6 - 1.0).abs() < 0.01,
             "{w:?}"
         );
         assert!(w.predicted.subsync_ratio.is_none());
