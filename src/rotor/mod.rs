@@ -15,9 +15,9 @@ mod statics;
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use machine::{
-    BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec, MachineDescription,
-    MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec, DEFAULT_MACHINE_NAME,
-    DEFAULT_MACHINE_YAML,
+    AlarmLevelsSpec, BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec,
+    MachineDescription, MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec,
+    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
     campbell, critical_speeds_rpm, damped_modes, stability_threshold, undamped_frequencies_hz,
