@@ -478,3 +478,41 @@ pub fn margin(ns: i64, speed_rad_s: f64, threshold: Option<(f64, f64)>) -> Stabi
         whirl_ratio,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::Coupling;
+    use crate::rotor::MachineDescription;
+
+    /// The hysteresis in model time: a worse (level, state) at once; a milder one only after
+    /// it has been reported for `state_hold_s` (1 s), and then the worst reported in that time;
+    /// a flicker within the hold changes nothing.
+    #[test]
+    fn a_milder_warning_waits_for_the_hold_time() {
+        let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+        let omega = rotor.rated_speed_rad_s;
+        let config = TwinConfig::with_steps_per_rev(Coupling::Linear, omega, 64);
+        let mut s = Session::new(&rotor, config, omega, SessionSettings::default(), 0).unwrap();
+        let (ok, warn, err) = (
+            InstabilityWarning::OK,
+            InstabilityWarning::WARN,
+            InstabilityWarning::ERROR,
+        );
+        let whip = (err, RotorState::Whip);
+        let whirl = (warn, RotorState::Whirl);
+        let stable = (ok, RotorState::Stable);
+        assert_eq!(s.hold(whip, 0.0), whip);
+        s.announced = whip;
+        // whirl and stable alternate for 0.99 s: still whip
+        for k in 1..100 {
+            let c = if k % 2 == 0 { whirl } else { stable };
+            assert_eq!(s.hold(c, 0.01 * k as f64), whip, "at {} s", 0.01 * k as f64);
+        }
+        // after 1 s of milder reports: the worst of them
+        assert_eq!(s.hold(stable, 1.05), whirl);
+        s.announced = whirl;
+        // worse again: at once
+        assert_eq!(s.hold(whip, 1.06), whip);
+    }
+}
