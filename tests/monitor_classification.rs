@@ -179,3 +179,30 @@ fn a_linear_orbit_beyond_the_clearance_is_flagged() {
     }
     assert!(judged > 100, "{judged} revolutions judged");
 }
+
+/// The machine file's optional `alarm_levels`: read when given, refused with the field and the
+/// rule when the danger level lies below the alert one.
+#[test]
+fn alarm_levels_in_the_machine_file_are_checked() {
+    use rotor_twin::rotor::DEFAULT_MACHINE_YAML;
+    let given = format!(
+        "{DEFAULT_MACHINE_YAML}\nalarm_levels: {{alert_amplitude_m: 25.0e-6, danger_amplitude_m: 35.0e-6}}\n"
+    );
+    let d = MachineDescription::from_yaml(&given, "machine.yaml").unwrap();
+    let a = d.alarm_levels.unwrap();
+    assert_eq!(
+        (a.alert_amplitude_m, a.danger_amplitude_m),
+        (25.0e-6, 35.0e-6)
+    );
+    assert!(MachineDescription::builtin_default().alarm_levels.is_none());
+    let bad = format!(
+        "{DEFAULT_MACHINE_YAML}\nalarm_levels: {{alert_amplitude_m: 50.0e-6, danger_amplitude_m: 30.0e-6}}\n"
+    );
+    let e = MachineDescription::from_yaml(&bad, "machine.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("alarm_levels.danger_amplitude_m") && e.contains("at least"),
+        "{e}"
+    );
+}

@@ -112,7 +112,7 @@ pub fn interpolate_peak(spec: &[OrderComponent], k: usize, resolution: usize) ->
         return OrderComponent::default();
     };
     let a0 = centre.semi_major_m();
-    if !(a0 > 0.0) {
+    if a0.is_nan() || a0 <= 0.0 {
         return *centre;
     }
     let below = if k >= 2 {
