@@ -5,11 +5,19 @@
 
 use crate::dynamics::{StepInput, Twin, TwinConfig, TwinError};
 use crate::messages::*;
-use crate::monitor::{ClassifierSettings, Monitor, RotorState, PRESSURE_POINTS};
+use crate::monitor::{
+    AlarmLevels, AlarmOverride, BearingRevolution, ClassifierSettings, Monitor, RotorState,
+    PRESSURE_POINTS,
+};
 use crate::rotor::Rotor;
 
-/// Revolutions a milder state must hold before the warning steps down to it.
-pub const DEESCALATION_REVOLUTIONS: u32 = 3;
+/// Time a milder warning (state or level) must hold before the warning steps down to it (s of
+/// model time). A worse one is announced at once: an alarm is never delayed. One second is
+/// the time scale an operator reads a panel on and the order of the alarm delays of
+/// machinery-protection systems (API 670); it spans 75 whirl periods of a 0.5X whirl at
+/// 9,000 rpm and 14 at 1,700 rpm, so a whirl grazing a threshold cannot flip the warning more
+/// than once a second, whatever the speed.
+pub const DEFAULT_STATE_HOLD_S: f64 = 1.0;
 
 /// Output rates and warning thresholds of a session (the node's parameters and the replay's
 /// options of the same names default to these).
@@ -27,6 +35,12 @@ pub struct SessionSettings {
     pub warning_amplitude_ratio: f64,
     /// While not stable, the warning is repeated this often (s of model time). Default 1 s.
     pub warning_repeat_s: f64,
+    /// A milder warning must hold this long before it is announced (s of model time; default
+    /// [`DEFAULT_STATE_HOLD_S`]).
+    pub state_hold_s: f64,
+    /// Alarm levels instead of the field-practice ones (e.g. the machine file's
+    /// `alarm_levels`, through `AlarmOverride::from`); None: API 617 / ISO 20816-3.
+    pub alarm_levels: Option<AlarmOverride>,
 }
 
 impl Default for SessionSettings {
@@ -36,6 +50,8 @@ impl Default for SessionSettings {
             pressure_map_rate_hz: 2.0,
             warning_amplitude_ratio: 0.5,
             warning_repeat_s: 1.0,
+            state_hold_s: DEFAULT_STATE_HOLD_S,
+            alarm_levels: None,
         }
     }
 }
@@ -119,10 +135,14 @@ pub struct Session {
     step_index: u64,
     decimation: u64,
     map_decimation: u64,
-    /// the state last announced by a warning
-    last_state: RotorState,
-    /// revolutions the monitor has reported a milder state than the announced one
-    milder_for: u32,
+    /// configured alarm levels (None: field practice)
+    alarm_override: Option<AlarmOverride>,
+    /// the (level, state) last announced by a warning
+    announced: (u8, RotorState),
+    /// since when (s of model time) the monitor has reported milder than the announced, and
+    /// the worst it reported since
+    milder_since_s: Option<f64>,
+    milder_worst: (u8, RotorState),
     last_warning_s: f64,
     /// probe displacements (m) and time (s) before the last step, for interpolation
     previous_probes: Vec<[f64; 2]>,
@@ -145,7 +165,14 @@ impl Session {
             (std::f64::consts::TAU / rotor.rated_speed_rad_s.max(1e-9) / config.time_step_s)
                 .round()
                 .max(8.0) as usize;
-        let monitor = Monitor::new(&twin, 2 * steps_per_rev, ClassifierSettings::default());
+        // the session's override, else the machine file's levels, else the monitor's defaults
+        let classifier = ClassifierSettings {
+            alarm_levels: settings
+                .alarm_levels
+                .or_else(|| rotor.alarm_levels.as_ref().map(Into::into)),
+            ..ClassifierSettings::default()
+        };
+        let monitor = Monitor::new(&twin, 2 * steps_per_rev, classifier);
         let names = twin.bearing_names().map(str::to_string).collect();
         let clearances = twin.bearing_clearances_m();
         let o = twin.output();
@@ -166,8 +193,10 @@ impl Session {
             step_index: 0,
             decimation: 1,
             map_decimation: 1,
-            last_state: RotorState::Stable,
-            milder_for: 0,
+            alarm_override: classifier.alarm_levels,
+            announced: (InstabilityWarning::OK, RotorState::Stable),
+            milder_since_s: None,
+            milder_worst: (InstabilityWarning::OK, RotorState::Stable),
             last_warning_s: f64::NEG_INFINITY,
             previous_probes,
             previous_time_s,
@@ -344,58 +373,102 @@ impl Session {
             }));
         }
         let now = self.twin.time_s();
-        // hysteresis: a worse state is announced at once, a milder one only once it has held
-        // for DEESCALATION_REVOLUTIONS revolutions (an orbit grazing a threshold would otherwise
-        // flip the warning every revolution)
-        let state = if rep.state >= self.last_state {
-            self.milder_for = 0;
-            rep.state
-        } else {
-            self.milder_for += 1;
-            if self.milder_for >= DEESCALATION_REVOLUTIONS {
-                self.milder_for = 0;
-                rep.state
-            } else {
-                self.last_state
-            }
-        };
-        let reminder = state != RotorState::Stable
-            && now - self.last_warning_s >= self.settings.warning_repeat_s;
-        if state == self.last_state && !reminder {
-            return;
-        }
-        self.last_warning_s = now;
-        self.last_state = state;
-        let (k, b) = rep
+        let Some((k, b)) = rep
             .bearings
             .iter()
             .enumerate()
-            .max_by(|a, b| a.1.state.cmp(&b.1.state))
+            .max_by(|a, b| {
+                (warning_level(a.1), a.1.state)
+                    .cmp(&(warning_level(b.1), b.1.state))
+                    .then(a.1.amplitude_m.total_cmp(&b.1.amplitude_m))
+            })
             .map(|(k, b)| (k, *b))
-            .unwrap_or_default();
-        let (level, kind) = match state {
-            RotorState::Stable => (InstabilityWarning::OK, "none"),
-            RotorState::Whirl => (InstabilityWarning::WARN, "whirl"),
-            RotorState::Whip => (InstabilityWarning::ERROR, "whip"),
-            RotorState::Contact => (InstabilityWarning::ERROR, "contact"),
+        else {
+            return;
         };
-        let amplitude = 0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m)
-            / self.clearances.get(k).copied().unwrap_or(1.0);
-        let level =
-            if state == RotorState::Stable && amplitude > self.settings.warning_amplitude_ratio {
-                InstabilityWarning::WARN
-            } else {
-                level
-            };
+        let (rep_state, speed_rad_s) = (rep.state, rep.speed_rad_s);
+        let announce = self.hold((warning_level(&b), rep_state), now);
+        let reminder = announce.1 != RotorState::Stable
+            && now - self.last_warning_s >= self.settings.warning_repeat_s;
+        if announce == self.announced && !reminder {
+            return;
+        }
+        self.last_warning_s = now;
+        self.announced = announce;
+        let (level, state) = announce;
+        let clearance = self.clearances.get(k).copied().unwrap_or(1.0);
+        let amplitude_ratio = b.amplitude_m / clearance;
+        let level = if state == RotorState::Stable
+            && amplitude_ratio > self.settings.warning_amplitude_ratio
+        {
+            level.max(InstabilityWarning::WARN)
+        } else {
+            level
+        };
+        let speed_rpm = speed_rad_s * 30.0 / std::f64::consts::PI;
+        let levels = AlarmLevels::new(clearance, speed_rpm, self.alarm_override);
         emit(Outgoing::Warning(InstabilityWarning {
             header: header(stamp, self.names.get(k).map_or("", String::as_str)),
             level,
-            kind: kind.into(),
+            kind: state.warning_kind().into(),
             bearing: self.names.get(k).cloned().unwrap_or_default(),
             whirl_ratio: b.subsync_ratio,
-            amplitude_over_clearance: amplitude,
-            evidence: rep.evidence(),
+            amplitude_over_clearance: amplitude_ratio,
+            evidence: self.monitor.report().evidence(),
+            growth_per_rev: b.subsync_growth_per_rev.unwrap_or(0.0),
+            time_to_alert: b.time_to_alert_s.unwrap_or(-1.0),
+            amplitude: b.amplitude_m,
+            alert_level: levels.alert_m,
+            danger_level: levels.danger_m,
+            alarm_basis: levels.basis,
+            contact: b.contact,
+            contact_count: b.contact_events,
+            max_penetration: b.max_penetration_m,
+            beyond_clearance: b.beyond_clearance,
         }));
+    }
+
+    /// The hysteresis: a worse (level, state) than the announced one is announced at once; a
+    /// milder one once the monitor has reported milder for `state_hold_s`, and then the worst
+    /// it reported in that time.
+    fn hold(&mut self, candidate: (u8, RotorState), now_s: f64) -> (u8, RotorState) {
+        if candidate >= self.announced {
+            self.milder_since_s = None;
+            return candidate;
+        }
+        match self.milder_since_s {
+            None => {
+                self.milder_since_s = Some(now_s);
+                self.milder_worst = candidate;
+            }
+            Some(_) => self.milder_worst = self.milder_worst.max(candidate),
+        }
+        let since = self.milder_since_s.unwrap_or(now_s);
+        if now_s - since >= self.settings.state_hold_s {
+            self.milder_since_s = None;
+            self.milder_worst
+        } else {
+            self.announced
+        }
+    }
+}
+
+/// The warning level of one bearing's revolution: ERROR for whip, wall contact, a journal
+/// beyond the clearance or an amplitude at the danger level; WARN for a growing or whirling
+/// sub-synchronous component or an amplitude at the alert level; else OK.
+pub fn warning_level(b: &BearingRevolution) -> u8 {
+    if b.state == RotorState::Whip
+        || b.contact
+        || b.beyond_clearance
+        || (b.danger_level_m > 0.0 && b.amplitude_m >= b.danger_level_m)
+    {
+        InstabilityWarning::ERROR
+    } else if b.state != RotorState::Stable
+        || (b.alert_level_m > 0.0 && b.amplitude_m >= b.alert_level_m)
+    {
+        InstabilityWarning::WARN
+    } else {
+        InstabilityWarning::OK
     }
 }
 
@@ -437,5 +510,43 @@ pub fn margin(ns: i64, speed_rad_s: f64, threshold: Option<(f64, f64)>) -> Stabi
             0.0
         },
         whirl_ratio,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::Coupling;
+    use crate::rotor::MachineDescription;
+
+    /// The hysteresis in model time: a worse (level, state) at once; a milder one only after
+    /// it has been reported for `state_hold_s` (1 s), and then the worst reported in that time;
+    /// a flicker within the hold changes nothing.
+    #[test]
+    fn a_milder_warning_waits_for_the_hold_time() {
+        let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+        let omega = rotor.rated_speed_rad_s;
+        let config = TwinConfig::with_steps_per_rev(Coupling::Linear, omega, 64);
+        let mut s = Session::new(&rotor, config, omega, SessionSettings::default(), 0).unwrap();
+        let (ok, warn, err) = (
+            InstabilityWarning::OK,
+            InstabilityWarning::WARN,
+            InstabilityWarning::ERROR,
+        );
+        let whip = (err, RotorState::Whip);
+        let whirl = (warn, RotorState::Whirl);
+        let stable = (ok, RotorState::Stable);
+        assert_eq!(s.hold(whip, 0.0), whip);
+        s.announced = whip;
+        // whirl and stable alternate for 0.99 s: still whip
+        for k in 1..100 {
+            let c = if k % 2 == 0 { whirl } else { stable };
+            assert_eq!(s.hold(c, 0.01 * k as f64), whip, "at {} s", 0.01 * k as f64);
+        }
+        // after 1 s of milder reports: the worst of them
+        assert_eq!(s.hold(stable, 1.05), whirl);
+        s.announced = whirl;
+        // worse again: at once
+        assert_eq!(s.hold(whip, 1.06), whip);
     }
 }

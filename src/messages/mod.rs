@@ -247,6 +247,26 @@ ros_message!(
         amplitude_over_clearance: f64 = "float64",
         /// The evidence in words.
         evidence: String = "string",
+        /// Growth rate of the sub-synchronous amplitude (1/rev); 0 if not yet known.
+        growth_per_rev: f64 = "float64",
+        /// Predicted time to the alert level (s); −1 if not growing.
+        time_to_alert: f64 = "float64",
+        /// Orbit amplitude, half peak-to-peak (m).
+        amplitude: f64 = "float64",
+        /// Alert amplitude (m).
+        alert_level: f64 = "float64",
+        /// Danger amplitude (m).
+        danger_level: f64 = "float64",
+        /// Basis of the two levels.
+        alarm_basis: String = "string",
+        /// Wall contact in the last revolution.
+        contact: bool = "bool",
+        /// Contacts begun in the last revolution.
+        contact_count: u32 = "uint32",
+        /// Largest penetration beyond the contact onset (m).
+        max_penetration: f64 = "float64",
+        /// Journal beyond the clearance without contact (model outside its validity).
+        beyond_clearance: bool = "bool",
     }
 );
 

@@ -3,9 +3,16 @@
 //! component, forward/backward), and a classification with its evidence. Fed one step at a time;
 //! storage is reserved at construction and nothing is allocated per step.
 
+pub mod classify;
 pub mod spectrum;
 
-pub use spectrum::{order_spectrum, OrderComponent};
+pub use classify::{
+    AlarmLevels, AlarmOverride, ClassifierSettings, Evidence, RotorState, API_617_CLEARANCE_SHARE,
+};
+
+pub use spectrum::{
+    interpolate_peak, one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
+};
 
 use crate::dynamics::{StepOutput, Twin};
 use serde::Serialize;
@@ -13,44 +20,10 @@ use std::f64::consts::TAU;
 
 /// Revolutions in the spectrum window (order resolution 1/16).
 pub const SPECTRUM_REVOLUTIONS: usize = 16;
+/// Revolutions (of spectrum windows, one a revolution) the growth rate is fitted over.
+pub const GROWTH_REVOLUTIONS: usize = 16;
 /// Points of the mid-plane pressure profile kept per step.
 pub const PRESSURE_POINTS: usize = 60;
-
-/// Operating state of the rotor.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum RotorState {
-    /// Synchronous response only.
-    #[default]
-    Stable,
-    /// A dominant sub-synchronous whirl of moderate amplitude.
-    Whirl,
-    /// A dominant sub-synchronous whirl with the orbit near the clearance.
-    Whip,
-    /// The journal touched the bearing wall.
-    Contact,
-}
-
-/// Thresholds of the classification.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ClassifierSettings {
-    /// Sub-synchronous semi-major axis that counts, as a share of the clearance.
-    pub subsync_min_clearance_share: f64,
-    /// ... and as a share of the 1X semi-major axis.
-    pub subsync_min_one_x_share: f64,
-    /// Largest eccentricity ratio in the revolution above which a whirl is a whip.
-    pub whip_eccentricity_ratio: f64,
-}
-
-impl Default for ClassifierSettings {
-    fn default() -> Self {
-        Self {
-            subsync_min_clearance_share: 0.02,
-            subsync_min_one_x_share: 0.5,
-            whip_eccentricity_ratio: 0.75,
-        }
-    }
-}
 
 /// One bearing over the last revolution (and the spectrum window).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -85,6 +58,29 @@ pub struct BearingRevolution {
     pub pressure_diff: f64,
     /// The journal touched the wall in the last revolution.
     pub contact: bool,
+    /// Contacts begun in the last revolution (steps entering contact; a contact under way at
+    /// its start counts once).
+    pub contact_events: u32,
+    /// Largest penetration beyond the contact onset in the last revolution (m).
+    pub max_penetration_m: f64,
+    /// The journal centre went beyond the clearance circle (ε > 1) without wall contact: a
+    /// model without a wall (the linear one) outside its validity.
+    pub beyond_clearance: bool,
+    /// Orbit amplitude: half the larger peak-to-peak displacement of the last revolution (m).
+    pub amplitude_m: f64,
+    /// Alert amplitude (m) at this speed ([`AlarmLevels`]).
+    pub alert_level_m: f64,
+    /// Danger amplitude (m).
+    pub danger_level_m: f64,
+    /// Growth rate of the non-synchronous motion (1/rev, per shaft revolution): the smaller of
+    /// the median revolution-to-revolution increments of the logarithms of the sub-synchronous
+    /// semi-major axis and of the rev-to-rev orbit difference over the last [`GROWTH_REVOLUTIONS`] revolutions; None
+    /// until that many full spectrum windows are in.
+    pub subsync_growth_per_rev: Option<f64>,
+    /// At that rate, the time until the sub-synchronous semi-major axis reaches the alert level
+    /// (s of model time, at the present speed); None unless it grows (beyond the classifier's
+    /// rate), zero once there.
+    pub time_to_alert_s: Option<f64>,
     /// This bearing's state.
     pub state: RotorState,
 }
@@ -126,16 +122,49 @@ impl RevolutionReport {
                 b.max_eccentricity_ratio,
                 b.orbit_diff,
                 b.pressure_diff,
-                if b.contact { ", wall contact" } else { "" }
+                growth_words(b),
             ),
             None => "no bearings".into(),
         }
     }
 }
 
+/// The growth, contact and validity clauses of the evidence (allocates).
+fn growth_words(b: &BearingRevolution) -> String {
+    let mut s = match b.subsync_growth_per_rev {
+        Some(g) => format!(", growth {g:+.4}/rev"),
+        None => String::new(),
+    };
+    if let Some(t) = b.time_to_alert_s {
+        s += &format!(", alert level {:.1} µm in {t:.2} s", b.alert_level_m * 1e6);
+    }
+    s += &format!(
+        ", amplitude {:.2} µm (alert {:.1}, danger {:.1} µm)",
+        b.amplitude_m * 1e6,
+        b.alert_level_m * 1e6,
+        b.danger_level_m * 1e6
+    );
+    if b.contact {
+        s += &format!(
+            ", wall contact ({} in the revolution, penetration up to {:.2} µm)",
+            b.contact_events,
+            b.max_penetration_m * 1e6
+        );
+    }
+    if b.beyond_clearance {
+        s += ", JOURNAL BEYOND THE CLEARANCE (the model knows no wall: outside its validity)";
+    }
+    s
+}
+
 /// Ring buffers of the recent samples of one bearing.
 struct BearingHistory {
     clearance_m: f64,
+    /// sub-synchronous semi-major axes (m) of the last GROWTH_REVOLUTIONS full windows,
+    /// oldest first
+    subsync_history: Vec<f64>,
+    /// rev-to-rev orbit differences of the last GROWTH_REVOLUTIONS comparable revolutions
+    diff_history: Vec<f64>,
     x: Vec<f64>,
     y: Vec<f64>,
     ecc: Vec<f64>,
@@ -158,6 +187,8 @@ pub struct Monitor {
     rev_lengths: Vec<usize>,
     current_rev_len: usize,
     revolutions: u64,
+    /// eccentricity ratio at which the wall takes over
+    contact_onset_ratio: f64,
     spectrum: Vec<OrderComponent>,
     profile: Vec<f64>,
     report: RevolutionReport,
@@ -172,6 +203,8 @@ impl Monitor {
             .iter()
             .map(|&c| BearingHistory {
                 clearance_m: c,
+                subsync_history: Vec::with_capacity(GROWTH_REVOLUTIONS),
+                diff_history: Vec::with_capacity(GROWTH_REVOLUTIONS),
                 x: vec![0.0; capacity],
                 y: vec![0.0; capacity],
                 ecc: vec![0.0; capacity],
@@ -191,6 +224,7 @@ impl Monitor {
             rev_lengths: Vec::with_capacity(SPECTRUM_REVOLUTIONS + 1),
             current_rev_len: 0,
             revolutions: 0,
+            contact_onset_ratio: twin.config().contact.onset_eccentricity_ratio,
             spectrum: vec![OrderComponent::default(); SPECTRUM_REVOLUTIONS],
             profile: vec![0.0; PRESSURE_POINTS],
             report: RevolutionReport {
@@ -299,154 +333,186 @@ impl Monitor {
         Some(&self.report)
     }
 
+    /// Ring index of the sample `back` steps before the newest.
+    fn idx(&self, back: usize) -> usize {
+        (self.head + 2 * self.capacity - 1 - back) % self.capacity
+    }
+
+    /// Extremes of the last `last` samples of bearing `bi`: x and y ranges (m), largest
+    /// eccentricity ratio and pressure (Pa), contacts begun, largest penetration (m).
+    fn last_revolution(&self, bi: usize, last: usize) -> LastRevolution {
+        let h = &self.bearings[bi];
+        let mut r = LastRevolution {
+            x: [f64::MAX, f64::MIN],
+            y: [f64::MAX, f64::MIN],
+            ..LastRevolution::default()
+        };
+        for back in 0..last {
+            let i = self.idx(back);
+            r.x = [r.x[0].min(h.x[i]), r.x[1].max(h.x[i])];
+            r.y = [r.y[0].min(h.y[i]), r.y[1].max(h.y[i])];
+            r.ecc = r.ecc.max(h.ecc[i]);
+            r.p_max = r.p_max.max(h.p_max[i]);
+            if h.contact[i] {
+                r.contact = true;
+                let before = back + 1 < last && h.contact[self.idx(back + 1)];
+                if !before {
+                    r.contact_events += 1;
+                }
+                r.penetration = r
+                    .penetration
+                    .max((h.ecc[i] - self.contact_onset_ratio).max(0.0) * h.clearance_m);
+            }
+        }
+        r
+    }
+
+    /// Rev-to-rev differences of bearing `bi` (orbit over the clearance, pressure relative):
+    /// each sample of the last revolution against the sample one revolution earlier (offset =
+    /// the last revolution's length; at constant speed the lengths differ by at most one step
+    /// from rounding); NaN when not comparable.
+    fn rev_to_rev(&self, bi: usize, last: usize, prev: usize) -> (f64, f64) {
+        let h = &self.bearings[bi];
+        let count = last.min(prev);
+        if count == 0 || last.abs_diff(prev) > 1 || self.len < last + count {
+            return (f64::NAN, f64::NAN);
+        }
+        let (mut d2, mut pd2, mut p2) = (0.0, 0.0, 0.0);
+        for back in 0..count {
+            let (i, j) = (self.idx(back), self.idx(back + last));
+            d2 += (h.x[i] - h.x[j]).powi(2) + (h.y[i] - h.y[j]).powi(2);
+            let (a, b) = (
+                &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS],
+                &h.pressure[j * PRESSURE_POINTS..(j + 1) * PRESSURE_POINTS],
+            );
+            for (u, v) in a.iter().zip(b) {
+                pd2 += (u - v).powi(2);
+                p2 += u * u;
+            }
+        }
+        let pressure = if p2 > 0.0 { (pd2 / p2).sqrt() } else { 0.0 };
+        ((d2 / count as f64).sqrt() / h.clearance_m, pressure)
+    }
+
+    /// Path distance of bearing `bi`: each point of the last revolution to the polyline of the
+    /// two before, over the clearance; None if not enough is stored.
+    fn path_diff(&self, bi: usize, last: usize) -> Option<f64> {
+        let h = &self.bearings[bi];
+        if last <= 1 || self.len < 3 * last {
+            return None;
+        }
+        // every point against every segment costs O(n²) a revolution: up to 32 points of the
+        // revolution, evenly spread, are compared (all segments are searched)
+        let stride = last.div_ceil(32);
+        let (mut sum, mut points) = (0.0, 0usize);
+        for back in (0..last).step_by(stride) {
+            points += 1;
+            let p = self.idx(back);
+            let (px, py) = (h.x[p], h.y[p]);
+            let mut best = f64::MAX;
+            for seg in last..3 * last - 1 {
+                let (a, b) = (self.idx(seg), self.idx(seg + 1));
+                best = best.min(point_segment_distance2(
+                    px, py, h.x[a], h.y[a], h.x[b], h.y[b],
+                ));
+            }
+            sum += best;
+        }
+        Some((sum / points as f64).sqrt() / h.clearance_m)
+    }
+
+    /// The order spectrum of bearing `bi` over the last `window` samples (oldest first) into
+    /// `self.spectrum`, from at most 32 samples a revolution: the orders resolved go up to 2,
+    /// far below that rate's Nyquist order of 16.
+    fn window_spectrum(&mut self, bi: usize, window: usize) {
+        let h = &self.bearings[bi];
+        let idx = |back: usize| (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+        let per_rev = window / self.rev_lengths.len().clamp(1, SPECTRUM_REVOLUTIONS);
+        let stride = per_rev.div_ceil(32).max(1);
+        let picks = window.div_ceil(stride);
+        order_spectrum(
+            (0..picks).map(|k| h.x[idx(window - 1 - k * stride)]),
+            (0..picks).map(|k| h.y[idx(window - 1 - k * stride)]),
+            (0..picks).map(|k| self.angle[idx(window - 1 - k * stride)]),
+            picks,
+            SPECTRUM_REVOLUTIONS,
+            &mut self.spectrum,
+        );
+    }
+
+    /// Appends a full window's sub-synchronous amplitude and the revolution's orbit difference
+    /// (if comparable) to bearing `bi`'s histories and estimates the growth rate: the smaller
+    /// of the two median increments of their logarithms (None until GROWTH_REVOLUTIONS amplitudes and half as many
+    /// differences are in). Both grow at the rate of an unstable mode; the window spectrum
+    /// alone also rises for one window length after a sudden change (a step of unbalance, the
+    /// start) while the free vibration it excites already decays, which the orbit difference,
+    /// with two revolutions of memory, shows at once.
+    fn growth(&mut self, bi: usize, subsync_m: f64, orbit_diff: f64) -> Option<f64> {
+        let h = &mut self.bearings[bi];
+        if h.subsync_history.len() == GROWTH_REVOLUTIONS {
+            h.subsync_history.remove(0);
+        }
+        h.subsync_history.push(subsync_m.max(1e-300));
+        if orbit_diff.is_finite() {
+            if h.diff_history.len() == GROWTH_REVOLUTIONS {
+                h.diff_history.remove(0);
+            }
+            h.diff_history.push(orbit_diff.max(1e-300));
+        }
+        if h.subsync_history.len() < GROWTH_REVOLUTIONS
+            || h.diff_history.len() < GROWTH_REVOLUTIONS / 2
+        {
+            return None;
+        }
+        let spectral = classify::log_growth_per_rev(h.subsync_history.iter().copied())?;
+        let diff = classify::log_growth_per_rev(h.diff_history.iter().copied())?;
+        Some(spectral.min(diff))
+    }
+
     fn analyse(&mut self, time_s: f64, speed_rad_s: f64) {
         let last = (*self.rev_lengths.last().unwrap_or(&0)).min(self.len);
-        let window: usize = self
-            .rev_lengths
-            .iter()
-            .rev()
-            .take(SPECTRUM_REVOLUTIONS)
-            .sum::<usize>()
-            .min(self.len);
+        let window = self.recent_samples(SPECTRUM_REVOLUTIONS);
         let prev = if self.rev_lengths.len() >= 2 {
             self.rev_lengths[self.rev_lengths.len() - 2]
         } else {
             0
         };
-        let s = self.settings;
+        // a window shorter than its resolution cannot resolve orders: no verdict on
+        // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
+        let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
+        let speed_rpm = speed_rad_s * 30.0 / std::f64::consts::PI;
         let mut state = RotorState::Stable;
         let (mut od, mut pd) = (0.0_f64, 0.0_f64);
-        for (bi, h) in self.bearings.iter().enumerate() {
-            let c = h.clearance_m;
-            let idx = |back: usize| (self.head + 2 * self.capacity - 1 - back) % self.capacity;
-            // the last revolution
-            let (mut x0, mut x1, mut y0, mut y1, mut e, mut p, mut contact) = (
-                f64::MAX,
-                f64::MIN,
-                f64::MAX,
-                f64::MIN,
-                0.0_f64,
-                0.0_f64,
-                false,
-            );
-            for back in 0..last {
-                let i = idx(back);
-                x0 = x0.min(h.x[i]);
-                x1 = x1.max(h.x[i]);
-                y0 = y0.min(h.y[i]);
-                y1 = y1.max(h.y[i]);
-                e = e.max(h.ecc[i]);
-                p = p.max(h.p_max[i]);
-                contact |= h.contact[i];
-            }
-            // rev-to-rev differences: each sample of the last revolution against the sample one
-            // revolution earlier (offset = the last revolution's length; at constant speed the
-            // lengths differ by at most one step from rounding)
-            let (orbit_diff, pressure_diff);
-            let count = last.min(prev);
-            if count > 0 && last.abs_diff(prev) <= 1 && self.len >= last + count {
-                let (mut d2, mut pd2, mut p2) = (0.0, 0.0, 0.0);
-                for back in 0..count {
-                    let (i, j) = (idx(back), idx(back + last));
-                    d2 += (h.x[i] - h.x[j]).powi(2) + (h.y[i] - h.y[j]).powi(2);
-                    let (a, b) = (
-                        &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS],
-                        &h.pressure[j * PRESSURE_POINTS..(j + 1) * PRESSURE_POINTS],
-                    );
-                    for (u, v) in a.iter().zip(b) {
-                        pd2 += (u - v).powi(2);
-                        p2 += u * u;
-                    }
-                }
-                orbit_diff = (d2 / count as f64).sqrt() / c;
-                pressure_diff = if p2 > 0.0 { (pd2 / p2).sqrt() } else { 0.0 };
+        for bi in 0..self.bearings.len() {
+            let c = self.bearings[bi].clearance_m;
+            let r = self.last_revolution(bi, last);
+            let (orbit_diff, pressure_diff) = self.rev_to_rev(bi, last, prev);
+            let path_diff = self
+                .path_diff(bi, last)
+                .unwrap_or(self.report.bearings[bi].orbit_path_diff);
+            self.window_spectrum(bi, window);
+            let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
+            let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
+            let subsync_m = peak.semi_major_m();
+            let growth = if full_window {
+                self.growth(bi, subsync_m, orbit_diff)
             } else {
-                orbit_diff = f64::NAN;
-                pressure_diff = f64::NAN;
-            }
-            // path distance: each point of the last revolution to the polyline of the two before
-            let mut path_diff = self.report.bearings[bi].orbit_path_diff;
-            if last > 1 && self.len >= 3 * last {
-                // every point against every segment costs O(n²) a revolution: up to 32 points of
-                // the revolution, evenly spread, are compared (all segments are searched)
-                let stride = last.div_ceil(32);
-                let (mut sum, mut points) = (0.0, 0usize);
-                for back in (0..last).step_by(stride) {
-                    points += 1;
-                    let p = idx(back);
-                    let (px, py) = (h.x[p], h.y[p]);
-                    let mut best = f64::MAX;
-                    for seg in last..3 * last - 1 {
-                        let (a, b) = (idx(seg), idx(seg + 1));
-                        best = best.min(point_segment_distance2(
-                            px, py, h.x[a], h.y[a], h.x[b], h.y[b],
-                        ));
-                    }
-                    sum += best;
-                }
-                path_diff = (sum / points as f64).sqrt() / c;
-            }
-            // spectrum over the window (oldest first), from at most 32 samples a revolution: the
-            // orders resolved go up to 2, far below that rate's Nyquist order of 16
-            let start = window;
-            let per_rev = window / self.rev_lengths.len().clamp(1, SPECTRUM_REVOLUTIONS);
-            let stride = per_rev.div_ceil(32).max(1);
-            let picks = window.div_ceil(stride);
-            let xs = (0..picks).map(|k| h.x[idx(start - 1 - k * stride)]);
-            let ys = (0..picks).map(|k| h.y[idx(start - 1 - k * stride)]);
-            let angles = (0..picks).map(|k| self.angle[idx(start - 1 - k * stride)]);
-            order_spectrum(
-                xs,
-                ys,
-                angles,
-                picks,
-                SPECTRUM_REVOLUTIONS,
-                &mut self.spectrum,
-            );
-            let one_x = self.spectrum[SPECTRUM_REVOLUTIONS - 1];
-            // dominant sub-synchronous order, k < R − 1: the Hann window leaks half of the 1X
-            // component into its neighbour bin (R−1)/R, so that bin is left out; refined by a
-            // parabola through the log amplitudes
-            let (mut kbest, mut abest) = (0, 0.0);
-            for (k, comp) in self
-                .spectrum
-                .iter()
-                .enumerate()
-                .take(SPECTRUM_REVOLUTIONS - 2)
-            {
-                if comp.semi_major_m() > abest {
-                    abest = comp.semi_major_m();
-                    kbest = k;
-                }
-            }
-            let mut ratio = self.spectrum[kbest].order;
-            if kbest > 0 && kbest + 1 < SPECTRUM_REVOLUTIONS - 2 {
-                let (a, b, cc) = (
-                    self.spectrum[kbest - 1].semi_major_m().max(1e-30).ln(),
-                    abest.max(1e-30).ln(),
-                    self.spectrum[kbest + 1].semi_major_m().max(1e-30).ln(),
-                );
-                let denom = a - 2.0 * b + cc;
-                if denom < 0.0 {
-                    ratio +=
-                        (0.5 * (a - cc) / denom).clamp(-0.5, 0.5) / SPECTRUM_REVOLUTIONS as f64;
-                }
-            }
-            // a window shorter than its resolution cannot resolve orders: no verdict on
-            // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
-            let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
-            let dominant = full_window
-                && abest > s.subsync_min_clearance_share * c
-                && abest > s.subsync_min_one_x_share * one_x.semi_major_m();
-            let b_state = if contact {
-                RotorState::Contact
-            } else if dominant && e > s.whip_eccentricity_ratio {
-                RotorState::Whip
-            } else if dominant {
-                RotorState::Whirl
-            } else {
-                RotorState::Stable
+                None
             };
+            let s = self.settings;
+            let b_state = s.classify(&Evidence {
+                clearance_m: c,
+                subsync_m,
+                one_x_m: one_x.semi_major_m(),
+                max_eccentricity_ratio: r.ecc,
+                full_window,
+                growth_per_rev: growth,
+            });
+            let dominant = full_window && s.subsync_counts(subsync_m, one_x.semi_major_m(), c);
+            let (alert, danger) = s.alarm_amplitudes_m(c, speed_rpm);
+            let time_to_alert_s = growth
+                .filter(|&g| g > s.growth_threshold_per_rev && speed_rad_s > 0.0)
+                .map(|g| (alert / subsync_m).ln().max(0.0) / g * TAU / speed_rad_s);
             state = state.max(b_state);
             if orbit_diff.is_finite() {
                 od = od.max(orbit_diff);
@@ -454,29 +520,39 @@ impl Monitor {
             if pressure_diff.is_finite() {
                 pd = pd.max(pressure_diff);
             }
+            let old = self.report.bearings[bi];
+            let (pp_x, pp_y) = ((r.x[1] - r.x[0]).max(0.0), (r.y[1] - r.y[0]).max(0.0));
             self.report.bearings[bi] = BearingRevolution {
-                orbit_pp_x_m: (x1 - x0).max(0.0),
-                orbit_pp_y_m: (y1 - y0).max(0.0),
-                max_eccentricity_ratio: e,
+                orbit_pp_x_m: pp_x,
+                orbit_pp_y_m: pp_y,
+                max_eccentricity_ratio: r.ecc,
                 one_x_amplitude_m: one_x.semi_major_m(),
                 one_x_phase_rad: one_x.forward_phase_rad,
-                subsync_ratio: if dominant { ratio } else { 0.0 },
-                subsync_amplitude_m: abest,
-                subsync_forward: self.spectrum[kbest].forward_m >= self.spectrum[kbest].backward_m,
-                max_pressure_pa: p,
+                subsync_ratio: if dominant { peak.order } else { 0.0 },
+                subsync_amplitude_m: subsync_m,
+                subsync_forward: peak.forward_m >= peak.backward_m,
+                max_pressure_pa: r.p_max,
                 // not comparable (speed changed within a revolution): keep the last value
                 orbit_path_diff: path_diff,
                 orbit_diff: if orbit_diff.is_finite() {
                     orbit_diff
                 } else {
-                    self.report.bearings[bi].orbit_diff
+                    old.orbit_diff
                 },
                 pressure_diff: if pressure_diff.is_finite() {
                     pressure_diff
                 } else {
-                    self.report.bearings[bi].pressure_diff
+                    old.pressure_diff
                 },
-                contact,
+                contact: r.contact,
+                contact_events: r.contact_events,
+                max_penetration_m: r.penetration,
+                beyond_clearance: r.ecc > 1.0 && !r.contact,
+                amplitude_m: 0.5 * pp_x.max(pp_y),
+                alert_level_m: alert,
+                danger_level_m: danger,
+                subsync_growth_per_rev: growth,
+                time_to_alert_s,
                 state: b_state,
             };
         }
@@ -487,6 +563,18 @@ impl Monitor {
         self.report.rev_to_rev_orbit_diff = od;
         self.report.rev_to_rev_pressure_diff = pd;
     }
+}
+
+/// The extremes of one bearing's last revolution.
+#[derive(Debug, Clone, Copy, Default)]
+struct LastRevolution {
+    x: [f64; 2],
+    y: [f64; 2],
+    ecc: f64,
+    p_max: f64,
+    contact: bool,
+    contact_events: u32,
+    penetration: f64,
 }
 
 /// Squared distance from point (px, py) to the segment (ax, ay)–(bx, by).

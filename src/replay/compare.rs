@@ -4,7 +4,9 @@
 //! are sampled at the same instants, so they are aligned by shaft angle by construction; the
 //! shaft angle is the twin's, integrated from the bag's speed.
 
-use crate::monitor::spectrum::{order_spectrum, OrderComponent};
+use crate::monitor::spectrum::{
+    one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
+};
 use crate::monitor::ClassifierSettings;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -14,6 +16,28 @@ use std::f64::consts::TAU;
 pub const BLOCK_REVS: usize = 8;
 /// Revolutions of the summary window at the end of the bag.
 pub const SUMMARY_REVS: usize = 32;
+/// Consecutive blocks over which a sub-synchronous component must persist or grow to be an
+/// onset (24 revolutions: 0.16 s at 9,000 rpm).
+pub const ONSET_BLOCKS: usize = 3;
+
+/// A run of blocks whose sub-synchronous component counted but decayed: a transient.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TransientSpan {
+    /// Start of its first block, bag time (s).
+    pub start_s: f64,
+    /// End of its last block (s).
+    pub end_s: f64,
+    /// Its largest sub-synchronous semi-major axis (m).
+    pub largest_subsync_m: f64,
+}
+
+/// Consecutive counting blocks `first ..= last`.
+#[derive(Debug, Clone, Copy)]
+struct CountingRun {
+    first: usize,
+    last: usize,
+    persistent: bool,
+}
 
 /// One probe sample with the prediction at the same instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -37,10 +61,11 @@ pub struct OrbitFeatures {
     pub one_x_amplitude_m: f64,
     /// Phase of the forward 1X component against the shaft angle (degrees).
     pub one_x_phase_deg: f64,
-    /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−2)/R.
+    /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−3)/R, corrected between
+    /// bins ([`subsynchronous_peak`], the monitor's detector).
     pub subsync_amplitude_m: f64,
-    /// Its order, refined between bins (Gaussian interpolation); None unless it counts by the
-    /// monitor's rule (≥ 2 % of the clearance and ≥ half the 1X amplitude).
+    /// Its order, refined between bins; None unless it counts by the monitor's rule (≥ 2 % of
+    /// the clearance and ≥ half the 1X amplitude).
     pub subsync_ratio: Option<f64>,
     /// Mean position `[x, y]` (m).
     pub mean_m: [f64; 2],
@@ -147,7 +172,7 @@ impl StationComparison {
         while self
             .recent
             .front()
-            .is_some_and(|f| s.angle_rad - f.angle_rad > SUMMARY_REVS as f64 * TAU)
+            .is_some_and(|f| s.angle_rad - f.angle_rad > (SUMMARY_REVS + 1) as f64 * TAU)
         {
             self.recent.pop_front();
         }
@@ -164,24 +189,97 @@ impl StationComparison {
         }
         let start = recent
             .iter()
-            .position(|s| last.angle_rad - s.angle_rad <= revs as f64 * TAU)
+            .position(|s| last.angle_rad - s.angle_rad < revs as f64 * TAU)
             .unwrap_or(0);
         self.compare(&recent[start..], revs)
     }
 
-    /// The first block whose orbit (measured, or predicted with `predicted`) shows a
-    /// sub-synchronous component that counts: its end time (s) and speed (rpm).
+    /// The onset (measured, or predicted with `predicted`): the first block of a run of
+    /// [`ONSET_BLOCKS`] consecutive blocks whose sub-synchronous component counts (the monitor's
+    /// rule) and persists or grows: over the run it decays by less than the classifier's growth
+    /// threshold allows (e^{−0.002/rev · 8 revolutions} a block). Its end time (s) and speed
+    /// (rpm). A decaying start-up transient is no onset (see [`Self::transients`]).
     pub fn onset(&self, predicted: bool) -> Option<(f64, f64)> {
-        self.blocks
+        let runs = self.counting_runs(predicted);
+        runs.iter()
+            .find(|r| r.persistent)
+            .map(|r| (self.blocks[r.first].end_s, self.blocks[r.first].speed_rpm))
+    }
+
+    /// The runs of consecutive counting blocks before the onset that do not persist: decaying
+    /// transients (e.g. the free vibration after a sudden unbalance), reported as such.
+    pub fn transients(&self, predicted: bool) -> Vec<TransientSpan> {
+        let pick = |b: &WindowComparison| {
+            if predicted {
+                b.predicted
+            } else {
+                b.measured
+            }
+        };
+        self.counting_runs(predicted)
             .iter()
-            .find(|b| {
-                if predicted {
-                    b.predicted.subsync_ratio.is_some()
-                } else {
-                    b.measured.subsync_ratio.is_some()
+            .take_while(|r| !r.persistent)
+            .map(|r| {
+                let blocks = &self.blocks[r.first..=r.last];
+                TransientSpan {
+                    start_s: blocks[0].start_s,
+                    end_s: blocks[blocks.len() - 1].end_s,
+                    largest_subsync_m: blocks
+                        .iter()
+                        .map(|b| pick(b).subsync_amplitude_m)
+                        .fold(0.0, f64::max),
                 }
             })
-            .map(|b| (b.end_s, b.speed_rpm))
+            .collect()
+    }
+
+    /// The runs of consecutive blocks whose sub-synchronous component counts, each marked
+    /// persistent if some [`ONSET_BLOCKS`] consecutive blocks of it persist or grow (then the
+    /// run starts at the first of those).
+    fn counting_runs(&self, predicted: bool) -> Vec<CountingRun> {
+        let amp = |b: &WindowComparison| {
+            let f = if predicted { b.predicted } else { b.measured };
+            f.subsync_ratio.map(|_| f.subsync_amplitude_m)
+        };
+        let least_ratio = (-self.settings.growth_threshold_per_rev * BLOCK_REVS as f64).exp();
+        let mut runs = Vec::new();
+        let mut i = 0;
+        while i < self.blocks.len() {
+            if amp(&self.blocks[i]).is_none() {
+                i += 1;
+                continue;
+            }
+            let mut end = i;
+            while end + 1 < self.blocks.len() && amp(&self.blocks[end + 1]).is_some() {
+                end += 1;
+            }
+            let a: Vec<f64> = self.blocks[i..=end].iter().filter_map(amp).collect();
+            let start = (0..a.len().saturating_sub(ONSET_BLOCKS - 1))
+                .find(|&k| (k..k + ONSET_BLOCKS - 1).all(|j| a[j + 1] >= least_ratio * a[j]));
+            match start {
+                Some(k) => {
+                    if k > 0 {
+                        runs.push(CountingRun {
+                            first: i,
+                            last: i + k - 1,
+                            persistent: false,
+                        });
+                    }
+                    runs.push(CountingRun {
+                        first: i + k,
+                        last: end,
+                        persistent: true,
+                    });
+                }
+                None => runs.push(CountingRun {
+                    first: i,
+                    last: end,
+                    persistent: false,
+                }),
+            }
+            i = end + 1;
+        }
+        runs
     }
 
     /// The order spectra (measured, predicted) of the summary window, orders 1/R … 2.
@@ -254,28 +352,14 @@ impl StationComparison {
             samples.iter().map(|s| pick(s)[0]).sum::<f64>() / n,
             samples.iter().map(|s| pick(s)[1]).sum::<f64>() / n,
         ];
-        let one_x = spec[revs - 1];
-        // the Hann window leaks 1X into the bin next to it: sub-synchronous bins are 2 … R−2
-        let (mut kbest, mut abest) = (0, 0.0);
-        for k in 2..revs.saturating_sub(1) {
-            let a = spec[k - 1].semi_major_m();
-            if a > abest {
-                (kbest, abest) = (k, a);
-            }
-        }
-        let counts = abest > self.settings.subsync_min_clearance_share * self.clearance_m
-            && abest > self.settings.subsync_min_one_x_share * one_x.semi_major_m();
-        let ratio = counts.then(|| {
-            let mag = |k: usize| spec[k - 1].semi_major_m().max(1e-30).ln();
-            let (a, b, c) = (mag(kbest - 1), mag(kbest), mag(kbest + 1));
-            let den = a - 2.0 * b + c;
-            let shift = if den.abs() > 1e-12 {
-                (0.5 * (a - c) / den).clamp(-0.5, 0.5)
-            } else {
-                0.0
-            };
-            (kbest as f64 + shift) / revs as f64
-        });
+        let one_x = one_x_component(&spec, revs);
+        // the monitor's detector (bins 2 … R−3, interpolated between bins)
+        let peak = subsynchronous_peak(&spec, revs);
+        let abest = peak.semi_major_m();
+        let counts = self
+            .settings
+            .subsync_counts(abest, one_x.semi_major_m(), self.clearance_m);
+        let ratio = counts.then_some(peak.order);
         OrbitFeatures {
             one_x_amplitude_m: one_x.semi_major_m(),
             one_x_phase_deg: one_x.forward_phase_rad.to_degrees(),
@@ -368,9 +452,10 @@ mod tests {
         assert!((dphi - 20.0).abs() < 1.0, "phase error {dphi}°");
         let r = w.measured.subsync_ratio.expect("0.45X found");
         assert!((r - 0.45).abs() < 0.01, "ratio {r}");
-        // an off-bin component loses up to ~15 % to the Hann window's scalloping
+        // off-bin (14.4 bins of 1/32 order): the interpolation undoes the Hann window's
+        // scalloping loss (13 % here), so to 1 %
         assert!(
-            (w.measured.subsync_amplitude_m / 2e-6 - 1.0).abs() < 0.2,
+            (w.measured.subsync_amplitude_m / 2e-6 - 1.0).abs() < 0.01,
             "{w:?}"
         );
         assert!(w.predicted.subsync_ratio.is_none());
@@ -387,6 +472,75 @@ mod tests {
         // counts from the first block on
         assert_eq!(c.blocks.len(), revs / BLOCK_REVS);
         assert!(c.onset(false).is_some() && c.onset(true).is_none());
+    }
+
+    /// Feeds `revs` revolutions of a 1X circle of 1 µm plus a forward 0.45X circle of radius
+    /// `sub(rev)` (64 samples a revolution, 150 rev/s) into a comparison (clearance 40 µm), as
+    /// the measured orbit.
+    fn fed(revs: usize, sub: impl Fn(f64) -> f64) -> StationComparison {
+        let mut c = StationComparison::new("s", 40e-6);
+        for i in 0..=revs * 64 {
+            let psi = TAU * i as f64 / 64.0;
+            let a = sub(psi / TAU);
+            let m = [
+                1e-6 * psi.cos() + a * (0.45 * psi).cos(),
+                1e-6 * psi.sin() + a * (0.45 * psi).sin(),
+            ];
+            c.push(Sample {
+                time_s: psi / (TAU * 150.0),
+                angle_rad: psi,
+                speed_rad_s: TAU * 150.0,
+                measured_m: m,
+                predicted_m: [1e-6 * psi.cos(), 1e-6 * psi.sin()],
+            });
+        }
+        c
+    }
+
+    /// A start-up transient: 0.45X from 5 µm decaying at 0.02/rev (it counts, ≥ 0.8 µm and
+    /// ≥ half the 1X, for some 9 blocks): no onset, one transient from the start. A component
+    /// growing at 0.02/rev from 0.2 µm counts from about revolution 70 (0.8 µm) on: the onset is
+    /// the first counting block, and there is no transient. A steady one (a limit cycle) is an
+    /// onset at its first block.
+    #[test]
+    fn decaying_transients_are_no_onsets() {
+        let decaying = fed(120, |rev| 5e-6 * (-0.02 * rev).exp());
+        assert!(
+            decaying.onset(false).is_none(),
+            "{:?}",
+            decaying.onset(false)
+        );
+        let t = decaying.transients(false);
+        assert_eq!(t.len(), 1, "{t:?}");
+        assert!(
+            t[0].start_s < 1e-9 && t[0].largest_subsync_m > 3e-6,
+            "{t:?}"
+        );
+        // formerly: the first block counted and was the onset
+        assert!(decaying.blocks[0].measured.subsync_ratio.is_some());
+
+        let growing = fed(120, |rev| 0.2e-6 * (0.02 * rev).exp());
+        let (t_on, _) = growing.onset(false).expect("an onset");
+        let first = growing
+            .blocks
+            .iter()
+            .find(|b| b.measured.subsync_ratio.is_some())
+            .unwrap();
+        assert!(
+            (t_on - first.end_s).abs() < 1e-9,
+            "{t_on} vs {}",
+            first.end_s
+        );
+        assert!(
+            (60.0..90.0).contains(&(t_on * 150.0)),
+            "onset at rev {}",
+            t_on * 150.0
+        );
+        assert!(growing.transients(false).is_empty());
+
+        let steady = fed(60, |_| 3e-6);
+        let (t_on, _) = steady.onset(false).expect("an onset");
+        assert!((t_on - steady.blocks[0].end_s).abs() < 1e-9);
     }
 
     #[test]

@@ -1,7 +1,9 @@
 //! The replay's report: what was read, what came out, predicted against measured per probe
 //! station, and when the instability set in. Serialized as the `--json` report.
 
-use super::compare::{phase_difference_deg, StationComparison, WindowComparison};
+use super::compare::{
+    phase_difference_deg, StationComparison, TransientSpan, WindowComparison, ONSET_BLOCKS,
+};
 use crate::bag::Bag;
 use crate::session::{Outgoing, Session};
 use serde::Serialize;
@@ -47,8 +49,8 @@ pub struct StationReport {
 /// When the instability set in, predicted and observed (null where there is none).
 #[derive(Debug, Clone, Default, Serialize, PartialEq)]
 pub struct OnsetReport {
-    /// First 8-revolution block whose predicted probe orbit shows a sub-synchronous component
-    /// that counts (bag time, s).
+    /// First 8-revolution block of the predicted probe orbit from which a sub-synchronous
+    /// component that counts persists or grows over 3 consecutive blocks (bag time, s).
     pub predicted_time_s: Option<f64>,
     /// The same detector on the measured orbit (s).
     pub observed_time_s: Option<f64>,
@@ -56,12 +58,20 @@ pub struct OnsetReport {
     pub predicted_speed_rpm: Option<f64>,
     /// Speed at the observed onset (rpm).
     pub observed_speed_rpm: Option<f64>,
-    /// The twin's first whirl/whip/contact warning (bag time, s).
+    /// The twin's first warning of a growing, whirling or whipping rotor (bag time, s): the
+    /// early warning.
     pub twin_warning_time_s: Option<f64>,
     /// Speed at that warning (rpm).
     pub twin_warning_speed_rpm: Option<f64>,
+    /// The twin's first whip warning (bag time, s).
+    pub twin_whip_time_s: Option<f64>,
     /// How onset is detected.
     pub detector: String,
+    /// Sub-synchronous components that counted but decayed before the predicted onset (at
+    /// any station): transients, not onsets.
+    pub predicted_transients: Vec<TransientSpan>,
+    /// The same on the measured orbits.
+    pub observed_transients: Vec<TransientSpan>,
 }
 
 /// A change of the twin's classification.
@@ -71,8 +81,8 @@ pub struct StateChange {
     pub time_s: f64,
     /// Speed (rpm).
     pub speed_rpm: f64,
-    /// start (the twin (re)started, from the static equilibrium) | none (stable) | whirl |
-    /// whip | contact.
+    /// start (the twin (re)started, from the static equilibrium) | none (stable) | growing
+    /// (unstable, growing: the early warning) | whirl | whip.
     pub state: String,
     /// Warning level: 0 OK, 1 WARN, 2 ERROR.
     pub level: u8,
@@ -162,13 +172,16 @@ impl ReplayReport {
         let Outgoing::Warning(w) = o else {
             return;
         };
-        if !matches!(w.kind.as_str(), "none" | "whirl" | "whip" | "contact") {
+        if !matches!(w.kind.as_str(), "none" | "growing" | "whirl" | "whip") {
             return;
         }
         let time_s = (w.header.stamp.as_nanos() - t0_ns as i64) as f64 * 1e-9;
         let speed_rpm = session.as_ref().map_or(0.0, |s| {
             s.twin().output().speed_rad_s * 30.0 / std::f64::consts::PI
         });
+        if w.kind == "whip" && self.onset.twin_whip_time_s.is_none() {
+            self.onset.twin_whip_time_s = Some(time_s);
+        }
         if w.kind != "none" && self.onset.twin_warning_time_s.is_none() {
             self.onset.twin_warning_time_s = Some(time_s);
             self.onset.twin_warning_speed_rpm = Some(speed_rpm);
@@ -192,9 +205,17 @@ impl ReplayReport {
             0.0
         };
         self.onset.detector = format!(
-            "first block of {} revolutions at any probe station whose largest sub-synchronous component is ≥ 2 % of the clearance and ≥ half the 1X amplitude",
+            "first block of {} revolutions at any probe station from which the largest sub-synchronous component is ≥ 2 % of the clearance and ≥ half the 1X amplitude over {ONSET_BLOCKS} consecutive blocks, decaying by less than 0.002/rev (persisting or growing); counting blocks that decay are transients",
             super::compare::BLOCK_REVS
         );
+        self.onset.predicted_transients = comparisons
+            .iter()
+            .flat_map(|c| c.transients(true))
+            .collect();
+        self.onset.observed_transients = comparisons
+            .iter()
+            .flat_map(|c| c.transients(false))
+            .collect();
         let earliest = |found: Vec<(f64, f64)>| {
             found
                 .into_iter()
@@ -288,6 +309,19 @@ impl ReplayReport {
                 self.onset.twin_warning_speed_rpm
             ),
         );
+        for (who, list) in [
+            ("predicted", &self.onset.predicted_transients),
+            ("observed", &self.onset.observed_transients),
+        ] {
+            for t in list {
+                s += &format!(
+                    "{who} transient (decaying, no onset): {:.2}–{:.2} s, sub-synchronous up to {:.2} µm\n",
+                    t.start_s,
+                    t.end_s,
+                    t.largest_subsync_m * 1e6
+                );
+            }
+        }
         let states: Vec<String> = self
             .states
             .iter()

@@ -47,6 +47,22 @@ pub struct MachineDescription {
     /// Optional stiffness-proportional structural damping of the shaft, C = β K_shaft (β in s).
     #[serde(default)]
     pub shaft_damping_beta_s: f64,
+    /// Optional alarm levels of the orbit amplitude at every bearing. Absent (the default): the
+    /// field-practice levels, API 617's 75 % of the clearance and the ISO 20816-3 zone
+    /// boundaries, each capped by the clearance (`monitor::AlarmLevels`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alarm_levels: Option<AlarmLevelsSpec>,
+}
+
+/// Alarm levels set by the machine's owner: orbit amplitudes (half the peak-to-peak
+/// displacement), each capped by the bearing's clearance when applied.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlarmLevelsSpec {
+    /// Alert (warning) amplitude (m).
+    pub alert_amplitude_m: f64,
+    /// Danger amplitude (m), at least the alert one.
+    pub danger_amplitude_m: f64,
 }
 
 fn default_gravity() -> [f64; 2] {
@@ -301,6 +317,20 @@ impl MachineDescription {
             }
         };
         positive("rated_speed_rpm".into(), self.rated_speed_rpm)?;
+        if let Some(a) = &self.alarm_levels {
+            positive("alarm_levels.alert_amplitude_m".into(), a.alert_amplitude_m)?;
+            positive(
+                "alarm_levels.danger_amplitude_m".into(),
+                a.danger_amplitude_m,
+            )?;
+            if a.danger_amplitude_m < a.alert_amplitude_m {
+                return Err(err(
+                    "alarm_levels.danger_amplitude_m".into(),
+                    a.danger_amplitude_m.to_string(),
+                    "must be at least alarm_levels.alert_amplitude_m",
+                ));
+            }
+        }
         non_negative("shaft_damping_beta_s".into(), self.shaft_damping_beta_s)?;
         if self.shaft_damping_beta_s > 1e-2 {
             return Err(err(

@@ -15,9 +15,9 @@ mod statics;
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use machine::{
-    BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec, MachineDescription,
-    MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec, DEFAULT_MACHINE_NAME,
-    DEFAULT_MACHINE_YAML,
+    AlarmLevelsSpec, BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec,
+    MachineDescription, MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec,
+    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
     campbell, critical_speeds_rpm, damped_modes, stability_threshold, undamped_frequencies_hz,
@@ -146,6 +146,9 @@ pub struct Rotor {
     pub gravity_m_s2: [f64; 2],
     /// Rated speed (rad/s).
     pub rated_speed_rad_s: f64,
+    /// Vibration alarm levels from the machine file (None: the monitor's API 617 / ISO 20816
+    /// defaults).
+    pub alarm_levels: Option<machine::AlarmLevelsSpec>,
     /// Global mass matrix (kg, kg·m²).
     pub mass: Mat<f64>,
     /// Global stiffness: shaft plus support springs (N/m, N·m/rad).
@@ -270,6 +273,7 @@ impl Rotor {
                 .collect(),
             gravity_m_s2: desc.gravity_m_s2,
             rated_speed_rad_s: rpm_to_rad_s(desc.rated_speed_rpm),
+            alarm_levels: desc.alarm_levels.clone(),
             node_z_m,
             elements,
             discs,

@@ -128,6 +128,16 @@ class InstabilityWarning(IdlStruct, typename="rotor_twin_msgs::msg::dds_::Instab
     whirl_ratio: float64
     amplitude_over_clearance: float64
     evidence: str
+    growth_per_rev: float64
+    time_to_alert: float64
+    amplitude: float64
+    alert_level: float64
+    danger_level: float64
+    alarm_basis: str
+    contact: bool
+    contact_count: uint32
+    max_penetration: float64
+    beyond_clearance: bool
 
 
 def main():
