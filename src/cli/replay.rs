@@ -158,7 +158,10 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let bag =
         Bag::read(&args.bag).with_context(|| format!("reading bag {}", args.bag.display()))?;
     for d in &bag.damage {
-        eprintln!("warning: {d}; replaying what came before it");
+        eprintln!("warning: {d}; replaying every intact message");
+    }
+    for n in &bag.notes {
+        eprintln!("warning: {}: {n}", args.bag.display());
     }
     let out_dir = args.out.clone().unwrap_or_else(|| {
         let stem = args
