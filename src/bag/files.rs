@@ -18,9 +18,9 @@ const MAX_METADATA_BYTES: u64 = 4 << 20;
 
 /// The files of the bag at `path`.
 pub(super) fn bag_files(path: &Path) -> Result<BagFiles, BagError> {
-    let io = |source| BagError::Io {
+    let io = |cause| BagError::Io {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let meta = std::fs::metadata(path).map_err(io)?;
     if !meta.is_dir() {
@@ -59,7 +59,7 @@ pub(super) fn bag_files(path: &Path) -> Result<BagFiles, BagError> {
 fn not_regular(path: &Path) -> BagError {
     BagError::Io {
         path: path.to_path_buf(),
-        source: std::io::Error::new(
+        cause: std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
             "not a regular file (a bag is a directory or an .mcap file)",
         ),
@@ -190,9 +190,9 @@ fn check_compression(files: Vec<PathBuf>) -> Result<Vec<PathBuf>, BagError> {
 
 /// The bytes of `file`, which must be a regular file (not a device or a pipe).
 pub(super) fn read_regular(file: &Path) -> Result<Vec<u8>, BagError> {
-    let io = |source| BagError::Io {
+    let io = |cause| BagError::Io {
         path: file.to_path_buf(),
-        source,
+        cause,
     };
     if !std::fs::metadata(file).map_err(io)?.is_file() {
         return Err(not_regular(file));

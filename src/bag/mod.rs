@@ -19,12 +19,12 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum BagError {
     /// The path cannot be read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// The path.
         path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
+        /// The cause (part of the message, so not also a `source`: reported once).
+        cause: std::io::Error,
     },
     /// A directory without a .mcap file.
     #[error("{0}: no .mcap file in this directory (is it a rosbag2 bag recorded with the mcap storage?)")]

@@ -8,7 +8,6 @@ use crate::rotor::{MachineDescription, Rotor};
 use crate::session::SessionSettings;
 use anyhow::Context;
 use clap::Args;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The bag shipped with the project (a synthetic run-up of the built-in microturbine).
@@ -109,7 +108,7 @@ pub fn run_sample() -> anyhow::Result<()> {
         // run from elsewhere than the repository root
         bag = Path::new(env!("CARGO_MANIFEST_DIR")).join(SAMPLE_BAG);
     }
-    println!(
+    outln!(
         "rotor-twin: replaying the shipped SYNTHETIC bag {} on the built-in machine",
         bag.display()
     );
@@ -155,14 +154,6 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         None => MachineDescription::builtin_default(),
     };
     let rotor = Rotor::from_description(&desc);
-    let bag =
-        Bag::read(&args.bag).with_context(|| format!("reading bag {}", args.bag.display()))?;
-    for d in &bag.damage {
-        eprintln!("warning: {d}; replaying every intact message");
-    }
-    for n in &bag.notes {
-        eprintln!("warning: {}: {n}", args.bag.display());
-    }
     let out_dir = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .bag
@@ -170,6 +161,15 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
             .map_or("bag".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from(format!("replay_{stem}"))
     });
+    refuse_overlap(&args.bag, &out_dir)?;
+    // the bag's errors name the file concerned
+    let bag = Bag::read(&args.bag)?;
+    for d in &bag.damage {
+        eprintln!("warning: {d}; replaying every intact message");
+    }
+    for n in &bag.notes {
+        eprintln!("warning: {}: {n}", args.bag.display());
+    }
     let options = ReplayOptions {
         coupling,
         steps_per_rev: args.steps_per_rev,
@@ -240,17 +240,56 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         )?;
     }
     // a closed standard output (e.g. piped into `head`) is not an error of the replay
-    let mut stdout = std::io::stdout().lock();
-    let printed = if args.json {
-        writeln!(stdout, "{json}")
+    if args.json {
+        super::print_out(&format!("{json}\n"))
     } else {
-        write!(stdout, "{}", report.summary())
-            .and_then(|()| writeln!(stdout, "output: {}", out_dir.display()))
-    };
-    match printed {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
-        _ => Ok(()),
+        super::print_out(&format!(
+            "{}output: {}\n",
+            report.summary(),
+            out_dir.display()
+        ))
     }
+}
+
+/// Refuses an output directory that is the input bag, lies inside it or holds it: the replay
+/// writes into `out` and replaces `out/bag`, and must never write into or over its input.
+fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
+    let (bag_abs, out_abs) = (resolved(bag)?, resolved(out)?);
+    anyhow::ensure!(
+        !out_abs.starts_with(&bag_abs) && !bag_abs.starts_with(&out_abs),
+        "--out {}: {} the input bag {}; choose an output directory apart from it",
+        out.display(),
+        if out_abs.starts_with(&bag_abs) {
+            "is or lies inside"
+        } else {
+            "holds"
+        },
+        bag.display()
+    );
+    Ok(())
+}
+
+/// `path` made absolute with its symbolic links resolved, as far as it exists.
+fn resolved(path: &Path) -> anyhow::Result<PathBuf> {
+    let abs = std::path::absolute(path).with_context(|| format!("{}", path.display()))?;
+    let mut existing = abs.as_path();
+    let mut rest = Vec::new();
+    while !existing.exists() {
+        match (existing.parent(), existing.file_name()) {
+            (Some(parent), Some(name)) => {
+                rest.push(name.to_owned());
+                existing = parent;
+            }
+            _ => break,
+        }
+    }
+    let mut real = existing
+        .canonicalize()
+        .unwrap_or_else(|_| existing.to_path_buf());
+    for name in rest.iter().rev() {
+        real.push(name);
+    }
+    Ok(real)
 }
 
 /// Creates `dir`, or clears a previous replay's output in it (a directory holding anything

@@ -77,16 +77,16 @@ struct TopicEntry {
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
     /// File-system trouble, with the path.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// The path concerned.
         path: PathBuf,
-        /// The error.
-        source: std::io::Error,
+        /// The error (part of the message, so not also a `source`: reported once).
+        cause: std::io::Error,
     },
-    /// The MCAP writer failed.
+    /// The MCAP writer failed (its message is part of this one: reported once).
     #[error("MCAP writer: {0}")]
-    Mcap(#[from] mcap::McapError),
+    Mcap(mcap::McapError),
     /// A message could not be encoded.
     #[error("encoding a {type_name} for {topic}: {why}")]
     Encode {
@@ -100,6 +100,12 @@ pub enum RecordError {
     /// A topic was written before it was added.
     #[error("topic {0} was not added to the recording")]
     UnknownTopic(String),
+}
+
+impl From<mcap::McapError> for RecordError {
+    fn from(e: mcap::McapError) -> Self {
+        Self::Mcap(e)
+    }
 }
 
 /// Writes one bag directory.
@@ -118,9 +124,9 @@ pub struct Recorder {
 impl Recorder {
     /// Creates bag directory `dir` (which must not exist yet, as with `ros2 bag record -o`).
     pub fn create(dir: &Path) -> Result<Self, RecordError> {
-        let io = |source| RecordError::Io {
+        let io = |cause| RecordError::Io {
             path: dir.to_path_buf(),
-            source,
+            cause,
         };
         if dir.exists() {
             return Err(io(std::io::Error::new(
@@ -134,9 +140,9 @@ impl Recorder {
             .map_or("rotor_twin".into(), |s| s.to_string_lossy().into_owned());
         let file_name = format!("{stem}_0.mcap");
         let path = dir.join(&file_name);
-        let file = File::create(&path).map_err(|source| RecordError::Io {
+        let file = File::create(&path).map_err(|cause| RecordError::Io {
             path: path.clone(),
-            source,
+            cause,
         })?;
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
@@ -293,7 +299,7 @@ impl Recorder {
         self.writer.finish()?;
         let metadata = self.metadata_yaml();
         let path = self.dir.join("metadata.yaml");
-        std::fs::write(&path, metadata).map_err(|source| RecordError::Io { path, source })?;
+        std::fs::write(&path, metadata).map_err(|cause| RecordError::Io { path, cause })?;
         Ok(self.dir)
     }
 
