@@ -212,7 +212,9 @@ impl Scan<'_> {
         let len = u64::from_le_bytes(prefix[1..].try_into().unwrap_or_default());
         if !(0x01..=0x0F).contains(&prefix[0]) {
             format!("unknown record opcode 0x{:02x} at byte {at}", prefix[0])
-        } else if at as u64 + PREFIX as u64 + len > self.bytes.len() as u64 {
+        } else if prefix[0] == OP_CHUNK && len == u64::MAX {
+            format!("the chunk at byte {at} was never finished (its length is still the writer's placeholder): cut off while recording")
+        } else if (at as u64 + PREFIX as u64).saturating_add(len) > self.bytes.len() as u64 {
             format!(
                 "a record at byte {at} declares {len} bytes, past the end of the file ({}): cut off",
                 self.bytes.len()

@@ -29,6 +29,7 @@ macro_rules! outln {
     };
 }
 
+mod bag;
 mod bearing;
 mod bench;
 mod modes;
@@ -66,6 +67,8 @@ enum Command {
     SynthBag(synth::SynthArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
+    /// Tools for recorded bags: `bag recover DIR` makes a cut-off recording a complete bag.
+    Bag(bag::BagArgs),
 }
 
 /// Runs the command line; with no subcommand, the main job: the shipped sample bag replayed on
@@ -88,6 +91,7 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Param(args)) => node::run_param(args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Bag(args)) => bag::run(&args),
         None => replay::run_sample(),
     }
 }

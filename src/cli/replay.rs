@@ -2,6 +2,7 @@
 
 use crate::bag::Bag;
 use crate::dynamics::Coupling;
+use crate::record::resolved_path;
 use crate::replay::{replay, ReplayOptions};
 use crate::ros::SpeedUnit;
 use crate::rotor::{MachineDescription, Rotor};
@@ -254,7 +255,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
 /// Refuses an output directory that is the input bag, lies inside it or holds it: the replay
 /// writes into `out` and replaces `out/bag`, and must never write into or over its input.
 fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
-    let (bag_abs, out_abs) = (resolved(bag)?, resolved(out)?);
+    let (bag_abs, out_abs) = (resolved_path(bag), resolved_path(out));
     anyhow::ensure!(
         !out_abs.starts_with(&bag_abs) && !bag_abs.starts_with(&out_abs),
         "--out {}: {} the input bag {}; choose an output directory apart from it",
@@ -267,29 +268,6 @@ fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
         bag.display()
     );
     Ok(())
-}
-
-/// `path` made absolute with its symbolic links resolved, as far as it exists.
-fn resolved(path: &Path) -> anyhow::Result<PathBuf> {
-    let abs = std::path::absolute(path).with_context(|| format!("{}", path.display()))?;
-    let mut existing = abs.as_path();
-    let mut rest = Vec::new();
-    while !existing.exists() {
-        match (existing.parent(), existing.file_name()) {
-            (Some(parent), Some(name)) => {
-                rest.push(name.to_owned());
-                existing = parent;
-            }
-            _ => break,
-        }
-    }
-    let mut real = existing
-        .canonicalize()
-        .unwrap_or_else(|_| existing.to_path_buf());
-    for name in rest.iter().rev() {
-        real.push(name);
-    }
-    Ok(real)
 }
 
 /// Creates `dir`, or clears a previous replay's output in it (a directory holding anything
