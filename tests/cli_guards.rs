@@ -126,20 +126,24 @@ fn a_long_bearing_fails_cleanly_in_the_cli() {
     }
 }
 
-/// Runs the CLI with its standard output a pipe whose reader is already gone.
+/// Runs the CLI with its standard output a pipe whose reader (`true`) has already exited: the
+/// exit code and standard error.
 fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
-    let (reader, writer) = std::io::pipe().unwrap();
-    drop(reader);
-    let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
-        .args(args)
-        .stdout(writer)
+    let script = format!(
+        "(sleep 0.3; \"$0\" {}; echo \"rc=$?\" >&2) | true",
+        args.join(" ")
+    );
+    let out = Command::new("sh")
+        .args(["-c", &script, env!("CARGO_BIN_EXE_rotor-twin")])
         .stderr(Stdio::piped())
         .output()
         .unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let code = err
+        .lines()
+        .find_map(|l| l.strip_prefix("rc="))
+        .and_then(|c| c.parse().ok());
+    (code, err)
 }
 
 #[test]
