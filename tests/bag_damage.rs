@@ -21,8 +21,8 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// A bag of N Float64 messages on /t, value i at T0 + i ms, a chunk closed every 400 messages.
-fn written_bag() -> Vec<u8> {
-    let dir = scratch("base");
+fn written_bag(name: &str) -> Vec<u8> {
+    let dir = scratch(name);
     let mut rec = Recorder::create(&dir).unwrap();
     let t = rec
         .add_topic::<Float64>("/t", TopicQos::reliable(10))
@@ -87,7 +87,7 @@ fn delivered(bytes: &[u8], what: &str) -> (usize, Bag) {
 
 #[test]
 fn every_intact_chunk_is_read_and_no_damaged_one_is_used() {
-    let bytes = written_bag();
+    let bytes = written_bag("flips");
     let chunks = chunks(&bytes);
     assert!(chunks.len() >= 10, "{} chunks", chunks.len());
     assert_eq!(chunks.iter().map(|c| c.2).sum::<usize>(), N);
@@ -123,7 +123,7 @@ fn every_intact_chunk_is_read_and_no_damaged_one_is_used() {
 /// Several flips at once and a cut: still every intact chunk after the first damage.
 #[test]
 fn a_cut_file_with_damaged_chunks_keeps_every_intact_chunk() {
-    let bytes = written_bag();
+    let bytes = written_bag("cut");
     let chunks = chunks(&bytes);
     let cut = chunks[chunks.len() * 7 / 10].0 + 10;
     let mut b = bytes[..cut].to_vec();
