@@ -1,10 +1,17 @@
 //! Reading rosbag2 MCAP bags: a bag directory (metadata.yaml and one or more .mcap files, as
 //! written by `ros2 bag record`, by rosbags or by the node) or a bare .mcap file. Messages come out
-//! in receive-time order (the order `ros2 bag play` uses). A bag that is damaged part-way (cut off
-//! by a crash, a bad chunk) yields every message before the damage and says what and where the
-//! damage is; it is not an error unless nothing at all can be read.
+//! in receive-time order (the order `ros2 bag play` uses). A damaged bag (cut off by a crash, bad
+//! chunks, flipped bits) yields every message of every intact chunk, never one of a chunk that
+//! fails its CRC, and names each damaged byte range; it is an error only if nothing at all can
+//! be read. metadata.yaml is checked, not trusted (see [`files`]).
 
-use std::collections::HashMap;
+mod files;
+mod scan;
+mod yaml;
+
+pub use yaml::{check_yaml_shape, MAX_YAML_FLOW_DEPTH, MAX_YAML_INDENT};
+
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -12,12 +19,12 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum BagError {
     /// The path cannot be read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// The path.
         path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
+        /// The cause (part of the message, so not also a `source`: reported once).
+        cause: std::io::Error,
     },
     /// A directory without a .mcap file.
     #[error("{0}: no .mcap file in this directory (is it a rosbag2 bag recorded with the mcap storage?)")]
@@ -70,25 +77,30 @@ pub struct BagMessage {
     len: usize,
 }
 
-/// Damage found while reading: where reading stopped and why.
+/// A damaged part of a file: skipped, the intact records after it read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BagDamage {
     /// The damaged file.
     pub file: PathBuf,
-    /// Messages of that file read before the damage.
+    /// The damaged byte range `[start, end)` of the file, when the damage is one.
+    pub bytes: Option<(usize, usize)>,
+    /// Messages of that file read before the damage (in file order).
     pub messages_before: usize,
-    /// Receive time (ns since the epoch) of the last good message, if any.
+    /// Receive time (ns since the epoch) of the last good message before it, if any.
     pub last_good_log_time_ns: Option<u64>,
-    /// What the MCAP reader said.
+    /// What was wrong.
     pub why: String,
 }
 
 impl std::fmt::Display for BagDamage {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: ", self.file.display())?;
+        if let Some((a, b)) = self.bytes {
+            write!(f, "bytes {a} to {b} unreadable, skipped; ")?;
+        }
         write!(
             f,
-            "{}: damaged after message {} of this file",
-            self.file.display(),
+            "damaged after message {} of this file",
             self.messages_before
         )?;
         if let Some(t) = self.last_good_log_time_ns {
@@ -105,125 +117,121 @@ pub struct Bag {
     pub files: Vec<PathBuf>,
     /// Topics, in order of first appearance.
     pub topics: Vec<BagTopic>,
-    /// Messages in receive-time order (ties keep file order).
+    /// Messages in receive-time order (ties keep file order), without the receive-time outliers
+    /// of [`Bag::excluded`].
     pub messages: Vec<BagMessage>,
-    /// Damage found, one entry per damaged file.
+    /// Damage found: every damaged range of every file.
     pub damage: Vec<BagDamage>,
+    /// What else was wrong and worked around: metadata.yaml naming missing, repeated or outside
+    /// files; receive-time outliers left out. One sentence each.
+    pub notes: Vec<String>,
+    /// Messages left out because their receive time lies far outside the rest of the bag.
+    pub excluded: Vec<BagMessage>,
     payloads: Vec<u8>,
 }
 
 impl Bag {
-    /// Reads the bag at `path`: a bag directory or a bare .mcap file.
+    /// Reads the bag at `path`: a bag directory or a bare .mcap file. A file that cannot be read
+    /// at all is noted and skipped when another file of the bag can be read.
     pub fn read(path: &Path) -> Result<Self, BagError> {
-        let files = mcap_files(path)?;
+        let listing = files::bag_files(path)?;
         let mut bag = Bag {
-            files: files.clone(),
+            files: listing.files.clone(),
+            notes: listing.notes,
             ..Bag::default()
         };
-        for file in &files {
-            let bytes = std::fs::read(file).map_err(|source| BagError::Io {
-                path: file.clone(),
-                source,
-            })?;
-            bag.read_file(file, &bytes)?;
+        let mut first_error = None;
+        for file in &listing.files {
+            let read = files::read_regular(file).and_then(|bytes| bag.read_file(file, &bytes));
+            if let Err(e) = read {
+                bag.notes.push(format!("{e}; file skipped"));
+                first_error.get_or_insert(e);
+            }
         }
+        if bag.messages.is_empty() {
+            if let Some(e) = first_error {
+                return Err(e);
+            }
+        }
+        bag.exclude_time_outliers();
         Ok(bag)
     }
 
     /// Reads one file's messages from `bytes` (an MCAP file's contents) and puts all messages
-    /// in receive-time order again. Reading stops at the first damaged record, which is noted in
-    /// [`Bag::damage`]; nothing read is an error only if the file has no message at all.
+    /// in receive-time order again. Every intact chunk is read; each damaged range is noted in
+    /// [`Bag::damage`]; it is an error only if the file yields no message at all.
     pub fn read_file(&mut self, file: &Path, bytes: &[u8]) -> Result<(), BagError> {
-        use mcap::records::Record;
-        use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-        // the reader trusts the sizes a file declares: the limit keeps a damaged size from
-        // making it allocate without bound; chunk CRCs catch damaged compressed data
-        let mut reader = LinearReader::new_with_options(
-            LinearReaderOptions::default()
-                .with_record_length_limit(MAX_RECORD_BYTES)
-                .with_validate_chunk_crcs(true),
-        );
-        let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
-        let mut channel_topic: HashMap<u16, usize> = HashMap::new();
-        let messages_at_start = self.messages.len();
-        let mut last_time = None;
-        let mut rest = bytes;
-        let mut failure = None;
-        while let Some(event) = reader.next_event() {
-            let (opcode, data) = match event {
-                Ok(LinearReadEvent::ReadRequest(need)) => {
-                    let n = need.min(rest.len());
-                    reader.insert(n).copy_from_slice(&rest[..n]);
-                    reader.notify_read(n);
-                    rest = &rest[n..];
-                    continue;
-                }
-                Ok(LinearReadEvent::Record { opcode, data }) => (opcode, data),
-                Err(e) => {
-                    failure = Some(e.to_string());
-                    break;
-                }
-            };
-            match mcap::parse_record(opcode, data) {
-                Ok(Record::Schema { header, data }) => {
-                    schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
-                }
-                Ok(Record::Channel(c)) => {
-                    let (type_name, schema_encoding, schema) =
-                        schemas.get(&c.schema_id).cloned().unwrap_or_default();
-                    let topic = self.topic_index(BagTopic {
-                        name: c.topic,
-                        type_name,
-                        schema_encoding,
-                        schema,
-                        message_encoding: c.message_encoding,
-                        offered_qos_profiles: c.metadata.get("offered_qos_profiles").cloned(),
-                    });
-                    channel_topic.insert(c.id, topic);
-                }
-                Ok(Record::Message { header, data }) => {
-                    let Some(&topic) = channel_topic.get(&header.channel_id) else {
-                        failure = Some(format!(
-                            "message {} names channel {}, which was never defined",
-                            header.sequence, header.channel_id
-                        ));
-                        break;
-                    };
-                    let start = self.payloads.len();
-                    self.payloads.extend_from_slice(&data);
-                    self.messages.push(BagMessage {
-                        topic,
-                        log_time_ns: header.log_time,
-                        publish_time_ns: header.publish_time,
-                        start,
-                        len: data.len(),
-                    });
-                    last_time = Some(header.log_time);
-                }
-                // the summary repeats schemas and channels; the rest is not needed to replay
-                Ok(Record::DataEnd(_)) => break,
-                Ok(_) => {}
-                Err(e) => {
-                    failure = Some(e.to_string());
-                    break;
-                }
-            }
+        let content = scan::read_mcap(bytes, &mut self.payloads, MAX_RECORD_BYTES);
+        let mut topic_of: HashMap<u16, usize> = HashMap::new();
+        let mut ids: Vec<u16> = content.channels.keys().copied().collect();
+        ids.sort_unstable();
+        for id in ids {
+            let c = &content.channels[&id];
+            let (type_name, schema_encoding, schema) = content
+                .schemas
+                .get(&c.schema_id)
+                .cloned()
+                .unwrap_or_default();
+            let topic = self.topic_index(BagTopic {
+                name: c.topic.clone(),
+                type_name,
+                schema_encoding,
+                schema,
+                message_encoding: c.message_encoding.clone(),
+                offered_qos_profiles: c.metadata.get("offered_qos_profiles").cloned(),
+            });
+            topic_of.insert(id, topic);
         }
-        let read = self.messages.len() - messages_at_start;
-        if let Some(why) = failure {
-            if read == 0 {
-                return Err(BagError::NotMcap {
-                    path: file.to_path_buf(),
-                    why,
-                });
-            }
-            self.damage.push(BagDamage {
-                file: file.to_path_buf(),
-                messages_before: read,
-                last_good_log_time_ns: last_time,
-                why,
+        let mut orphans: BTreeMap<u16, usize> = BTreeMap::new();
+        let mut read = 0;
+        for m in &content.messages {
+            let Some(&topic) = topic_of.get(&m.channel) else {
+                *orphans.entry(m.channel).or_default() += 1;
+                continue;
+            };
+            read += 1;
+            self.messages.push(BagMessage {
+                topic,
+                log_time_ns: m.log_time_ns,
+                publish_time_ns: m.publish_time_ns,
+                start: m.start,
+                len: m.len,
             });
         }
+        let time_before = |k: usize| k.checked_sub(1).map(|i| content.messages[i].log_time_ns);
+        let mut damage: Vec<BagDamage> = content
+            .damage
+            .iter()
+            .map(|d| BagDamage {
+                file: file.to_path_buf(),
+                bytes: Some((d.start, d.end)),
+                messages_before: d.messages_before,
+                last_good_log_time_ns: time_before(d.messages_before),
+                why: d.why.clone(),
+            })
+            .collect();
+        for (channel, n) in orphans {
+            damage.push(BagDamage {
+                file: file.to_path_buf(),
+                bytes: None,
+                messages_before: content.messages.len(),
+                last_good_log_time_ns: None,
+                why: format!(
+                    "{n} intact message(s) on channel {channel} left out: the channel's definition was in a damaged range"
+                ),
+            });
+        }
+        if read == 0 && !damage.is_empty() {
+            return Err(BagError::NotMcap {
+                path: file.to_path_buf(),
+                why: damage
+                    .iter()
+                    .map(|d| d.why.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            });
+        }
+        self.damage.extend(damage);
         self.messages.sort_by_key(|m| m.log_time_ns);
         Ok(())
     }
@@ -241,79 +249,64 @@ impl Bag {
         &self.payloads[message.start..message.start + message.len]
     }
 
-    /// First and last receive time (ns since the epoch), if any message.
+    /// First and last receive time (ns since the epoch), if any message (outliers excluded, see
+    /// [`Bag::exclude_time_outliers`]).
     pub fn time_span_ns(&self) -> Option<(u64, u64)> {
         Some((
             self.messages.first()?.log_time_ns,
             self.messages.last()?.log_time_ns,
         ))
     }
-}
 
-/// The .mcap files of a bag: the file itself, or those metadata.yaml lists (falling back to the
-/// directory's .mcap files when there is no usable metadata.yaml).
-fn mcap_files(path: &Path) -> Result<Vec<PathBuf>, BagError> {
-    let io = |source| BagError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_dir() {
-        return check_compression(vec![path.to_path_buf()]);
-    }
-    let from_metadata = std::fs::read_to_string(path.join("metadata.yaml"))
-        .ok()
-        .and_then(|text| relative_file_paths(&text));
-    let files = match from_metadata {
-        Some(names) if !names.is_empty() => names.iter().map(|n| path.join(n)).collect(),
-        _ => {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(path)
-                .map_err(io)?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| {
-                    let name = p.to_string_lossy();
-                    name.ends_with(".mcap") || name.ends_with(".mcap.zstd")
-                })
-                .collect();
-            found.sort();
-            found
+    /// Moves receive-time outliers from [`Bag::messages`] to [`Bag::excluded`] (with a note), so
+    /// that one bad clock reading does not become the bag's start or end. The bulk of the bag is
+    /// its middle half (the quartiles q1..q3 of the receive times); a message is an outlier if it
+    /// lies more than max(1 h, 4·(q3 − q1)) outside it, and only if at most 1 % of the messages
+    /// (at least one) are: a bag with two large groups of times is left as it is.
+    pub fn exclude_time_outliers(&mut self) {
+        let n = self.messages.len();
+        if n < 4 {
+            return;
         }
-    };
-    if files.is_empty() {
-        return Err(BagError::NoMcap(path.to_path_buf()));
-    }
-    check_compression(files)
-}
-
-fn check_compression(files: Vec<PathBuf>) -> Result<Vec<PathBuf>, BagError> {
-    for f in &files {
-        let name = f.to_string_lossy();
-        if let Some(ext) = [".zstd", ".zst", ".lz4"]
+        let (q1, q3) = (
+            self.messages[n / 4].log_time_ns,
+            self.messages[(3 * n) / 4].log_time_ns,
+        );
+        let margin = (4 * (q3 - q1)).max(OUTLIER_MIN_MARGIN_NS);
+        let (lo, hi) = (q1.saturating_sub(margin), q3.saturating_add(margin));
+        let outside = |m: &BagMessage| m.log_time_ns < lo || m.log_time_ns > hi;
+        let count = self.messages.iter().filter(|m| outside(m)).count();
+        if count == 0 || count > (n / 100).max(1) {
+            return;
+        }
+        let (excluded, kept): (Vec<BagMessage>, Vec<BagMessage>) =
+            self.messages.iter().partition(|m| outside(m));
+        let times: Vec<String> = excluded
             .iter()
-            .find(|e| name.ends_with(*e))
-        {
-            return Err(BagError::Compressed {
-                path: f.clone(),
-                what: ext.trim_start_matches('.').into(),
-            });
-        }
+            .take(5)
+            .map(|m| {
+                format!(
+                    "{} at {:.3} s",
+                    self.topics[m.topic].name,
+                    m.log_time_ns as f64 * 1e-9
+                )
+            })
+            .collect();
+        self.notes.push(format!(
+            "{count} message(s) with a receive time far outside the rest of the bag ({:.3} s to {:.3} s) left out: {}{}",
+            kept.first().map_or(0.0, |m| m.log_time_ns as f64 * 1e-9),
+            kept.last().map_or(0.0, |m| m.log_time_ns as f64 * 1e-9),
+            times.join(", "),
+            if count > 5 { ", …" } else { "" }
+        ));
+        self.messages = kept;
+        self.excluded.extend(excluded);
     }
-    Ok(files)
 }
 
-/// `rosbag2_bagfile_information.relative_file_paths` of a metadata.yaml.
-fn relative_file_paths(text: &str) -> Option<Vec<String>> {
-    let doc: serde_yaml_ng::Value = serde_yaml_ng::from_str(text).ok()?;
-    let list = doc
-        .get("rosbag2_bagfile_information")?
-        .get("relative_file_paths")?
-        .as_sequence()?;
-    Some(
-        list.iter()
-            .filter_map(|v| v.as_str().map(str::to_string))
-            .collect(),
-    )
-}
+/// Smallest distance from the bulk of the bag's receive times at which a message counts as an
+/// outlier: 1 h (ns).
+const OUTLIER_MIN_MARGIN_NS: u64 = 3_600_000_000_000;
 
 /// Largest record believed (bytes): 256 MiB. A damaged length above it is reported, not
 /// allocated.

@@ -112,9 +112,9 @@ struct BearingReport {
 pub(crate) fn run(args: &BearingArgs) -> anyhow::Result<()> {
     let report = analyse(args)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print_table(&report);
+        print_table(&report)?;
     }
     Ok(())
 }
@@ -216,7 +216,7 @@ fn report_is_finite(r: &BearingReport) -> bool {
         && matrices.iter().flatten().flatten().all(|v| v.is_finite())
 }
 
-fn print_table(r: &BearingReport) {
+fn print_table(r: &BearingReport) -> anyhow::Result<()> {
     let m = |a: [[f64; 2]; 2]| {
         format!(
             "[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]",
@@ -229,48 +229,51 @@ fn print_table(r: &BearingReport) {
             a[0][0], a[0][1], a[1][0], a[1][1]
         )
     };
-    println!(
+    outln!(
         "rotor-twin bearing: {:?} film, grid {}, grooves {:?}",
-        r.model, r.grid, r.grooves
+        r.model,
+        r.grid,
+        r.grooves
     );
-    println!("  speed                      {:>12.1} rpm", r.speed_rpm);
-    println!("  static load                {:>12.2} N", r.load_n);
-    println!("  Sommerfeld number S        {:>12.5}", r.sommerfeld_number);
-    println!(
+    outln!("  speed                      {:>12.1} rpm", r.speed_rpm);
+    outln!("  static load                {:>12.2} N", r.load_n);
+    outln!("  Sommerfeld number S        {:>12.5}", r.sommerfeld_number);
+    outln!(
         "  eccentricity ratio ε       {:>12.4}",
         r.eccentricity_ratio
     );
-    println!(
+    outln!(
         "  attitude angle φ           {:>12.2} deg",
         r.attitude_angle_deg
     );
-    println!(
+    outln!(
         "  minimum film               {:>12.2} µm",
         r.min_film_thickness_m * 1e6
     );
-    println!(
+    outln!(
         "  peak pressure              {:>12.4} MPa at {:.1} deg",
         r.max_pressure_pa * 1e-6,
         r.max_pressure_angle_deg
     );
-    println!(
+    outln!(
         "  pressure zone ζ1 → ζ2      {:>6.1} → {:.1} deg",
-        r.film_start_deg, r.film_end_deg
+        r.film_start_deg,
+        r.film_end_deg
     );
-    println!(
+    outln!(
         "  friction torque            {:>12.4} N·m",
         r.friction_torque_n_m
     );
-    println!("  power loss                 {:>12.1} W", r.power_loss_w);
-    println!(
+    outln!("  power loss                 {:>12.1} W", r.power_loss_w);
+    outln!(
         "  side flow                  {:>12.3} cm³/s",
         r.side_flow_m3_s * 1e6
     );
-    println!(
+    outln!(
         "  inflow at ζ1               {:>12.3} cm³/s",
         r.inflow_m3_s * 1e6
     );
-    println!(
+    outln!(
         "  film Reynolds number       {:>12.0}{}",
         r.film_reynolds_number,
         if r.film_reynolds_number > 1000.0 {
@@ -279,15 +282,16 @@ fn print_table(r: &BearingReport) {
             ""
         }
     );
-    println!("  stiffness k (N/m)          {}", m(r.stiffness_n_per_m));
-    println!("  damping c (N·s/m)          {}", m(r.damping_n_s_per_m));
-    println!(
+    outln!("  stiffness k (N/m)          {}", m(r.stiffness_n_per_m));
+    outln!("  damping c (N·s/m)          {}", m(r.damping_n_s_per_m));
+    outln!(
         "  K = k c/W                  {}",
         d(r.stiffness_dimensionless)
     );
-    println!(
+    outln!(
         "  B = c ω c_r/W              {}",
         d(r.damping_dimensionless)
     );
-    println!("  frame: {}", r.frame);
+    outln!("  frame: {}", r.frame);
+    Ok(())
 }

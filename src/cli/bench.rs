@@ -65,14 +65,15 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Workload::Orc9000 => return orc_9000(args),
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&figures)?);
+        outln!("{}", serde_json::to_string_pretty(&figures)?);
     } else {
-        println!(
+        outln!(
             "film solve, seed bearing (D 60 mm, L 30 mm, c 40 µm, 9000 rpm, 275 N), grid {}x{}:",
-            args.grid.n_theta, args.grid.n_z
+            args.grid.n_theta,
+            args.grid.n_z
         );
         for f in &figures {
-            println!(
+            outln!(
                 "  {:<44} median {:>8.2} µs   p99 {:>8.2} µs   ({} samples, {:.2} active-set passes)",
                 f.case, f.median_us, f.p99_us, f.samples, f.mean_active_set_passes
             );
@@ -149,10 +150,10 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         newton_iterations_per_step: iterations as f64 / n as f64,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&fig)?);
+        outln!("{}", serde_json::to_string_pretty(&fig)?);
     } else {
-        println!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
-        println!(
+        outln!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
+        outln!(
             "  {} steps: median {:.1} µs, p99 {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
             fig.steps, fig.median_step_us, fig.p99_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step
         );

@@ -1,5 +1,35 @@
 //! The `rotor-twin` command line: one subcommand per job.
 
+use clap::{Parser, Subcommand};
+
+/// Standard output was closed by its reader (`rotor-twin modes | head`, `| true`): the command
+/// ends there, quietly and successfully, as a Unix filter does.
+#[derive(Debug, thiserror::Error)]
+#[error("standard output closed by its reader")]
+pub struct StdoutClosed;
+
+/// Writes `text` to standard output. A closed standard output gives [`StdoutClosed`], which
+/// [`run`] treats as the normal end of the command (`print!` would panic); any other write error
+/// is an error.
+pub fn print_out(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(StdoutClosed.into()),
+        Err(e) => Err(anyhow::Error::new(e).context("writing to standard output")),
+    }
+}
+
+/// `println!` through [`print_out`]: returns from the enclosing function (which gives an
+/// `anyhow::Result`) when standard output is closed.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::cli::print_out(&format!("{}\n", format_args!($($arg)*)))?
+    };
+}
+
+mod bag;
 mod bearing;
 mod bench;
 mod modes;
@@ -7,8 +37,6 @@ mod node;
 mod replay;
 mod simulate;
 mod synth;
-
-use clap::{Parser, Subcommand};
 
 /// rotor-twin: a live digital twin of a rotor on fluid-film bearings.
 #[derive(Debug, Parser)]
@@ -39,11 +67,20 @@ enum Command {
     SynthBag(synth::SynthArgs),
     /// Measure the cost of the hot paths (prints its figures).
     Bench(bench::BenchArgs),
+    /// Tools for recorded bags: `bag recover DIR` makes a cut-off recording a complete bag.
+    Bag(bag::BagArgs),
 }
 
 /// Runs the command line; with no subcommand, the main job: the shipped sample bag replayed on
 /// the built-in default machine.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match run_command(cli) {
+        Err(e) if e.downcast_ref::<StdoutClosed>().is_some() => Ok(()),
+        result => result,
+    }
+}
+
+fn run_command(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bearing(args)) => bearing::run(&args),
         Some(Command::Modes(args)) => modes::run(&args),
@@ -54,6 +91,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Param(args)) => node::run_param(args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Bag(args)) => bag::run(&args),
         None => replay::run_sample(),
     }
 }

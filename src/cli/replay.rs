@@ -2,13 +2,13 @@
 
 use crate::bag::Bag;
 use crate::dynamics::Coupling;
+use crate::record::resolved_path;
 use crate::replay::{replay, ReplayOptions};
 use crate::ros::SpeedUnit;
 use crate::rotor::{MachineDescription, Rotor};
 use crate::session::SessionSettings;
 use anyhow::Context;
 use clap::Args;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The bag shipped with the project (a synthetic run-up of the built-in microturbine).
@@ -109,7 +109,7 @@ pub fn run_sample() -> anyhow::Result<()> {
         // run from elsewhere than the repository root
         bag = Path::new(env!("CARGO_MANIFEST_DIR")).join(SAMPLE_BAG);
     }
-    println!(
+    outln!(
         "rotor-twin: replaying the shipped SYNTHETIC bag {} on the built-in machine",
         bag.display()
     );
@@ -155,11 +155,6 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         None => MachineDescription::builtin_default(),
     };
     let rotor = Rotor::from_description(&desc);
-    let bag =
-        Bag::read(&args.bag).with_context(|| format!("reading bag {}", args.bag.display()))?;
-    for d in &bag.damage {
-        eprintln!("warning: {d}; replaying what came before it");
-    }
     let out_dir = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .bag
@@ -167,6 +162,15 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
             .map_or("bag".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from(format!("replay_{stem}"))
     });
+    refuse_overlap(&args.bag, &out_dir)?;
+    // the bag's errors name the file concerned
+    let bag = Bag::read(&args.bag)?;
+    for d in &bag.damage {
+        eprintln!("warning: {d}; replaying every intact message");
+    }
+    for n in &bag.notes {
+        eprintln!("warning: {}: {n}", args.bag.display());
+    }
     let options = ReplayOptions {
         coupling,
         steps_per_rev: args.steps_per_rev,
@@ -237,17 +241,33 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         )?;
     }
     // a closed standard output (e.g. piped into `head`) is not an error of the replay
-    let mut stdout = std::io::stdout().lock();
-    let printed = if args.json {
-        writeln!(stdout, "{json}")
+    if args.json {
+        super::print_out(&format!("{json}\n"))
     } else {
-        write!(stdout, "{}", report.summary())
-            .and_then(|()| writeln!(stdout, "output: {}", out_dir.display()))
-    };
-    match printed {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
-        _ => Ok(()),
+        super::print_out(&format!(
+            "{}output: {}\n",
+            report.summary(),
+            out_dir.display()
+        ))
     }
+}
+
+/// Refuses an output directory that is the input bag, lies inside it or holds it: the replay
+/// writes into `out` and replaces `out/bag`, and must never write into or over its input.
+fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
+    let (bag_abs, out_abs) = (resolved_path(bag), resolved_path(out));
+    anyhow::ensure!(
+        !out_abs.starts_with(&bag_abs) && !bag_abs.starts_with(&out_abs),
+        "--out {}: {} the input bag {}; choose an output directory apart from it",
+        out.display(),
+        if out_abs.starts_with(&bag_abs) {
+            "is or lies inside"
+        } else {
+            "holds"
+        },
+        bag.display()
+    );
+    Ok(())
 }
 
 /// Creates `dir`, or clears a previous replay's output in it (a directory holding anything

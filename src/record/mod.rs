@@ -1,8 +1,15 @@
 //! Recording to MCAP in the rosbag2 conventions: a bag directory with `<name>_0.mcap` (profile
 //! `ros2`, CDR messages, `ros2msg` schemas, each channel's `offered_qos_profiles`) and
-//! `metadata.yaml` (rosbag2 version 9). Flushed on demand (the node does it at least every second)
-//! so that a killed process loses at most the last chunk; [`Recorder::finish`] writes the summary
-//! and the metadata.
+//! `metadata.yaml` (rosbag2 version 9). metadata.yaml is written when the recording starts and
+//! rewritten at every flush (the node flushes at least every second), so a killed process loses at
+//! most the last chunk and leaves a bag directory that [`recover`] (`rotor-twin bag recover`)
+//! makes whole; [`Recorder::finish`] writes the summary and the final metadata. A write that fails
+//! (a full disk) is returned as [`RecordError::Write`], naming the file: the caller must stop
+//! and say so; what was flushed before stays readable.
+
+mod recover;
+
+pub use recover::{recover, resolved_path, RecoverError, Recovered};
 
 use crate::messages::RosMessage;
 use serde::Serialize;
@@ -77,16 +84,16 @@ struct TopicEntry {
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
     /// File-system trouble, with the path.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// The path concerned.
         path: PathBuf,
-        /// The error.
-        source: std::io::Error,
+        /// The error (part of the message, so not also a `source`: reported once).
+        cause: std::io::Error,
     },
-    /// The MCAP writer failed.
+    /// The MCAP writer failed (its message is part of this one: reported once).
     #[error("MCAP writer: {0}")]
-    Mcap(#[from] mcap::McapError),
+    Mcap(mcap::McapError),
     /// A message could not be encoded.
     #[error("encoding a {type_name} for {topic}: {why}")]
     Encode {
@@ -97,9 +104,23 @@ pub enum RecordError {
         /// Why.
         why: String,
     },
+    /// Writing the recording failed (a full disk, a lost device): the recording cannot go on.
+    #[error("{path}: the recording failed and stops: {why}; what was flushed before is readable (`rotor-twin bag recover` makes it a complete bag)")]
+    Write {
+        /// The file being written.
+        path: PathBuf,
+        /// What the writer said.
+        why: String,
+    },
     /// A topic was written before it was added.
     #[error("topic {0} was not added to the recording")]
     UnknownTopic(String),
+}
+
+impl From<mcap::McapError> for RecordError {
+    fn from(e: mcap::McapError) -> Self {
+        Self::Mcap(e)
+    }
 }
 
 /// Writes one bag directory.
@@ -118,9 +139,9 @@ pub struct Recorder {
 impl Recorder {
     /// Creates bag directory `dir` (which must not exist yet, as with `ros2 bag record -o`).
     pub fn create(dir: &Path) -> Result<Self, RecordError> {
-        let io = |source| RecordError::Io {
+        let io = |cause| RecordError::Io {
             path: dir.to_path_buf(),
-            source,
+            cause,
         };
         if dir.exists() {
             return Err(io(std::io::Error::new(
@@ -134,17 +155,21 @@ impl Recorder {
             .map_or("rotor_twin".into(), |s| s.to_string_lossy().into_owned());
         let file_name = format!("{stem}_0.mcap");
         let path = dir.join(&file_name);
-        let file = File::create(&path).map_err(|source| RecordError::Io {
+        let file = File::create(&path).map_err(|cause| RecordError::Io {
             path: path.clone(),
-            source,
+            cause,
         })?;
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
             .library("rotor-twin")
             // chunks of 64 KiB: a file cut off (a crash, a full disk) loses at most that much
             .chunk_size(Some(64 * 1024))
-            .create(BufWriter::new(file))?;
-        Ok(Self {
+            .create(BufWriter::new(file))
+            .map_err(|e| RecordError::Write {
+                path: path.clone(),
+                why: e.to_string(),
+            })?;
+        let rec = Self {
             dir: dir.to_path_buf(),
             file_name,
             writer,
@@ -154,7 +179,39 @@ impl Recorder {
             last_ns: 0,
             last_flush: Instant::now(),
             custom_data: BTreeMap::new(),
-        })
+        };
+        rec.write_metadata()?;
+        Ok(rec)
+    }
+
+    /// The .mcap file being written.
+    pub fn file(&self) -> PathBuf {
+        self.dir.join(&self.file_name)
+    }
+
+    /// A writer error with its causes in one message (the I/O error, e.g. "No space left on
+    /// device", is the MCAP error's source).
+    fn failed(&self, e: mcap::McapError) -> RecordError {
+        let mut why = e.to_string();
+        let mut cause = std::error::Error::source(&e);
+        while let Some(c) = cause {
+            why = format!("{why}: {c}");
+            cause = c.source();
+        }
+        RecordError::Write {
+            path: self.file(),
+            why,
+        }
+    }
+
+    /// Writes metadata.yaml as the recording stands (atomically: a kill while writing leaves
+    /// the previous one).
+    fn write_metadata(&self) -> Result<(), RecordError> {
+        let path = self.dir.join("metadata.yaml");
+        let tmp = self.dir.join(".metadata.yaml.partial");
+        std::fs::write(&tmp, self.metadata_yaml())
+            .and_then(|()| std::fs::rename(&tmp, &path))
+            .map_err(|cause| RecordError::Io { path, cause })
     }
 
     /// Adds topic `name` of type `T` offered with `qos`; returns its handle. Adding the same name
@@ -249,29 +306,38 @@ impl Recorder {
             .get_mut(topic)
             .ok_or_else(|| RecordError::UnknownTopic(format!("#{topic}")))?;
         self.sequence = self.sequence.wrapping_add(1);
-        self.writer.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: entry.channel,
-                sequence: self.sequence,
-                log_time: log_time_ns,
-                publish_time: publish_time_ns,
-            },
-            cdr,
-        )?;
-        entry.count += 1;
+        let channel = entry.channel;
+        self.writer
+            .write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: channel,
+                    sequence: self.sequence,
+                    log_time: log_time_ns,
+                    publish_time: publish_time_ns,
+                },
+                cdr,
+            )
+            .map_err(|e| self.failed(e))?;
+        self.topics[topic].count += 1;
         self.first_ns = Some(self.first_ns.map_or(log_time_ns, |f| f.min(log_time_ns)));
         self.last_ns = self.last_ns.max(log_time_ns);
         Ok(())
     }
 
-    /// Closes the current chunk if `every` has passed since the last flush, so that a killed
-    /// process loses at most that much.
+    /// Closes the current chunk and rewrites metadata.yaml if `every` has passed since the last
+    /// flush, so that a killed process loses at most that much.
     pub fn flush_if_due(&mut self, every: Duration) -> Result<(), RecordError> {
         if self.last_flush.elapsed() >= every {
-            self.writer.flush()?;
-            self.last_flush = Instant::now();
+            self.flush()?;
         }
         Ok(())
+    }
+
+    /// Closes the current chunk (written to the file) and rewrites metadata.yaml.
+    pub fn flush(&mut self) -> Result<(), RecordError> {
+        self.writer.flush().map_err(|e| self.failed(e))?;
+        self.last_flush = Instant::now();
+        self.write_metadata()
     }
 
     /// Messages recorded per topic so far.
@@ -285,15 +351,14 @@ impl Recorder {
     /// Writes the summary section and `metadata.yaml`. Returns the bag directory.
     pub fn finish(mut self) -> Result<PathBuf, RecordError> {
         if !self.custom_data.is_empty() {
-            self.writer.write_metadata(&mcap::records::Metadata {
+            let m = mcap::records::Metadata {
                 name: "rotor_twin".into(),
                 metadata: self.custom_data.clone(),
-            })?;
+            };
+            self.writer.write_metadata(&m).map_err(|e| self.failed(e))?;
         }
-        self.writer.finish()?;
-        let metadata = self.metadata_yaml();
-        let path = self.dir.join("metadata.yaml");
-        std::fs::write(&path, metadata).map_err(|source| RecordError::Io { path, source })?;
+        self.writer.finish().map_err(|e| self.failed(e))?;
+        self.write_metadata()?;
         Ok(self.dir)
     }
 

@@ -236,12 +236,25 @@ impl MachineDescription {
     /// Reads and checks a machine file.
     pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
+        let unreadable = |rule: String| ConfigError {
             file: file.clone(),
             field: "(file)".into(),
             value: String::new(),
-            rule: format!("cannot be read: {e}"),
-        })?;
+            rule,
+        };
+        let meta =
+            std::fs::metadata(path).map_err(|e| unreadable(format!("cannot be read: {e}")))?;
+        if !meta.is_file() {
+            return Err(unreadable("is not a regular file".into()));
+        }
+        if meta.len() > MAX_MACHINE_FILE_BYTES as u64 {
+            return Err(unreadable(format!(
+                "is {} bytes, more than the {MAX_MACHINE_FILE_BYTES} a machine description may be",
+                meta.len()
+            )));
+        }
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| unreadable(format!("cannot be read: {e}")))?;
         Self::from_yaml(&text, &file)
     }
 
@@ -262,6 +275,12 @@ impl MachineDescription {
 
     /// Parses and checks YAML text; `file` names it in errors.
     pub fn from_yaml(text: &str, file: &str) -> Result<Self, ConfigError> {
+        crate::bag::check_yaml_shape(text, MAX_MACHINE_FILE_BYTES).map_err(|rule| ConfigError {
+            file: file.to_string(),
+            field: "(document)".into(),
+            value: String::new(),
+            rule,
+        })?;
         let de = serde_yaml_ng::Deserializer::from_str(text);
         let desc: Self = serde_path_to_error::deserialize(de).map_err(|e| {
             let field = e.path().to_string();
@@ -288,6 +307,7 @@ impl MachineDescription {
 
     /// Checks every field against its rule; the first broken rule is reported.
     pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        self.validate_limits(file)?;
         let err = |field: String, value: String, rule: &str| ConfigError {
             file: file.to_string(),
             field,
@@ -429,9 +449,6 @@ impl MachineDescription {
         for (i, b) in self.bearings.iter().enumerate() {
             let f = |name: &str| format!("bearings[{i}].{name}");
             node_ok(f("node"), b.node)?;
-            if self.bearings[..i].iter().any(|o| o.name == b.name) {
-                return Err(err(f("name"), b.name.clone(), "must be unique"));
-            }
             match b.model {
                 BearingModelKind::Finite | BearingModelKind::Short => {
                     for (name, v) in [
@@ -551,6 +568,93 @@ impl MachineDescription {
             }
         }
         Ok(())
+    }
+}
+
+/// Largest machine file read (bytes): 1 MiB (the shipped ones are 2–4 kB).
+pub const MAX_MACHINE_FILE_BYTES: usize = 1 << 20;
+/// Most shaft elements in total: 200. The matrices are dense, 4 degrees of freedom a node, and
+/// the modal analysis solves a state-space eigenproblem of 8 per node: its cost grows as the cube
+/// of the node count (10,000 elements would ask for 12.8 GB). The shipped machines use 30.
+pub const MAX_SHAFT_ELEMENTS: usize = 200;
+/// Longest name of a bearing or probe station (characters); names appear in topics, warnings
+/// and file names.
+pub const MAX_NAME_CHARS: usize = 64;
+/// A film bearing at most this many diameters long (the film model's own bound).
+const MAX_BEARING_LENGTH_DIAMETERS: f64 = 10.0;
+
+impl MachineDescription {
+    /// The bounds checked before the per-field rules: model size, names, bearing proportions.
+    fn validate_limits(&self, file: &str) -> Result<(), ConfigError> {
+        let err = |field: String, value: String, rule: String| ConfigError {
+            file: file.to_string(),
+            field,
+            value,
+            rule,
+        };
+        let elements: usize = self.shaft.iter().map(|s| s.elements).sum();
+        if elements > MAX_SHAFT_ELEMENTS {
+            return Err(err(
+                "shaft[*].elements".into(),
+                format!("{elements} in total"),
+                format!(
+                    "at most {MAX_SHAFT_ELEMENTS} elements in all: the dense model's memory grows as the square and its modal analysis as the cube of the node count"
+                ),
+            ));
+        }
+        let bearing_names = self.bearings.iter().map(|b| &b.name);
+        let probe_names = self.probes.iter().map(|p| &p.name);
+        for (kind, names) in [
+            ("bearings", bearing_names.collect::<Vec<_>>()),
+            ("probes", probe_names.collect::<Vec<_>>()),
+        ] {
+            for (i, name) in names.iter().enumerate() {
+                let field = format!("{kind}[{i}].name");
+                if let Some(rule) = name_problem(name) {
+                    return Err(err(field, shown(name), rule));
+                }
+                if names[..i].contains(name) {
+                    return Err(err(field, shown(name), "must be unique".into()));
+                }
+            }
+        }
+        for (i, b) in self.bearings.iter().enumerate() {
+            if let (Some(d), Some(l)) = (b.diameter_m, b.length_m) {
+                if l > MAX_BEARING_LENGTH_DIAMETERS * d {
+                    return Err(err(
+                        format!("bearings[{i}].length_m"),
+                        l.to_string(),
+                        format!(
+                            "must not exceed {MAX_BEARING_LENGTH_DIAMETERS} diameters (diameter_m = {d}): beyond it the film model does not hold"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why `name` cannot name a bearing or station, if it cannot.
+fn name_problem(name: &str) -> Option<String> {
+    if name.trim().is_empty() {
+        Some("must not be empty".into())
+    } else if name.chars().count() > MAX_NAME_CHARS {
+        Some(format!("must be at most {MAX_NAME_CHARS} characters"))
+    } else if name.chars().any(char::is_control) {
+        Some("must not contain control characters".into())
+    } else {
+        None
+    }
+}
+
+/// `value` as shown in an error: at most 40 characters, then its length.
+fn shown(value: &str) -> String {
+    if value.chars().count() <= 40 {
+        format!("{value:?}")
+    } else {
+        let head: String = value.chars().take(40).collect();
+        format!("{head:?}… ({} characters)", value.chars().count())
     }
 }
 

@@ -1,0 +1,213 @@
+//! The command line under hostile or unlucky input: machine files the model cannot hold (a
+//! bearing 20 diameters long, 10,000 elements, bad station names, deep YAML) are refused with
+//! the field and the reason, not a panic; a closed standard output ends a command quietly;
+//! `replay` never writes into or over its input bag; errors are printed once.
+
+mod common;
+
+use common::run_cli;
+use rotor_twin::rotor::MachineDescription;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rotor-twin-guards-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&d).ok();
+    d
+}
+
+fn shipped_machine() -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/orc_microturbine_100kw.yaml");
+    std::fs::read_to_string(p).unwrap()
+}
+
+/// The shipped machine with `from` replaced by `to` (once, checked).
+fn machine_with(from: &str, to: &str) -> String {
+    let text = shipped_machine();
+    assert!(text.contains(from), "{from}");
+    text.replacen(from, to, 1)
+}
+
+fn refusal(yaml: &str) -> String {
+    MachineDescription::from_yaml(yaml, "m.yaml")
+        .expect_err("must be refused")
+        .to_string()
+}
+
+#[test]
+fn machines_the_model_cannot_hold_are_refused_with_the_field() {
+    // a bearing 20 diameters long (the film model's bound is 10)
+    let long = machine_with("    length_m: 0.030\n", "    length_m: 1.2\n");
+    let e = refusal(&long);
+    assert!(
+        e.contains("bearings[0].length_m = 1.2") && e.contains("10 diameters"),
+        "{e}"
+    );
+    // 10,000 elements: 50 sections of 200
+    let many = machine_with(
+        "  - {length_m: 0.73333333, outer_diameter_m: 0.055, material: steel, elements: 22}\n",
+        &"  - {length_m: 0.0146, outer_diameter_m: 0.055, material: steel, elements: 200}\n"
+            .repeat(50),
+    );
+    let e = refusal(&many);
+    assert!(
+        e.contains("10") && e.contains("at most 200 elements"),
+        "{e}"
+    );
+    // station names: empty, duplicate, 100 kB long (not echoed whole)
+    let e = refusal(&machine_with("name: probe_outboard,", "name: '',"));
+    assert!(e.contains("probes[1].name") && e.contains("empty"), "{e}");
+    let e = refusal(&machine_with(
+        "name: probe_outboard,",
+        "name: probe_pulley_end,",
+    ));
+    assert!(e.contains("probes[1].name") && e.contains("unique"), "{e}");
+    let huge = "x".repeat(100_000);
+    let e = refusal(&machine_with(
+        "name: probe_outboard,",
+        &format!("name: {huge},"),
+    ));
+    assert!(
+        e.contains("at most 64 characters") && e.len() < 300,
+        "{} chars",
+        e.len()
+    );
+    let e = refusal(&machine_with("name: bearing_outboard", "name: \"a\\tb\""));
+    assert!(
+        e.contains("bearings[1].name") && e.contains("control"),
+        "{e}"
+    );
+}
+
+/// 200 kB of nesting took minutes to parse before (issue 15): now refused at once.
+#[test]
+fn deep_yaml_is_refused_before_parsing() {
+    let deep = format!("name: {}{}\n", "[".repeat(100_000), "]".repeat(100_000));
+    let started = std::time::Instant::now();
+    let e = refusal(&deep);
+    assert!(e.contains("brackets open at once"), "{e}");
+    let mut block = String::from("name: x\nmaterials:\n");
+    for d in 1..400 {
+        block += &format!("{}m{d}:\n", " ".repeat(d + 1));
+    }
+    let e = refusal(&block);
+    assert!(e.contains("columns deep"), "{e}");
+    // not a timing test: a bound far above the milliseconds this takes, to catch a parse
+    assert!(started.elapsed().as_secs() < 5);
+    let e = refusal(&"a: 1\n".repeat(300_000));
+    assert!(e.contains("bytes"), "{e}");
+}
+
+/// The CLI with a machine the model cannot hold: an error (exit 1), not a panic (exit 101).
+#[test]
+fn a_long_bearing_fails_cleanly_in_the_cli() {
+    let dir = scratch("long");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = dir.join("long.yaml");
+    std::fs::write(
+        &cfg,
+        machine_with("    length_m: 0.030\n", "    length_m: 0.7\n"),
+    )
+    .unwrap();
+    for cmd in [&["modes"][..], &["replay", "--no-bag"]] {
+        let mut args = cmd.to_vec();
+        args.extend(["--config", cfg.to_str().unwrap()]);
+        let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("10 diameters") && !err.contains("panicked"),
+            "{err}"
+        );
+    }
+}
+
+/// Runs the CLI with its standard output a pipe whose reader (`true`) has already exited: the
+/// exit code and standard error.
+fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
+    let script = format!(
+        "(sleep 0.3; \"$0\" {}; echo \"rc=$?\" >&2) | true",
+        args.join(" ")
+    );
+    let out = Command::new("sh")
+        .args(["-c", &script, env!("CARGO_BIN_EXE_rotor-twin")])
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let code = err
+        .lines()
+        .find_map(|l| l.strip_prefix("rc="))
+        .and_then(|c| c.parse().ok());
+    (code, err)
+}
+
+#[test]
+fn a_closed_stdout_ends_the_command_quietly() {
+    for args in [
+        &["bearing"][..],
+        &["bearing", "--json"],
+        &["bench", "--seconds", "0.05"],
+    ] {
+        let (code, err) = with_closed_stdout(args);
+        assert_eq!(code, Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn replay_never_writes_into_or_over_its_input() {
+    let root = scratch("overlap");
+    let bag = root.join("bag");
+    std::fs::create_dir_all(&root).unwrap();
+    let sample = Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/orc_runup_synthetic");
+    let status = Command::new("cp")
+        .args(["-r", sample.to_str().unwrap(), bag.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    // a previous replay's output there, so that only the overlap can refuse it
+    std::fs::write(root.join("report.json"), "{}").unwrap();
+    let before: Vec<_> = std::fs::read_dir(&bag)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    for out in [
+        root.clone(),
+        bag.clone(),
+        bag.join("sub"),
+        root.join("bag/../bag"),
+    ] {
+        let (ok, _, err) = run_cli(&[
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--duration",
+            "0.01",
+        ]);
+        assert!(
+            !ok && err.contains("input bag"),
+            "--out {}: {err}",
+            out.display()
+        );
+    }
+    let after: Vec<_> = std::fs::read_dir(&bag)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(before, after);
+    assert!(rotor_twin::bag::Bag::read(&bag).unwrap().damage.is_empty());
+}
+
+#[test]
+fn a_missing_bag_is_reported_once() {
+    let (ok, out, err) = run_cli(&["replay", "/nonexistent/bag"]);
+    assert!(!ok && out.is_empty());
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
+    assert_eq!(err.matches("/nonexistent/bag").count(), 1, "{err}");
+}
