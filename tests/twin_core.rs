@@ -201,3 +201,35 @@ fn run_up_tracks_speed_and_angle() {
     assert!((twin.output().angle_rad - angle).abs() < 1e-9 * angle);
     assert!((twin.time_s() - steps as f64 * h).abs() < 1e-12);
 }
+
+/// The unbalance force is the d'Alembert force −m r̈ of the mass point r = e (cos ψ, sin ψ) on
+/// a rotor that accelerates, ψ(t) = ψ0 + ω0 t + ½ α t²: checked against r̈ by central
+/// differences of the position (an independent computation, kinematics only), tangential part
+/// included. The tangential part had the wrong sign (it pushed the shaft forwards).
+#[test]
+fn unbalance_force_is_minus_m_times_the_acceleration_of_the_mass() {
+    use rotor_twin::rotor::unbalance_force;
+    let (me, psi0, w0, alpha) = (140e-6, 0.7, 900.0, 2.0e4);
+    let psi = |t: f64| psi0 + w0 * t + 0.5 * alpha * t * t;
+    let r = |t: f64| [me * psi(t).cos(), me * psi(t).sin()];
+    let dt = 1e-6;
+    let (a, b, c) = (r(-dt), r(0.0), r(dt));
+    let accel = [
+        (a[0] - 2.0 * b[0] + c[0]) / (dt * dt),
+        (a[1] - 2.0 * b[1] + c[1]) / (dt * dt),
+    ];
+    let f = unbalance_force(me, psi0, w0, alpha);
+    let scale = me * w0 * w0;
+    for i in 0..2 {
+        assert!(
+            (f[i] + accel[i]).abs() < 1e-5 * scale,
+            "component {i}: {} vs −m r̈ {}",
+            f[i],
+            -accel[i]
+        );
+    }
+    // the tangential part alone: m e α against the rotation (ψ̂ = (−sin ψ, cos ψ))
+    let tangential = unbalance_force(me, psi0, 0.0, alpha);
+    let along = -tangential[0] * psi0.sin() + tangential[1] * psi0.cos();
+    assert!((along + me * alpha).abs() < 1e-12, "{along}");
+}

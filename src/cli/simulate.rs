@@ -168,7 +168,35 @@ struct SimulateReport {
     real_time_factor: f64,
     newton_iterations_per_step: f64,
     max_substeps: usize,
+    /// Prehistory coupling: substeps whose relaxed iteration fell back to Newton (0 otherwise).
+    prehistory_fallbacks: usize,
+    /// False when the run left the model's validity: the linear coupling has no wall, and an
+    /// orbit beyond the clearance (ε ≥ 1) is then no motion the machine can make.
+    valid: bool,
+    /// Why `valid` is false (empty when valid).
+    validity: String,
     bearings: Vec<BearingSummary>,
+}
+
+/// Whether run `r` stayed inside what its model can represent: with the linear coupling (no
+/// film nonlinearity, no wall) every journal must stay inside its clearance circle.
+fn validity(model: ModelArg, r: &TransientResult) -> (bool, String) {
+    let worst = r
+        .history
+        .iter()
+        .flat_map(|rev| rev.bearings.iter().map(|b| b.max_eccentricity_ratio))
+        .fold(0.0_f64, f64::max);
+    if model == ModelArg::Linear && worst >= 1.0 {
+        (
+            false,
+            format!(
+                "linear model beyond the clearance: eccentricity ratio reached {worst:.3} \
+                 (the linear coupling has no wall; use the nonlinear model)"
+            ),
+        )
+    } else {
+        (true, String::new())
+    }
 }
 
 fn summarise(
@@ -177,6 +205,7 @@ fn summarise(
     r: &TransientResult,
 ) -> SimulateReport {
     let rep = &r.report;
+    let (valid, why) = validity(args.options.model, r);
     SimulateReport {
         machine: desc.name.clone(),
         speed_rpm: args.speed_rpm,
@@ -194,6 +223,9 @@ fn summarise(
         real_time_factor: r.real_time_factor(),
         newton_iterations_per_step: r.newton_iterations as f64 / r.steps.max(1) as f64,
         max_substeps: r.max_substeps,
+        prehistory_fallbacks: r.prehistory_fallbacks,
+        valid,
+        validity: why,
         bearings: rep
             .bearings
             .iter()
@@ -249,6 +281,15 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             report.steps_per_rev
         );
         println!("  state: {:?} — {}", report.state, report.evidence);
+        if !report.valid {
+            println!("  NOT VALID: {}", report.validity);
+        }
+        if report.prehistory_fallbacks > 0 {
+            println!(
+                "  prehistory: {} substeps fell back to Newton",
+                report.prehistory_fallbacks
+            );
+        }
         println!(
             "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}; growth {:+.4}/rev",
             report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff, report.growth_per_rev

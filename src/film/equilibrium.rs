@@ -26,7 +26,8 @@ pub struct Equilibrium {
     /// The film solution at equilibrium.
     #[serde(skip)]
     pub film: FilmResult,
-    /// The eight coefficients at equilibrium.
+    /// The eight coefficients at equilibrium, for a linearised analysis
+    /// ([`FilmModel::linearised_coefficients`]).
     pub coefficients: FilmCoefficients,
     /// Newton iterations used.
     pub iterations: usize,
@@ -103,6 +104,7 @@ pub fn equilibrium_under_load(
     for it in 0..MAX_ITERATIONS {
         if norm(r) <= 1e-9 * w {
             let eps = kin.eccentricity_ratio(c);
+            let coef = model.linearised_coefficients(&kin)?;
             let mut phi = turn * (q[1].atan2(q[0]) - load_angle);
             phi = (phi + PI).rem_euclid(2.0 * PI) - PI;
             return Ok(Equilibrium {
@@ -190,6 +192,7 @@ pub fn equilibrium_at_eccentricity(
         imbalance_n = fy.abs();
         if fy.abs() <= 1e-10 * w.abs().max(f64::MIN_POSITIVE) {
             positive("load carried at this eccentricity (N)", w)?;
+            let coef = model.linearised_coefficients(&kin)?;
             return Ok(Equilibrium {
                 position_m: q,
                 eccentricity_ratio,

@@ -36,6 +36,10 @@ use std::f64::consts::TAU;
 /// Marks a node that is not in the current linear system.
 const NOT_FREE: u32 = u32::MAX;
 
+/// Grid phases over which [`FilmModel::linearised_coefficients`] averages the perturbation
+/// coefficients of a plain bearing (see there).
+pub const LINEARISATION_GRID_PHASES: usize = 8;
+
 /// Most active-set passes allowed before the solve is declared failed.
 const MAX_ACTIVE_SET_PASSES: usize = 200;
 
@@ -567,6 +571,65 @@ impl FilmModel for FiniteFilm {
             kin.velocity_m_s[1] / c,
         ]);
         Ok((result, coefficients))
+    }
+
+    /// The perturbation coefficients averaged over [`LINEARISATION_GRID_PHASES`] positions of
+    /// the grid relative to the journal (plain bearings; a grooved one fixes the grid's phase).
+    ///
+    /// Why: the discrete pressure zone ends at a grid node, so the discrete film force is a
+    /// piecewise-smooth function of the journal state with a kink each time the rupture boundary
+    /// ζ2 or the zone start crosses a node. The perturbation solution on the converged zone is the
+    /// slope of the current piece, which differs from the continuous film's derivative by an
+    /// O(Δθ) error that changes sign as the boundary moves through a cell (on the seed bearing at
+    /// ε 0.555 on 60 × 10: ±2.7 % of the stiffness scale in K_rt, ±5.9 % in the squeeze damping
+    /// B_rr). Averaged over the phase of the grid the slope is that of the averaged force, which
+    /// is smooth. The phase is moved by turning the journal state (position and velocity) by
+    /// α_k = kΔθ/m against the grid and the coefficients back by −α_k (a plain bearing is
+    /// invariant under rotation).
+    fn linearised_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<FilmCoefficients, FilmError> {
+        if !self.geometry.grooves.is_empty() {
+            return self.solve_with_coefficients(kin).map(|(_, c)| c);
+        }
+        let m = LINEARISATION_GRID_PHASES;
+        let mut sum = FilmCoefficients::default();
+        // the unrotated state last, so that the warm start is that of a solve at `kin`
+        for k in (0..m).rev() {
+            let alpha = k as f64 * self.dtheta / m as f64;
+            let (c, s) = (alpha.cos(), alpha.sin());
+            let turn = |v: [f64; 2]| [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+            let turned = JournalKinematics {
+                position_m: turn(kin.position_m),
+                velocity_m_s: turn(kin.velocity_m_s),
+                speed_rad_s: kin.speed_rad_s,
+            };
+            let (_, coef) = self.solve_with_coefficients(&turned)?;
+            // k = Rᵀ k' R with R the rotation by α
+            let back = |a: [[f64; 2]; 2]| {
+                let r = [[c, -s], [s, c]];
+                let mut out = [[0.0; 2]; 2];
+                for (i, row) in out.iter_mut().enumerate() {
+                    for (j, v) in row.iter_mut().enumerate() {
+                        for p in 0..2 {
+                            for q in 0..2 {
+                                *v += r[p][i] * a[p][q] * r[q][j];
+                            }
+                        }
+                    }
+                }
+                out
+            };
+            let (kb, db) = (back(coef.stiffness_n_per_m), back(coef.damping_n_s_per_m));
+            for i in 0..2 {
+                for j in 0..2 {
+                    sum.stiffness_n_per_m[i][j] += kb[i][j] / m as f64;
+                    sum.damping_n_s_per_m[i][j] += db[i][j] / m as f64;
+                }
+            }
+        }
+        Ok(sum)
     }
 
     fn midplane_pressure(&self, out: &mut [f64]) {

@@ -133,6 +133,18 @@ pub trait FilmModel {
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError>;
 
+    /// The eight coefficients for a constant-coefficient (linearised) analysis about `kin`: the
+    /// seed's "classical" description, the stability threshold. By default those of
+    /// [`FilmModel::solve_with_coefficients`]; a grid-based model may return a better estimate of
+    /// the continuous film's derivatives (see [`FiniteFilm`]). Leaves the model as a solve at
+    /// `kin` would.
+    fn linearised_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<FilmCoefficients, FilmError> {
+        self.solve_with_coefficients(kin).map(|(_, c)| c)
+    }
+
     /// The mid-plane pressure of the last solve at `out.len()` equally spaced angles
     /// θ_k = 2πk/len from `+x` (Pa). Allocates nothing.
     fn midplane_pressure(&self, out: &mut [f64]);

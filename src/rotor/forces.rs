@@ -24,8 +24,8 @@ impl Rotor {
     }
 
     /// Adds the unbalance forces (N) to `out` (length n_dof) for rotor angle `angle_rad` (rad),
-    /// speed `speed_rad_s` (rad/s) and angular acceleration `accel_rad_s2` (rad/s²):
-    /// F = m e [ψ̇² (cos(ψ+φ), sin(ψ+φ)) + ψ̈ (−sin(ψ+φ), cos(ψ+φ))]. Allocates nothing.
+    /// speed `speed_rad_s` (rad/s) and angular acceleration `accel_rad_s2` (rad/s²)
+    /// ([`unbalance_force`]). Allocates nothing.
     pub fn add_unbalance_force(
         &self,
         angle_rad: f64,
@@ -34,11 +34,35 @@ impl Rotor {
         out: &mut [f64],
     ) {
         for u in &self.unbalance {
-            let (s, c) = (angle_rad + u.phase_rad).sin_cos();
-            let centrifugal = u.magnitude_kg_m * speed_rad_s * speed_rad_s;
-            let tangential = u.magnitude_kg_m * accel_rad_s2;
-            out[4 * u.node] += centrifugal * c - tangential * s;
-            out[4 * u.node + 1] += centrifugal * s + tangential * c;
+            let [fx, fy] = unbalance_force(
+                u.magnitude_kg_m,
+                angle_rad + u.phase_rad,
+                speed_rad_s,
+                accel_rad_s2,
+            );
+            out[4 * u.node] += fx;
+            out[4 * u.node + 1] += fy;
         }
     }
+}
+
+/// The force `[F_x, F_y]` (N) of an unbalance m·e = `magnitude_kg_m` (kg·m) at angle
+/// `angle_rad` (rad, rotor angle plus the heavy spot's phase) on the shaft, turning at
+/// ψ̇ = `speed_rad_s` (rad/s) with ψ̈ = `accel_rad_s2` (rad/s²): the d'Alembert force −m r̈ of
+/// the mass point r = e (cos ψ, sin ψ), i.e.
+/// F = m e [ψ̇² (cos ψ, sin ψ) + ψ̈ (sin ψ, −cos ψ)]: under acceleration the mass lags and pulls
+/// the shaft backwards, against the rotation.
+pub fn unbalance_force(
+    magnitude_kg_m: f64,
+    angle_rad: f64,
+    speed_rad_s: f64,
+    accel_rad_s2: f64,
+) -> [f64; 2] {
+    let (s, c) = angle_rad.sin_cos();
+    let centrifugal = magnitude_kg_m * speed_rad_s * speed_rad_s;
+    let tangential = magnitude_kg_m * accel_rad_s2;
+    [
+        centrifugal * c + tangential * s,
+        centrifugal * s - tangential * c,
+    ]
 }

@@ -14,6 +14,7 @@ mod statics;
 
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
+pub use forces::unbalance_force;
 pub use machine::{
     AlarmLevelsSpec, BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec,
     MachineDescription, MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec,

@@ -5,6 +5,7 @@ use crate::dynamics::bearing_link::LinearReference;
 use crate::dynamics::linear::solve_small;
 use crate::dynamics::{Coupling, StepInput, StepOutput, TwinError};
 use crate::film::{equilibrium_under_load, FilmCoefficients};
+use crate::rotor::unbalance_force;
 
 impl Twin {
     /// Advances one time step of `config.time_step_s` to the input speed. On failure the state is
@@ -329,15 +330,13 @@ impl Twin {
 
     fn add_unbalance(&mut self, angle: f64, speed: f64, accel: f64) {
         for u in &self.unbalance {
-            let (s, c) = (angle + u.phase_rad).sin_cos();
-            let centrifugal = u.magnitude_kg_m * speed * speed;
-            let tangential = u.magnitude_kg_m * accel;
+            let [fx, fy] = unbalance_force(u.magnitude_kg_m, angle + u.phase_rad, speed, accel);
             let (rx, ry) = (self.reduced_of[4 * u.node], self.reduced_of[4 * u.node + 1]);
             if rx != HELD {
-                self.rhs[rx] += centrifugal * c - tangential * s;
+                self.rhs[rx] += fx;
             }
             if ry != HELD {
-                self.rhs[ry] += centrifugal * s + tangential * c;
+                self.rhs[ry] += fy;
             }
         }
     }

@@ -389,9 +389,19 @@ fn catmull_rom(t: f64) -> [f64; 4] {
     ]
 }
 
-/// One row of the table (fixed ε): two direct solves at each ψ, with the journal on the grid's x
-/// axis. Solve 1 has ω = 0 and the whole source from the journal's velocity (pressure parts);
-/// solve 2 adds ω = 1 rad/s with the whirl that keeps U (the Couette parts, by difference).
+/// Grid phases over which each table node is averaged: the line of centres at α_k = kΔθ/m
+/// against the grid. One solve's force is piecewise smooth in the state (a kink each time a
+/// pressure-zone boundary crosses a grid node), so an interpolant of single-phase solves carries
+/// that O(Δθ) jitter into its derivatives, the coefficients (up to 12 % of their scale in the
+/// whip domain on 60 × 10, `tests/film_table.rs`); the phase average is smooth, as in
+/// [`crate::film::FilmModel::linearised_coefficients`].
+const TABLE_GRID_PHASES: usize = 8;
+
+/// One row of the table (fixed ε): at each ψ, a direct solve at each grid phase with ω = 0 and
+/// the whole source from the journal's velocity (pressure parts), and one more at phase 0 with
+/// ω = 1 rad/s and the whirl that keeps U (the Couette parts, by difference). Angles and the
+/// force are turned back to the line of centres; the mid-plane profile is that of phase 0 (on
+/// the grid's angles).
 fn row(
     film: &mut FiniteFilm,
     geometry: &BearingGeometry,
@@ -401,38 +411,54 @@ fn row(
     let c = geometry.radial_clearance_m;
     let mut nodes = Vec::with_capacity(N_PSI);
     let mut profiles = vec![0.0; N_PSI * n_theta];
+    let m = TABLE_GRID_PHASES;
     for j in 0..N_PSI {
         let psi = TAU * j as f64 / N_PSI as f64;
         let (u, w) = (psi.cos(), psi.sin());
-        // U = ω ε − 2 v_t / c, W = 2 v_r / c, journal at (ε c, 0): v_r = ẋ, v_t = ẏ
-        let kin = |omega: f64| JournalKinematics {
-            position_m: [eps * c, 0.0],
-            velocity_m_s: [0.5 * w * c, 0.5 * (omega * eps - u) * c],
-            speed_rad_s: omega,
-        };
-        let pressure = film.solve(&kin(0.0))?;
-        film.midplane_pressure(&mut profiles[j * n_theta..(j + 1) * n_theta]);
-        let with_shear = film.solve(&kin(1.0))?;
-        let unit = |a: f64| [a.cos(), a.sin()];
-        let zone = pressure.max_pressure_pa > 0.0;
-        nodes.push(Node {
-            force: pressure.force_n,
-            p_max: pressure.max_pressure_pa,
-            angles: if zone {
-                [
+        let mut node = Node::default();
+        for k in 0..m {
+            let alpha = k as f64 * TAU / n_theta as f64 / m as f64;
+            let (ca, sa) = (alpha.cos(), alpha.sin());
+            let turn = |v: [f64; 2]| [ca * v[0] - sa * v[1], sa * v[0] + ca * v[1]];
+            let back = |v: [f64; 2]| [ca * v[0] + sa * v[1], -sa * v[0] + ca * v[1]];
+            // U = ω ε − 2 v_t / c, W = 2 v_r / c, journal at (ε c, 0) turned by α
+            let kin = |omega: f64| JournalKinematics {
+                position_m: turn([eps * c, 0.0]),
+                velocity_m_s: turn([0.5 * w * c, 0.5 * (omega * eps - u) * c]),
+                speed_rad_s: omega,
+            };
+            let pressure = film.solve(&kin(0.0))?;
+            if k == 0 {
+                film.midplane_pressure(&mut profiles[j * n_theta..(j + 1) * n_theta]);
+            }
+            let unit = |a: f64| [(a - alpha).cos(), (a - alpha).sin()];
+            let share = 1.0 / m as f64;
+            let f = back(pressure.force_n);
+            node.force[0] += share * f[0];
+            node.force[1] += share * f[1];
+            node.p_max += share * pressure.max_pressure_pa;
+            if pressure.max_pressure_pa > 0.0 {
+                let a = [
                     unit(pressure.max_pressure_angle_rad),
                     unit(pressure.film_start_rad),
                     unit(pressure.film_end_rad),
-                ]
-            } else {
-                [[0.0; 2]; 3]
-            },
-            torque_pressure: pressure.friction_torque_n_m,
-            torque_couette: with_shear.friction_torque_n_m - pressure.friction_torque_n_m,
-            side_flow: pressure.side_flow_m3_s,
-            inflow_pressure: pressure.inflow_m3_s,
-            inflow_couette: with_shear.inflow_m3_s - pressure.inflow_m3_s,
-        });
+                ];
+                for (n, v) in node.angles.iter_mut().zip(a) {
+                    n[0] += share * v[0];
+                    n[1] += share * v[1];
+                }
+            }
+            node.torque_pressure += share * pressure.friction_torque_n_m;
+            node.side_flow += share * pressure.side_flow_m3_s;
+            node.inflow_pressure += share * pressure.inflow_m3_s;
+            if k == 0 {
+                // the Couette parts (friction, inflow) enter no coefficient: phase 0 suffices
+                let with_shear = film.solve(&kin(1.0))?;
+                node.torque_couette = with_shear.friction_torque_n_m - pressure.friction_torque_n_m;
+                node.inflow_couette = with_shear.inflow_m3_s - pressure.inflow_m3_s;
+            }
+        }
+        nodes.push(node);
     }
     Ok((nodes, profiles))
 }
