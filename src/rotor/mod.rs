@@ -10,6 +10,7 @@ mod error;
 mod forces;
 mod machine;
 mod modal;
+pub mod mode_tracking;
 mod statics;
 
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
@@ -20,8 +21,10 @@ pub use machine::{
     DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
-    campbell, critical_speeds_rpm, damped_modes, stability_threshold, undamped_frequencies_hz,
-    BearingCoefficientSet, CampbellPoint, Constraint, Mode, Threshold, WhirlDirection,
+    campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
+    natural_frequencies, stability_threshold, undamped_frequencies_hz, BearingCoefficientSet,
+    CampbellPoint, Constraint, CriticalSpeed, Mode, ModeShape, NaturalFrequencies, Threshold,
+    WhirlDirection,
 };
 pub use statics::{static_solution, StaticSolution};
 
