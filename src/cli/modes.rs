@@ -151,6 +151,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
             &format!("Campbell diagram: {}", report.machine),
             &report.campbell,
             report.threshold_speed_rpm,
+            &report.critical_speeds,
         )
         .with_context(|| format!("writing {}", path.display()))?;
     }

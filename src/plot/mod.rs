@@ -1,6 +1,7 @@
 //! Plots written as SVG files (plotters' SVG backend).
 
 mod campbell;
+mod legend;
 mod replay;
 mod transient;
 
