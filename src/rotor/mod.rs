@@ -12,6 +12,7 @@ mod machine;
 mod modal;
 pub mod mode_tracking;
 mod statics;
+mod unbalance_response;
 
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
@@ -27,6 +28,10 @@ pub use modal::{
     WhirlDirection,
 };
 pub use statics::{static_solution, StaticSolution};
+pub use unbalance_response::{
+    required_separation_margin_pct, response_peaks, response_stations, unbalance_response,
+    ResponsePeak, Station, StationResponse, UnbalanceResponse,
+};
 
 use crate::film::{
     BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FiniteFilm, Lubricant, ShortFilm,

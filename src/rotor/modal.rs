@@ -265,7 +265,7 @@ pub fn damped_mode_shapes(
 
 /// The full stiffness K + K_bearings and damping C + ΩG + C_bearings at spin `speed_rad_s`, and
 /// the DOFs left free (all but the rigid bearings' journals).
-fn assembled_matrices(
+pub(crate) fn assembled_matrices(
     rotor: &Rotor,
     speed_rad_s: f64,
     coefficients: &[FilmCoefficients],
@@ -417,10 +417,10 @@ pub struct CampbellPoint {
 }
 
 /// The film solvers of a rotor's bearings, reused from speed to speed (warm starts).
-struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>);
+pub(crate) struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>);
 
 impl BearingSolvers {
-    fn new(rotor: &Rotor) -> Self {
+    pub(crate) fn new(rotor: &Rotor) -> Self {
         Self(
             rotor
                 .bearings
@@ -435,7 +435,7 @@ impl BearingSolvers {
 
     /// Coefficients and eccentricity ratios of every bearing at its static equilibrium under
     /// `loads` (N) at `speed_rad_s` (rad/s).
-    fn at_speed(
+    pub(crate) fn at_speed(
         &mut self,
         rotor: &Rotor,
         loads: &[[f64; 2]],
