@@ -207,7 +207,30 @@ pub fn required_separation_margin_pct(af: f64, above: bool) -> f64 {
     }
 }
 
-/// The peaks of the semi-major axis `amplitude_m` over `speeds_rpm` (interior local maxima),
+/// Least fall on each side of a peak, relative to it, for it to count: smaller wiggles are the
+/// film coefficients' solver tolerance, not resonances.
+const PEAK_PROMINENCE: f64 = 0.05;
+
+/// Whether the local maximum at `k` falls by [`PEAK_PROMINENCE`] on both sides before the curve
+/// rises above it again.
+fn prominent(a: &[f64], k: usize) -> bool {
+    let floor = (1.0 - PEAK_PROMINENCE) * a[k];
+    let falls = |it: &mut dyn Iterator<Item = &f64>| {
+        for &v in it {
+            if v > a[k] {
+                return false;
+            }
+            if v <= floor {
+                return true;
+            }
+        }
+        false
+    };
+    falls(&mut a[..k].iter().rev()) && falls(&mut a[k + 1..].iter())
+}
+
+/// The peaks of the semi-major axis `amplitude_m` over `speeds_rpm` (interior local maxima that
+/// stand 5 % above the curve on both sides),
 /// with amplification factors and separation margins from the operating range
 /// [`min_operating_rpm`, `max_continuous_rpm`].
 pub fn response_peaks(
@@ -219,7 +242,7 @@ pub fn response_peaks(
     let mut out = Vec::new();
     for k in 1..amplitude_m.len().saturating_sub(1) {
         let (a0, a1, a2) = (amplitude_m[k - 1], amplitude_m[k], amplitude_m[k + 1]);
-        if !(a1 > a0 && a1 >= a2) {
+        if !(a1 > a0 && a1 >= a2 && prominent(amplitude_m, k)) {
             continue;
         }
         // vertex of the parabola through the three points
