@@ -35,6 +35,7 @@ mod bench;
 mod modes;
 mod node;
 mod replay;
+mod response;
 mod simulate;
 mod synth;
 
@@ -52,6 +53,8 @@ enum Command {
     Bearing(bearing::BearingArgs),
     /// Linear rotordynamics: natural frequencies, Campbell diagram, stability threshold.
     Modes(modes::ModesArgs),
+    /// Unbalance response of the linear model (API 684): Bode/polar, peaks, AF, separation margins.
+    Response(response::ResponseArgs),
     /// Nonlinear transient at constant speed: orbits, spectrum, instability classification.
     Simulate(simulate::SimulateArgs),
     /// Amplitude–speed characteristic: a transient at each speed, in parallel.
@@ -84,6 +87,7 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Bearing(args)) => bearing::run(&args),
         Some(Command::Modes(args)) => modes::run(&args),
+        Some(Command::Response(args)) => response::run(&args),
         Some(Command::Simulate(args)) => simulate::run_simulate(&args),
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
         Some(Command::Node(args)) => node::run(args),

@@ -1,8 +1,8 @@
 //! `rotor-twin modes`: natural frequencies, static loads, Campbell diagram, stability threshold.
 
 use crate::rotor::{
-    campbell, critical_speeds_rpm, stability_threshold, static_solution, undamped_frequencies_hz,
-    CampbellPoint, Constraint, MachineDescription, Rotor,
+    campbell, critical_speeds, natural_frequencies, stability_threshold, static_solution,
+    CampbellPoint, Constraint, CriticalSpeed, MachineDescription, Rotor,
 };
 use crate::units::rad_s_to_rpm;
 use anyhow::Context;
@@ -37,6 +37,13 @@ pub struct ModesArgs {
     plot: Option<PathBuf>,
 }
 
+/// Frequencies set apart as modes of a massless shaft's own mass (Hz).
+#[derive(Debug, Serialize)]
+struct MasslessShaftModes {
+    free_free: Vec<f64>,
+    pinned: Vec<f64>,
+}
+
 /// The `--json` report.
 #[derive(Debug, Serialize)]
 struct ModesReport {
@@ -51,7 +58,12 @@ struct ModesReport {
     static_max_deflection_m: f64,
     free_free_hz: Vec<f64>,
     pinned_hz: Vec<f64>,
+    /// Modes of a massless-shaft idealisation's own negligible mass (Hz), free–free and pinned:
+    /// not modes of the modelled machine, left out of the lists above and of the Campbell diagram.
+    massless_shaft_modes_hz: MasslessShaftModes,
     critical_speeds_rpm: Vec<f64>,
+    /// Each forward critical speed with the track id of its mode and its log decrement there.
+    critical_speeds: Vec<CriticalSpeed>,
     threshold_speed_rpm: Option<f64>,
     whirl_ratio_at_threshold: Option<f64>,
     threshold_frequency_hz: Option<f64>,
@@ -93,8 +105,8 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     );
 
     let statics = static_solution(&rotor).context("static deflection")?;
-    let free_free_hz = undamped_frequencies_hz(&rotor, Constraint::FreeFree)?;
-    let pinned_hz = undamped_frequencies_hz(&rotor, Constraint::Pinned)?;
+    let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
+    let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
     let n_speeds = ((to - from) / step).round() as usize;
     let speeds: Vec<f64> = (0..=n_speeds)
         .map(|k| (from + k as f64 * step).min(to))
@@ -102,6 +114,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
     let threshold =
         stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
+    let criticals = critical_speeds(&points);
     let report = ModesReport {
         machine: desc.name.clone(),
         rotor_mass_kg: rotor.rotor_mass_kg(),
@@ -111,9 +124,22 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         bearing_names: rotor.bearings.iter().map(|b| b.name.clone()).collect(),
         bearing_loads_n: statics.bearing_loads_n.clone(),
         static_max_deflection_m: statics.max_deflection_m,
-        free_free_hz: free_free_hz.into_iter().take(args.modes).collect(),
-        pinned_hz: pinned_hz.into_iter().take(args.modes).collect(),
-        critical_speeds_rpm: critical_speeds_rpm(&points),
+        free_free_hz: free_free.hz.into_iter().take(args.modes).collect(),
+        pinned_hz: pinned.hz.into_iter().take(args.modes).collect(),
+        massless_shaft_modes_hz: MasslessShaftModes {
+            free_free: free_free
+                .massless_shaft_hz
+                .into_iter()
+                .take(args.modes)
+                .collect(),
+            pinned: pinned
+                .massless_shaft_hz
+                .into_iter()
+                .take(args.modes)
+                .collect(),
+        },
+        critical_speeds_rpm: criticals.iter().map(|c| c.speed_rpm).collect(),
+        critical_speeds: criticals,
         threshold_speed_rpm: threshold.map(|t| t.speed_rpm),
         whirl_ratio_at_threshold: threshold.map(|t| t.whirl_ratio),
         threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
@@ -125,6 +151,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
             &format!("Campbell diagram: {}", report.machine),
             &report.campbell,
             report.threshold_speed_rpm,
+            &report.critical_speeds,
         )
         .with_context(|| format!("writing {}", path.display()))?;
     }
@@ -156,37 +183,73 @@ fn print_tables(r: &ModesReport) {
             .collect::<Vec<_>>()
             .join(", ")
     };
+    let or_none = |v: &[f64]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            list(v)
+        }
+    };
     println!(
         "  natural frequencies at rest, free–free (Hz): {}",
-        list(&r.free_free_hz)
+        or_none(&r.free_free_hz)
     );
     println!(
         "  natural frequencies at rest, pinned at the bearings (Hz): {}",
-        list(&r.pinned_hz)
+        or_none(&r.pinned_hz)
     );
+    let shaft_own = &r.massless_shaft_modes_hz;
+    if let Some(lowest) = shaft_own
+        .free_free
+        .iter()
+        .chain(&shaft_own.pinned)
+        .copied()
+        .reduce(f64::min)
+    {
+        println!(
+            "  (the shaft is idealised massless, below 0.1 % of the rotor's mass: the modes of its own \
+             mass, {:.0} kHz and up, are not modes of the machine and are left out)",
+            lowest / 1e3
+        );
+    }
     println!("  Campbell diagram (film bearings linearised at their static equilibrium):");
     println!(
-        "    {:>8}  modes: frequency Hz / log dec / F(orward) B(ackward)",
+        "    {:>8}  modes: frequency Hz / log dec / F(orward) B(ackward) and mode id (followed by shape)",
         "rpm"
     );
     for p in &r.campbell {
         let modes: Vec<String> = p
             .modes
             .iter()
-            .map(|m| {
+            .zip(&p.tracks)
+            .map(|(m, id)| {
                 let d = if m.direction == crate::rotor::WhirlDirection::Forward {
                     'F'
                 } else {
                     'B'
                 };
-                format!("{:7.1}/{:6.3}/{d}", m.frequency_hz, m.log_dec)
+                format!("{:7.1}/{:6.3}/{d}{id:<2}", m.frequency_hz, m.log_dec)
             })
             .collect();
         println!("    {:>8.0}  {}", p.speed_rpm, modes.join("  "));
     }
+    let criticals: Vec<String> = r
+        .critical_speeds
+        .iter()
+        .map(|c| {
+            format!(
+                "{:.1} (mode {}, log dec {:.3})",
+                c.speed_rpm, c.track, c.log_dec
+            )
+        })
+        .collect();
     println!(
         "  forward critical speeds (rpm): {}",
-        list(&r.critical_speeds_rpm)
+        if criticals.is_empty() {
+            "none in the range".to_string()
+        } else {
+            criticals.join(", ")
+        }
     );
     match (r.threshold_speed_rpm, r.whirl_ratio_at_threshold) {
         (Some(t), Some(w)) => {

@@ -1,18 +1,51 @@
 //! The Campbell diagram.
 
-use crate::rotor::{CampbellPoint, WhirlDirection};
+use super::legend::{draw_side_legend, Entry, Swatch};
+use crate::rotor::{CampbellPoint, CriticalSpeed, Mode, WhirlDirection};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
-/// Writes a Campbell diagram to `path`: damped natural frequencies against speed, forward modes
-/// in blue, backward in green, unstable points (negative log decrement) in red, the running
-/// frequency 1X and 0.5X as lines, the stability threshold (rpm) as a vertical line; a lower panel
-/// shows the logarithmic decrements.
+const FORWARD: RGBColor = RGBColor(31, 90, 200);
+const BACKWARD: RGBColor = RGBColor(20, 150, 60);
+const UNSTABLE: RGBColor = RGBColor(220, 30, 30);
+
+/// Log decrement below which a point is drawn unstable: below the round-off of an undamped
+/// model's zero (the threshold search uses the same, `rotor::stability_threshold`).
+const UNSTABLE_LOG_DEC: f64 = -1e-6;
+
+fn colour(m: &Mode) -> RGBColor {
+    if m.log_dec < UNSTABLE_LOG_DEC {
+        UNSTABLE
+    } else if m.direction == WhirlDirection::Forward {
+        FORWARD
+    } else {
+        BACKWARD
+    }
+}
+
+/// The points of one mode track: (speed rpm, mode) where the track is present.
+fn track(points: &[CampbellPoint], id: usize) -> Vec<(f64, Mode)> {
+    points
+        .iter()
+        .filter_map(|p| {
+            let j = p.tracks.iter().position(|&t| t == id)?;
+            Some((p.speed_rpm, p.modes[j]))
+        })
+        .collect()
+}
+
+/// Writes a Campbell diagram to `path`: damped natural frequencies against speed, each mode a line
+/// (followed by shape) with its points, forward whirl in blue, backward in green, unstable points
+/// (negative log decrement) in red; the running frequency 1X and 0.5X as labelled lines; the
+/// forward critical speeds as diamonds on 1X; the stability threshold (rpm) as a vertical line.
+/// The lower panel shows the logarithmic decrements, unclipped. The legend has its own panel.
 pub fn campbell_svg(
     path: &Path,
     title: &str,
     points: &[CampbellPoint],
     threshold_rpm: Option<f64>,
+    critical_speeds: &[CriticalSpeed],
 ) -> anyhow::Result<()> {
     let (x0, x1) = (
         points.first().map_or(0.0, |p| p.speed_rpm),
@@ -27,12 +60,21 @@ pub fn campbell_svg(
         .iter()
         .flat_map(|p| p.modes.iter().map(|m| m.log_dec))
         .fold((0.0_f64, 0.1_f64), |(a, b), d| (a.min(d), b.max(d)));
-    let d_max = d_max.min(5.0);
-    let root = SVGBackend::new(path, (900, 900)).into_drawing_area();
+    let ids: Vec<usize> = {
+        let mut v: Vec<usize> = points
+            .iter()
+            .flat_map(|p| p.tracks.iter().copied())
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let root = SVGBackend::new(path, (1100, 900)).into_drawing_area();
     root.fill(&WHITE)?;
-    let (upper, lower) = root.split_vertically(600);
+    let root = root.titled(title, ("sans-serif", 22))?;
+    let (plots, legend_area) = root.split_horizontally(860);
+    let (upper, lower) = plots.split_vertically(560);
     let mut chart = ChartBuilder::on(&upper)
-        .caption(title, ("sans-serif", 22))
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
@@ -40,67 +82,114 @@ pub fn campbell_svg(
     chart
         .configure_mesh()
         .x_desc("speed (rpm)")
-        .y_desc("frequency (Hz)")
+        .y_desc("damped natural frequency (Hz)")
         .draw()?;
-    for (ratio, label) in [(1.0, "1X"), (0.5, "0.5X")] {
-        chart
-            .draw_series(LineSeries::new(
-                [(x0, x0 * ratio / 60.0), (x1, x1 * ratio / 60.0)],
-                BLACK.mix(if ratio == 1.0 { 0.8 } else { 0.4 }),
-            ))?
-            .label(label)
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+    for (ratio, label, shade) in [(1.0, "1X", 0.9), (0.5, "0.5X", 0.45)] {
+        // the line ends where it leaves the frame; its label sits at its end
+        let x_end = x1.min(f_max * 60.0 / ratio);
+        chart.draw_series(LineSeries::new(
+            [(x0, x0 * ratio / 60.0), (x_end, x_end * ratio / 60.0)],
+            BLACK
+                .mix(shade)
+                .stroke_width(if ratio == 1.0 { 2 } else { 1 }),
+        ))?;
+        chart.draw_series(std::iter::once(Text::new(
+            label,
+            (0.97 * x_end, 0.97 * x_end * ratio / 60.0),
+            ("sans-serif", 16)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Right, VPos::Bottom)),
+        )))?;
     }
-    let colour = |dir: WhirlDirection, log_dec: f64| {
-        if log_dec < 0.0 {
-            RED
-        } else if dir == WhirlDirection::Forward {
-            BLUE
-        } else {
-            GREEN
-        }
-    };
-    chart.draw_series(points.iter().flat_map(|p| {
-        p.modes.iter().map(move |m| {
-            Circle::new(
-                (p.speed_rpm, m.frequency_hz),
-                3,
-                colour(m.direction, m.log_dec).filled(),
+    for &id in &ids {
+        let t = track(points, id);
+        chart.draw_series(t.windows(2).map(|w| {
+            PathElement::new(
+                [(w[0].0, w[0].1.frequency_hz), (w[1].0, w[1].1.frequency_hz)],
+                colour(&w[1].1).mix(0.6).stroke_width(1),
             )
-        })
-    }))?;
-    if let Some(t) = threshold_rpm {
-        chart
-            .draw_series(LineSeries::new([(t, 0.0), (t, f_max)], RED))?
-            .label(format!("stability threshold {t:.0} rpm"))
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+        }))?;
+        chart.draw_series(
+            t.iter()
+                .map(|(s, m)| Circle::new((*s, m.frequency_hz), 3, colour(m).filled())),
+        )?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    for c in critical_speeds {
+        let (x, y) = (c.speed_rpm, c.speed_rpm / 60.0);
+        // the label above and left of its marker, clear of the 1X line below it
+        let label = Text::new(
+            format!("{:.0} rpm", c.speed_rpm),
+            (-10, -10),
+            ("sans-serif", 14)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Right, VPos::Bottom)),
+        );
+        chart.draw_series(std::iter::once(
+            EmptyElement::at((x, y)) + diamond(8) + label,
+        ))?;
+    }
+    if let Some(t) = threshold_rpm {
+        chart.draw_series(LineSeries::new(
+            [(t, 0.0), (t, f_max)],
+            UNSTABLE.stroke_width(2),
+        ))?;
+    }
 
+    let span = (d_max - d_min).max(0.1);
     let mut decs = ChartBuilder::on(&lower)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, (d_min * 1.1 - 0.05)..(d_max * 1.05))?;
+        .build_cartesian_2d(x0..x1, (d_min - 0.05 * span)..(d_max + 0.05 * span))?;
     decs.configure_mesh()
         .x_desc("speed (rpm)")
-        .y_desc("log decrement")
+        .y_desc("logarithmic decrement (–)")
         .draw()?;
     decs.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK))?;
-    decs.draw_series(points.iter().flat_map(|p| {
-        p.modes.iter().filter(|m| m.log_dec <= d_max).map(move |m| {
-            Circle::new(
-                (p.speed_rpm, m.log_dec),
-                3,
-                colour(m.direction, m.log_dec).filled(),
+    if let Some(t) = threshold_rpm {
+        decs.draw_series(LineSeries::new(
+            [(t, d_min - 0.05 * span), (t, d_max + 0.05 * span)],
+            UNSTABLE.stroke_width(2),
+        ))?;
+    }
+    for &id in &ids {
+        let t = track(points, id);
+        decs.draw_series(t.windows(2).map(|w| {
+            PathElement::new(
+                [(w[0].0, w[0].1.log_dec), (w[1].0, w[1].1.log_dec)],
+                colour(&w[1].1).mix(0.6).stroke_width(1),
             )
-        })
-    }))?;
+        }))?;
+        decs.draw_series(
+            t.iter()
+                .map(|(s, m)| Circle::new((*s, m.log_dec), 3, colour(m).filled())),
+        )?;
+    }
+    let mut entries = vec![
+        Entry::new(Swatch::Dot(FORWARD), "forward whirl"),
+        Entry::new(Swatch::Dot(BACKWARD), "backward whirl"),
+        Entry::new(Swatch::Dot(UNSTABLE), "unstable (log dec < 0)"),
+        Entry::new(Swatch::Line(BLACK, 2), "1X running speed"),
+        Entry::new(Swatch::Line(RGBColor(140, 140, 140), 1), "0.5X"),
+        Entry::new(Swatch::Diamond(BLACK), "forward critical speed"),
+    ];
+    if let Some(t) = threshold_rpm {
+        entries.push(Entry::new(
+            Swatch::Line(UNSTABLE, 2),
+            format!("threshold {t:.0} rpm"),
+        ));
+    }
+    draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())
+}
+
+/// A hollow diamond marker of half-width `r` px.
+fn diamond(r: i32) -> PathElement<(i32, i32)> {
+    PathElement::new(
+        [(0, -r), (r, 0), (0, r), (-r, 0), (0, -r)],
+        BLACK.stroke_width(2),
+    )
 }

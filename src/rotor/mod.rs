@@ -10,7 +10,9 @@ mod error;
 mod forces;
 mod machine;
 mod modal;
+pub mod mode_tracking;
 mod statics;
+mod unbalance_response;
 
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
@@ -21,10 +23,16 @@ pub use machine::{
     DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
-    campbell, critical_speeds_rpm, damped_modes, stability_threshold, undamped_frequencies_hz,
-    BearingCoefficientSet, CampbellPoint, Constraint, Mode, Threshold, WhirlDirection,
+    campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
+    natural_frequencies, stability_threshold, undamped_frequencies_hz, BearingCoefficientSet,
+    CampbellPoint, Constraint, CriticalSpeed, Mode, ModeShape, NaturalFrequencies, Threshold,
+    WhirlDirection,
 };
 pub use statics::{static_solution, StaticSolution};
+pub use unbalance_response::{
+    required_separation_margin_pct, response_peaks, response_stations, unbalance_response,
+    ResponsePeak, Station, StationResponse, UnbalanceResponse,
+};
 
 use crate::film::{
     BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FiniteFilm, Lubricant, ShortFilm,

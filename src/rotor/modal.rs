@@ -1,7 +1,10 @@
 //! Natural frequencies, damped eigenvalues with the bearings' speed-dependent coefficients
-//! (the seed's "classical" linear description), the Campbell diagram and the linear stability
-//! threshold.
+//! (the seed's "classical" linear description), the Campbell diagram with its modes followed by
+//! shape, the critical speeds and the linear stability threshold.
 
+use super::mode_tracking::{
+    assign_tracks, normalise, rotate_to_whirl_senses, sense, tilt_weight_m2, Shape,
+};
 use super::{BearingModel, Rotor, RotorError, StaticSolution};
 use crate::film::{equilibrium_under_load, FilmCoefficients, FilmModel, JournalKinematics};
 use crate::units::rad_s_to_rpm;
@@ -13,64 +16,150 @@ use std::f64::consts::PI;
 /// Supports for the non-rotating natural frequencies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Constraint {
-    /// No supports at all (4 rigid-body modes are dropped).
+    /// No supports at all (the 2 rigid-body modes of each bending plane are dropped).
     FreeFree,
     /// x and y held at every bearing node.
     Pinned,
 }
 
-/// Natural frequencies of the non-rotating shaft (Hz), each once (the two bending planes give
-/// every frequency twice), rigid-body modes dropped. Solves K φ = ω² M φ on the shaft DOFs by
-/// the Cholesky reduction L⁻¹ K L⁻ᵀ.
-pub fn undamped_frequencies_hz(
+/// A shaft lighter than this fraction of the rotor is a massless-shaft idealisation (a textbook
+/// Jeffcott or Stodola–Green rotor): the modes that its own, negligible mass carries are set apart.
+const MASSLESS_SHAFT_FRACTION: f64 = 1e-3;
+
+/// Natural frequencies of the non-rotating shaft, each once, rigid-body modes dropped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NaturalFrequencies {
+    /// The rotor's natural frequencies (Hz), ascending.
+    pub hz: Vec<f64>,
+    /// Modes of a massless-shaft idealisation's own, negligible mass (Hz): more than half their
+    /// kinetic energy is in a shaft lighter than 0.1 % of the rotor. They come from the density
+    /// that stands for "massless" (hundreds of kHz for the textbook rotor) and are not modes of
+    /// the modelled machine. Empty for a real shaft.
+    pub massless_shaft_hz: Vec<f64>,
+}
+
+/// True if the shaft is a massless idealisation (below 0.1 % of the rotor's mass).
+pub(crate) fn massless_shaft(rotor: &Rotor) -> bool {
+    let shaft: f64 = rotor.elements.iter().map(|e| e.mass_kg()).sum();
+    shaft < MASSLESS_SHAFT_FRACTION * rotor.rotor_mass_kg()
+}
+
+/// Natural frequencies of the non-rotating shaft and discs (Hz). The isotropic shaft's two
+/// bending planes have the same frequencies, so one plane, x–z (x, θy), is solved. K φ = ω² M φ
+/// is solved as the shifted, inverted problem M φ = μ (K + σM) φ, μ = 1/(ω² + σ), by the
+/// Cholesky reduction L⁻¹ M L⁻ᵀ with L Lᵀ = K + σM: the low modes are its largest eigenvalues and
+/// come out to round-off of them even when massless nodes make M nearly singular (the direct
+/// reduction L_M⁻¹ K L_M⁻ᵀ loses 1e-3 of them there); σ = (2π · 0.1 Hz)² keeps K + σM
+/// positive definite with rigid-body modes.
+pub fn natural_frequencies(
     rotor: &Rotor,
     constraint: Constraint,
-) -> Result<Vec<f64>, RotorError> {
-    let n_shaft = 4 * rotor.n_nodes();
+) -> Result<NaturalFrequencies, RotorError> {
     let held: Vec<usize> = match constraint {
         Constraint::FreeFree => Vec::new(),
-        Constraint::Pinned => rotor.bearings.iter().flat_map(|b| b.journal_dofs).collect(),
+        Constraint::Pinned => rotor.bearings.iter().map(|b| b.journal_dofs[0]).collect(),
     };
-    let dofs: Vec<usize> = (0..n_shaft).filter(|d| !held.contains(d)).collect();
+    let dofs: Vec<usize> = (0..rotor.n_nodes())
+        .flat_map(|n| [4 * n, 4 * n + 3])
+        .filter(|d| !held.contains(d))
+        .collect();
     let n = dofs.len();
-    let m = Mat::<f64>::from_fn(n, n, |i, j| rotor.mass[(dofs[i], dofs[j])]);
-    let k = Mat::<f64>::from_fn(n, n, |i, j| rotor.stiffness[(dofs[i], dofs[j])]);
-    let llt = m.llt(Side::Lower).map_err(|_| RotorError::LinearAlgebra {
+    let fail = |why: String| RotorError::LinearAlgebra {
         what: "natural frequencies",
-        why: "the mass matrix is not positive definite (a shaft element of zero density?)".into(),
+        why,
+    };
+    let sigma = (2.0 * PI * 0.1_f64).powi(2);
+    let m = Mat::<f64>::from_fn(n, n, |i, j| rotor.mass[(dofs[i], dofs[j])]);
+    let a = Mat::<f64>::from_fn(n, n, |i, j| {
+        rotor.stiffness[(dofs[i], dofs[j])] + sigma * m[(i, j)]
+    });
+    let llt = a.llt(Side::Lower).map_err(|_| {
+        fail("K + σM is not positive definite (a shaft element of zero density?)".into())
     })?;
     let l = llt.L();
-    // S = L⁻¹ K L⁻ᵀ
-    let mut x = k.clone();
+    // S = L⁻¹ M L⁻ᵀ
+    let mut x = m.clone();
     l.solve_lower_triangular_in_place(&mut x);
     let mut s = x.transpose().to_owned();
     l.solve_lower_triangular_in_place(&mut s);
     let s = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
-    let values =
-        s.self_adjoint_eigenvalues(Side::Lower)
-            .map_err(|e| RotorError::LinearAlgebra {
-                what: "natural frequencies",
-                why: format!("{e:?}"),
-            })?;
-    // rigid-body modes: 2 per bending plane when free, 1 per plane when pinned at one node only
-    let pinned_nodes = {
+    let eig = s
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|e| fail(format!("{e:?}")))?;
+    // φ = L⁻ᵀ u, the mode shape (its kinetic energy in the shaft elements tells a massless
+    // shaft's own modes)
+    let mut phi = eig.U().to_owned();
+    l.transpose().solve_upper_triangular_in_place(&mut phi);
+    let bearing_nodes = {
         let mut nodes: Vec<usize> = rotor.bearings.iter().map(|b| b.node).collect();
         nodes.sort_unstable();
         nodes.dedup();
         nodes.len()
     };
+    // rigid-body modes of one plane: translation and tilt when free, 2 − pinned nodes when pinned
     let rigid = match constraint {
-        Constraint::FreeFree => 4,
-        Constraint::Pinned => 2 * 2usize.saturating_sub(pinned_nodes),
+        Constraint::FreeFree => 2,
+        Constraint::Pinned => 2usize.saturating_sub(bearing_nodes),
     };
-    let mut hz: Vec<f64> = values
-        .into_iter()
-        .skip(rigid)
-        .map(|v| v.max(0.0).sqrt() / (2.0 * PI))
-        .collect();
-    hz.sort_by(f64::total_cmp);
-    hz.dedup_by(|a, b| (*a - *b).abs() <= 1e-6 * b.abs());
-    Ok(hz)
+    let massless = massless_shaft(rotor);
+    let mut out = NaturalFrequencies {
+        hz: Vec::new(),
+        massless_shaft_hz: Vec::new(),
+    };
+    let values = eig.S().column_vector();
+    // ascending μ is descending ω: the rigid-body modes are the last `rigid`
+    for col in (0..n.saturating_sub(rigid)).rev() {
+        let mu = values[col];
+        if mu <= 0.0 {
+            continue;
+        }
+        let hz = (1.0 / mu - sigma).max(0.0).sqrt() / (2.0 * PI);
+        let mut full = vec![faer::c64::new(0.0, 0.0); rotor.n_dof()];
+        for (r, &d) in dofs.iter().enumerate() {
+            full[d] = faer::c64::new(phi[(r, col)], 0.0);
+        }
+        if massless && shaft_energy_fraction(rotor, &full) > 0.5 {
+            out.massless_shaft_hz.push(hz);
+        } else {
+            out.hz.push(hz);
+        }
+    }
+    Ok(out)
+}
+
+/// Natural frequencies of the non-rotating shaft (Hz), each once, rigid-body modes and the
+/// modes of a massless shaft's own mass (see [`NaturalFrequencies`]) left out.
+pub fn undamped_frequencies_hz(
+    rotor: &Rotor,
+    constraint: Constraint,
+) -> Result<Vec<f64>, RotorError> {
+    Ok(natural_frequencies(rotor, constraint)?.hz)
+}
+
+/// Share of a mode's kinetic energy carried by the shaft elements, φᴴ M_shaft φ / φᴴ M φ (the
+/// rest is in the discs and pedestals).
+pub(crate) fn shaft_energy_fraction(rotor: &Rotor, shape: &[faer::c64]) -> f64 {
+    let quad = |m: &dyn Fn(usize, usize) -> f64, dofs: &mut dyn Iterator<Item = usize>| {
+        let d: Vec<usize> = dofs.collect();
+        let mut s = 0.0;
+        for (a, &i) in d.iter().enumerate() {
+            for (b, &j) in d.iter().enumerate() {
+                s += m(a, b) * (shape[i].conj() * shape[j]).re;
+            }
+        }
+        s
+    };
+    let total = quad(&|a, b| rotor.mass[(a, b)], &mut (0..rotor.n_dof()));
+    let mut shaft = 0.0;
+    for (e, el) in rotor.elements.iter().enumerate() {
+        let me = el.mass();
+        shaft += quad(&|a, b| me[a][b], &mut (4 * e..4 * e + 8));
+    }
+    if total > 0.0 {
+        shaft / total
+    } else {
+        0.0
+    }
 }
 
 /// Sense of whirl of a mode relative to the rotation (from +x towards +y).
@@ -96,17 +185,91 @@ pub struct Mode {
     pub direction: WhirlDirection,
 }
 
+/// A damped mode with its shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeShape {
+    /// Frequency, damping and whirl sense.
+    pub mode: Mode,
+    /// Complex amplitude of every global DOF (rigid bearings' journals zero), unit norm in the
+    /// inner product of [`mode_tracking`](super::mode_tracking) (tilts weighted by ℓ²).
+    pub shape: Shape,
+}
+
 /// Coefficients of every bearing at one speed (rigid bearings carry zeros: they are constraints).
 pub type BearingCoefficientSet = Vec<FilmCoefficients>;
 
+/// Two eigenvalues closer than this (relative to |λ|) are one repeated eigenvalue: the solver's
+/// round-off on the stiff massless-shaft models is a few 1e-6 of ω.
+const REPEATED_EIGENVALUE_REL: f64 = 1e-5;
+
 /// Damped modes at spin `speed_rad_s` (rad/s) with bearing coefficients `coefficients` (one per
-/// bearing), sorted by frequency; overdamped (real) eigenvalues are left out. State-space form
-/// ż = A z, A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]], on all DOFs but the rigid bearings' journals.
+/// bearing), sorted by frequency; overdamped (real) eigenvalues and the modes of a massless
+/// shaft's own mass (see [`NaturalFrequencies`]) are left out.
 pub fn damped_modes(
     rotor: &Rotor,
     speed_rad_s: f64,
     coefficients: &[FilmCoefficients],
 ) -> Result<Vec<Mode>, RotorError> {
+    Ok(damped_mode_shapes(rotor, speed_rad_s, coefficients)?
+        .into_iter()
+        .map(|m| m.mode)
+        .collect())
+}
+
+/// [`damped_modes`] with their shapes. A repeated eigenvalue's eigenvectors are rotated into
+/// the modes of extreme whirl sense (circular forward and backward for an isotropic rotor), so
+/// that their labels and shapes are defined.
+pub fn damped_mode_shapes(
+    rotor: &Rotor,
+    speed_rad_s: f64,
+    coefficients: &[FilmCoefficients],
+) -> Result<Vec<ModeShape>, RotorError> {
+    let (values, mut shapes) = state_eigen(rotor, speed_rad_s, coefficients)?;
+    let (n_nodes, ell2) = (rotor.n_nodes(), tilt_weight_m2(rotor));
+    let mut start = 0;
+    while start < values.len() {
+        let mut end = start + 1;
+        while end < values.len()
+            && (values[end] - values[start]).norm()
+                <= REPEATED_EIGENVALUE_REL * values[start].norm()
+        {
+            end += 1;
+        }
+        rotate_to_whirl_senses(&mut shapes[start..end], n_nodes, ell2);
+        start = end;
+    }
+    let massless = massless_shaft(rotor);
+    let mut out = Vec::new();
+    for (lam, mut shape) in values.into_iter().zip(shapes) {
+        if massless && shaft_energy_fraction(rotor, &shape) > 0.5 {
+            continue;
+        }
+        normalise(&mut shape, n_nodes, ell2);
+        let s = sense(&shape, &shape, n_nodes, ell2).re;
+        out.push(ModeShape {
+            mode: Mode {
+                frequency_hz: lam.im / (2.0 * PI),
+                log_dec: -2.0 * PI * lam.re / lam.im,
+                damping_ratio: -lam.re / lam.re.hypot(lam.im),
+                direction: if s <= 0.0 {
+                    WhirlDirection::Forward
+                } else {
+                    WhirlDirection::Backward
+                },
+            },
+            shape,
+        });
+    }
+    Ok(out)
+}
+
+/// The full stiffness K + K_bearings and damping C + ΩG + C_bearings at spin `speed_rad_s`, and
+/// the DOFs left free (all but the rigid bearings' journals).
+pub(crate) fn assembled_matrices(
+    rotor: &Rotor,
+    speed_rad_s: f64,
+    coefficients: &[FilmCoefficients],
+) -> (Mat<f64>, Mat<f64>, Vec<usize>) {
     let n_all = rotor.n_dof();
     let mut k = rotor.stiffness.clone();
     let mut c = Mat::<f64>::from_fn(n_all, n_all, |i, j| {
@@ -119,36 +282,44 @@ pub fn damped_modes(
             continue;
         }
         // the film acts on the relative motion journal − pedestal
-        let pairs: &[(usize, f64)] = if b.pedestal_dofs.is_some() {
-            &[(0, 1.0), (1, -1.0)]
-        } else {
-            &[(0, 1.0)]
+        let sides: Vec<([usize; 2], f64)> = match b.pedestal_dofs {
+            Some(p) => vec![(b.journal_dofs, 1.0), (p, -1.0)],
+            None => vec![(b.journal_dofs, 1.0)],
         };
-        let dofs = |side: usize| {
-            if side == 0 {
-                b.journal_dofs
-            } else {
-                b.pedestal_dofs.unwrap_or(b.journal_dofs)
-            }
-        };
-        for &(si, ssi) in pairs {
-            for &(sj, ssj) in pairs {
+        for &(di, si) in &sides {
+            for &(dj, sj) in &sides {
                 for i in 0..2 {
                     for j in 0..2 {
-                        k[(dofs(si)[i], dofs(sj)[j])] += ssi * ssj * coef.stiffness_n_per_m[i][j];
-                        c[(dofs(si)[i], dofs(sj)[j])] += ssi * ssj * coef.damping_n_s_per_m[i][j];
+                        k[(di[i], dj[j])] += si * sj * coef.stiffness_n_per_m[i][j];
+                        c[(di[i], dj[j])] += si * sj * coef.damping_n_s_per_m[i][j];
                     }
                 }
             }
         }
     }
-    let dofs: Vec<usize> = (0..n_all).filter(|d| !held.contains(d)).collect();
+    let free = (0..n_all).filter(|d| !held.contains(d)).collect();
+    (k, c, free)
+}
+
+/// Eigenvalues λ (Im λ > 0, ascending) of the state-space form ż = A z,
+/// A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]], and the displacement half of each eigenvector on the
+/// global DOFs (held DOFs zero).
+fn state_eigen(
+    rotor: &Rotor,
+    speed_rad_s: f64,
+    coefficients: &[FilmCoefficients],
+) -> Result<(Vec<faer::c64>, Vec<Shape>), RotorError> {
+    let n_all = rotor.n_dof();
+    let (k, c, dofs) = assembled_matrices(rotor, speed_rad_s, coefficients);
     let n = dofs.len();
-    let m = Mat::<f64>::from_fn(n, n, |i, j| rotor.mass[(dofs[i], dofs[j])]);
-    let llt = m.llt(Side::Lower).map_err(|_| RotorError::LinearAlgebra {
+    let fail = |why: String| RotorError::LinearAlgebra {
         what: "damped modes",
-        why: "the mass matrix is not positive definite".into(),
-    })?;
+        why,
+    };
+    let m = Mat::<f64>::from_fn(n, n, |i, j| rotor.mass[(dofs[i], dofs[j])]);
+    let llt = m
+        .llt(Side::Lower)
+        .map_err(|_| fail("the mass matrix is not positive definite".into()))?;
     let mut mk = Mat::<f64>::from_fn(n, n, |i, j| k[(dofs[i], dofs[j])]);
     let mut mc = Mat::<f64>::from_fn(n, n, |i, j| c[(dofs[i], dofs[j])]);
     llt.solve_in_place(&mut mk);
@@ -160,54 +331,23 @@ pub fn damped_modes(
         (false, false) => -mc[(i - n, j - n)],
     });
     let (a, scale) = balance(a);
-    let eig = a.eigen().map_err(|e| RotorError::LinearAlgebra {
-        what: "damped modes",
-        why: format!("{e:?}"),
-    })?;
+    let eig = a.eigen().map_err(|e| fail(format!("{e:?}")))?;
     let values = eig.S().column_vector();
     // eigenvectors of the balanced matrix D⁻¹AD are D⁻¹ times those of A
     let u = eig.U();
-    let vectors = Mat::<faer::c64>::from_fn(u.nrows(), u.ncols(), |i, j| u[(i, j)] * scale[i]);
-    let span = rotor.node_z_m.last().copied().unwrap_or(1.0) - rotor.node_z_m[0];
-    let ell2 = (0.1 * span).powi(2);
-    let mut full_index = vec![usize::MAX; n_all];
-    for (r, &d) in dofs.iter().enumerate() {
-        full_index[d] = r;
-    }
-    let mut modes = Vec::new();
+    let mut modes: Vec<(faer::c64, Shape)> = Vec::new();
     for (col, lam) in values.iter().enumerate() {
         if lam.im <= 1e-6 * lam.re.abs().max(1.0) || !lam.im.is_finite() {
             continue;
         }
-        // whirl sense: Σ Im(conj(X)·Y) over nodes, with the cross-section axis (θy, −θx) weighted
-        // by ℓ² (ℓ = a tenth of the rotor); negative = forward for the e^{+iωt} convention
-        let mut sense = 0.0;
-        let comp = |d: usize| {
-            let r = full_index[d];
-            if r == usize::MAX {
-                faer::c64::new(0.0, 0.0)
-            } else {
-                vectors[(r, col)]
-            }
-        };
-        for node in 0..rotor.n_nodes() {
-            let (x, y) = (comp(4 * node), comp(4 * node + 1));
-            let (tx, ty) = (comp(4 * node + 2), comp(4 * node + 3));
-            sense += (x.conj() * y).im + ell2 * (ty.conj() * (-tx)).im;
+        let mut shape = vec![faer::c64::new(0.0, 0.0); n_all];
+        for (r, &d) in dofs.iter().enumerate() {
+            shape[d] = u[(r, col)] * scale[r];
         }
-        modes.push(Mode {
-            frequency_hz: lam.im / (2.0 * PI),
-            log_dec: -2.0 * PI * lam.re / lam.im,
-            damping_ratio: -lam.re / lam.re.hypot(lam.im),
-            direction: if sense <= 0.0 {
-                WhirlDirection::Forward
-            } else {
-                WhirlDirection::Backward
-            },
-        });
+        modes.push((*lam, shape));
     }
-    modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-    Ok(modes)
+    modes.sort_by(|a, b| a.0.im.total_cmp(&b.0.im));
+    Ok(modes.into_iter().unzip())
 }
 
 /// Balances a square matrix by a diagonal similarity D⁻¹ A D with D a power of two per row
@@ -266,6 +406,9 @@ pub struct CampbellPoint {
     pub speed_rpm: f64,
     /// The lowest modes, by frequency.
     pub modes: Vec<Mode>,
+    /// Track id of each mode: the same id at two speeds is the same mode, followed by its shape
+    /// (MAC ≥ 0.5 with the speed before); ids are numbered as the modes first appear.
+    pub tracks: Vec<usize>,
     /// Eccentricity ratio of each film bearing at its static equilibrium (0 for others).
     pub eccentricity_ratios: Vec<f64>,
     /// The bearing coefficients used.
@@ -274,10 +417,10 @@ pub struct CampbellPoint {
 }
 
 /// The film solvers of a rotor's bearings, reused from speed to speed (warm starts).
-struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>);
+pub(crate) struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>);
 
 impl BearingSolvers {
-    fn new(rotor: &Rotor) -> Self {
+    pub(crate) fn new(rotor: &Rotor) -> Self {
         Self(
             rotor
                 .bearings
@@ -292,7 +435,7 @@ impl BearingSolvers {
 
     /// Coefficients and eccentricity ratios of every bearing at its static equilibrium under
     /// `loads` (N) at `speed_rad_s` (rad/s).
-    fn at_speed(
+    pub(crate) fn at_speed(
         &mut self,
         rotor: &Rotor,
         loads: &[[f64; 2]],
@@ -339,7 +482,9 @@ impl BearingSolvers {
 }
 
 /// The Campbell diagram: the `n_modes` lowest damped modes at each speed of `speeds_rpm`, the
-/// film bearings linearised at their static equilibrium under the loads of `statics`.
+/// film bearings linearised at their static equilibrium under the loads of `statics`; each mode
+/// carries a track id that follows its shape from speed to speed (MAC, see
+/// [`mode_tracking`](super::mode_tracking)).
 pub fn campbell(
     rotor: &Rotor,
     statics: &StaticSolution,
@@ -347,21 +492,29 @@ pub fn campbell(
     n_modes: usize,
 ) -> Result<Vec<CampbellPoint>, RotorError> {
     let mut solvers = BearingSolvers::new(rotor);
-    speeds_rpm
-        .iter()
-        .map(|&rpm| {
-            let omega = crate::units::rpm_to_rad_s(rpm);
-            let (coefs, eps) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;
-            let mut modes = damped_modes(rotor, omega, &coefs)?;
-            modes.truncate(n_modes);
-            Ok(CampbellPoint {
-                speed_rpm: rpm,
-                modes,
-                eccentricity_ratios: eps,
-                coefficients: coefs,
-            })
-        })
-        .collect()
+    let (n_nodes, ell2) = (rotor.n_nodes(), tilt_weight_m2(rotor));
+    // a few modes more than shown are followed, so that a mode entering from above keeps its id
+    let followed = n_modes + 4;
+    let mut previous: Vec<(usize, Shape)> = Vec::new();
+    let mut next_id = 0;
+    let mut out = Vec::with_capacity(speeds_rpm.len());
+    for &rpm in speeds_rpm {
+        let omega = crate::units::rpm_to_rad_s(rpm);
+        let (coefs, eps) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;
+        let mut shapes = damped_mode_shapes(rotor, omega, &coefs)?;
+        shapes.truncate(followed);
+        let current: Vec<Shape> = shapes.iter().map(|m| m.shape.clone()).collect();
+        let tracks = assign_tracks(&previous, &current, n_nodes, ell2, &mut next_id);
+        previous = tracks.iter().copied().zip(current).collect();
+        out.push(CampbellPoint {
+            speed_rpm: rpm,
+            modes: shapes.iter().take(n_modes).map(|m| m.mode).collect(),
+            tracks: tracks.into_iter().take(n_modes).collect(),
+            eccentricity_ratios: eps,
+            coefficients: coefs,
+        });
+    }
+    Ok(out)
 }
 
 /// The linear stability threshold.
@@ -459,28 +612,55 @@ pub fn stability_threshold(
     Ok(None)
 }
 
-/// Forward critical speeds (rpm) read off a Campbell diagram: where the k-th forward mode's
-/// frequency crosses the running frequency, by linear interpolation between grid speeds.
-pub fn critical_speeds_rpm(points: &[CampbellPoint]) -> Vec<f64> {
-    let forward = |p: &CampbellPoint| -> Vec<f64> {
-        p.modes
-            .iter()
-            .filter(|m| m.direction == WhirlDirection::Forward)
-            .map(|m| m.frequency_hz)
-            .collect()
-    };
+/// Forward critical speeds (rpm) read off a Campbell diagram: where a forward mode's frequency
+/// crosses the running frequency, the mode followed by its track (its shape), not by its rank;
+/// linear interpolation between grid speeds. Each is listed once with its track id.
+pub fn critical_speeds(points: &[CampbellPoint]) -> Vec<CriticalSpeed> {
     let mut out = Vec::new();
     for w in points.windows(2) {
-        let (fa, fb) = (forward(&w[0]), forward(&w[1]));
-        for k in 0..fa.len().min(fb.len()) {
-            let ga = fa[k] - w[0].speed_rpm / 60.0;
-            let gb = fb[k] - w[1].speed_rpm / 60.0;
-            if ga > 0.0 && gb <= 0.0 {
+        for (m0, id) in w[0].modes.iter().zip(&w[0].tracks) {
+            let Some(m1) = w[1]
+                .tracks
+                .iter()
+                .position(|t| t == id)
+                .map(|j| w[1].modes[j])
+            else {
+                continue;
+            };
+            if m0.direction != WhirlDirection::Forward || m1.direction != WhirlDirection::Forward {
+                continue;
+            }
+            let ga = m0.frequency_hz - w[0].speed_rpm / 60.0;
+            let gb = m1.frequency_hz - w[1].speed_rpm / 60.0;
+            if (ga > 0.0 && gb <= 0.0) || (ga < 0.0 && gb >= 0.0) {
                 let t = ga / (ga - gb);
-                out.push(w[0].speed_rpm + t * (w[1].speed_rpm - w[0].speed_rpm));
+                out.push(CriticalSpeed {
+                    speed_rpm: w[0].speed_rpm + t * (w[1].speed_rpm - w[0].speed_rpm),
+                    track: *id,
+                    log_dec: m0.log_dec + t * (m1.log_dec - m0.log_dec),
+                });
             }
         }
     }
-    out.sort_by(f64::total_cmp);
+    out.sort_by(|a, b| a.speed_rpm.total_cmp(&b.speed_rpm));
     out
+}
+
+/// Forward critical speeds (rpm), see [`critical_speeds`].
+pub fn critical_speeds_rpm(points: &[CampbellPoint]) -> Vec<f64> {
+    critical_speeds(points)
+        .iter()
+        .map(|c| c.speed_rpm)
+        .collect()
+}
+
+/// A forward critical speed: a forward mode's frequency equals the running frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CriticalSpeed {
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// Track id of the mode (see [`CampbellPoint::tracks`]).
+    pub track: usize,
+    /// The mode's log decrement there (interpolated).
+    pub log_dec: f64,
 }

@@ -1,0 +1,204 @@
+//! `rotor-twin response`: the unbalance response of the linear model (API 684): Bode and polar
+//! plots at the bearings and probe stations, peaks, amplification factors, separation margins.
+
+use crate::rotor::{
+    response_peaks, static_solution, unbalance_response, MachineDescription, ResponsePeak, Rotor,
+    Station, StationResponse,
+};
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Unbalance response of the linear model: 1X amplitude and phase lag against speed.
+#[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
+pub struct ResponseArgs {
+    /// Machine description (YAML); the built-in ORC microturbine if absent.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Lowest speed (rpm); default 10 % of rated.
+    #[arg(long)]
+    from_rpm: Option<f64>,
+    /// Highest speed (rpm); default 150 % of rated.
+    #[arg(long)]
+    to_rpm: Option<f64>,
+    /// Speed step (rpm); default 1/200 of the range.
+    #[arg(long)]
+    step_rpm: Option<f64>,
+    /// Minimum operating speed for the separation margins (rpm); default the rated speed.
+    #[arg(long)]
+    min_operating_rpm: Option<f64>,
+    /// Maximum continuous speed for the separation margins (rpm); default the rated speed.
+    #[arg(long)]
+    max_continuous_rpm: Option<f64>,
+    /// Print one JSON object instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Write the Bode plot to PREFIX_bode.svg and the polar plot to PREFIX_polar.svg.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// One station of the report.
+#[derive(Debug, Serialize)]
+struct StationReport {
+    #[serde(flatten)]
+    station: Station,
+    peaks: Vec<ResponsePeak>,
+    response: Vec<StationResponse>,
+}
+
+/// The `--json` report.
+#[derive(Debug, Serialize)]
+struct ResponseReport {
+    machine: String,
+    /// Unbalances applied: node, m·e (g·mm), heavy-spot angle (deg).
+    unbalance_g_mm: Vec<(usize, f64, f64)>,
+    min_operating_rpm: f64,
+    max_continuous_rpm: f64,
+    speeds_rpm: Vec<f64>,
+    stations: Vec<StationReport>,
+}
+
+fn speed_grid(args: &ResponseArgs, rated: f64) -> anyhow::Result<Vec<f64>> {
+    let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));
+    let to = args.to_rpm.unwrap_or(1.5 * rated);
+    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
+        anyhow::ensure!(
+            v.is_finite() && v > 0.0,
+            "invalid {name} {v}: must be a finite speed above zero"
+        );
+    }
+    anyhow::ensure!(
+        to > from,
+        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
+    );
+    let step = args.step_rpm.unwrap_or((to - from) / 200.0);
+    anyhow::ensure!(
+        step.is_finite() && step > 0.0 && (to - from) / step <= 5000.0,
+        "invalid --step-rpm {step}: must be above zero, at most 5,000 speeds"
+    );
+    let n = ((to - from) / step).round() as usize;
+    Ok((0..=n).map(|k| (from + k as f64 * step).min(to)).collect())
+}
+
+pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
+    let desc = match &args.config {
+        Some(p) => MachineDescription::from_file(p)?,
+        None => MachineDescription::builtin_default(),
+    };
+    let rotor = Rotor::from_description(&desc);
+    let rated = desc.rated_speed_rpm;
+    let speeds = speed_grid(args, rated)?;
+    let n_min = args.min_operating_rpm.unwrap_or(rated);
+    let n_max = args.max_continuous_rpm.unwrap_or(rated);
+    anyhow::ensure!(
+        n_min.is_finite() && n_min > 0.0 && n_max >= n_min,
+        "invalid --min-operating-rpm {n_min} / --max-continuous-rpm {n_max}: need 0 < min ≤ max"
+    );
+    anyhow::ensure!(
+        !rotor.unbalance.is_empty(),
+        "the machine has no unbalance: add one under `unbalance:` in the machine file"
+    );
+    let statics = static_solution(&rotor).context("static deflection")?;
+    let r = unbalance_response(&rotor, &statics, &speeds).context("unbalance response")?;
+    let stations = r
+        .stations
+        .iter()
+        .zip(&r.response)
+        .map(|(st, resp)| {
+            let amp: Vec<f64> = resp.iter().map(|s| s.major_semi_axis_m).collect();
+            StationReport {
+                station: st.clone(),
+                peaks: response_peaks(&speeds, &amp, n_min, n_max),
+                response: resp.clone(),
+            }
+        })
+        .collect();
+    let report = ResponseReport {
+        machine: desc.name.clone(),
+        unbalance_g_mm: desc
+            .unbalance
+            .iter()
+            .map(|u| (u.node, u.magnitude_g_mm, u.phase_deg))
+            .collect(),
+        min_operating_rpm: n_min,
+        max_continuous_rpm: n_max,
+        speeds_rpm: speeds,
+        stations,
+    };
+    if let Some(prefix) = &args.plot {
+        let with = |suffix: &str| {
+            let mut p = prefix.clone().into_os_string();
+            p.push(suffix);
+            PathBuf::from(p)
+        };
+        let curves: Vec<crate::plot::ResponseCurve> = report
+            .stations
+            .iter()
+            .map(|s| crate::plot::ResponseCurve {
+                name: &s.station.name,
+                response: &s.response,
+                peaks: &s.peaks,
+            })
+            .collect();
+        for (path, bode) in [(with("_bode.svg"), true), (with("_polar.svg"), false)] {
+            let title = format!(
+                "Unbalance response ({}): {}",
+                if bode { "Bode" } else { "polar, x" },
+                report.machine
+            );
+            let written = if bode {
+                crate::plot::bode_svg(&path, &title, &report.speeds_rpm, &curves)
+            } else {
+                crate::plot::polar_svg(&path, &title, &report.speeds_rpm, &curves)
+            };
+            written.with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_tables(&report);
+    }
+    Ok(())
+}
+
+fn print_tables(r: &ResponseReport) {
+    println!(
+        "rotor-twin response: {} (linear model, film bearings linearised at each speed)",
+        r.machine
+    );
+    for (node, me, deg) in &r.unbalance_g_mm {
+        println!("  unbalance {me:.1} g·mm at node {node}, {deg:.0}°");
+    }
+    println!(
+        "  operating range {:.0}–{:.0} rpm; peaks of the 1X semi-major axis per station:",
+        r.min_operating_rpm, r.max_continuous_rpm
+    );
+    println!(
+        "    {:<22} {:>9} {:>11} {:>7} {:>10} {:>12}",
+        "station", "peak rpm", "1X µm", "AF", "margin %", "API 684 %"
+    );
+    for s in &r.stations {
+        if s.peaks.is_empty() {
+            println!("    {:<22} no peak in the range", s.station.name);
+        }
+        for p in &s.peaks {
+            let af = p
+                .amplification_factor
+                .map_or("—".to_string(), |a| format!("{a:.2}"));
+            println!(
+                "    {:<22} {:>9.0} {:>11.3} {:>7} {:>10.1} {:>12.1}{}",
+                s.station.name,
+                p.speed_rpm,
+                p.amplitude_m * 1e6,
+                af,
+                p.separation_margin_pct,
+                p.required_margin_pct,
+                if p.meets_api_684 { "" } else { "  NOT MET" }
+            );
+        }
+    }
+}

@@ -1,0 +1,139 @@
+//! `rotor-twin response`: the JSON contract, the Bode and polar SVGs read back (title, axes
+//! with units, legend clear of the data, polar 1:1), and bad input named.
+
+mod common;
+mod svg_check;
+use common::run_cli;
+
+/// Pixels per unit of the x and y axes, from the numeric tick labels (plotters puts the x-axis
+/// labels on one row and the y-axis labels in one column).
+fn px_per_unit(svg: &svg_check::Svg) -> (f64, f64) {
+    let ticks: Vec<(f64, f64, f64)> = svg
+        .texts
+        .iter()
+        .filter_map(|t| Some((t.x, t.y, t.text.parse::<f64>().ok()?)))
+        .collect();
+    let row_y = ticks.iter().map(|t| t.1).fold(f64::MIN, f64::max);
+    let col_x = ticks.iter().map(|t| t.0).fold(f64::MAX, f64::min);
+    let slope = |pts: Vec<(f64, f64)>| {
+        let (a, b) = (pts.first().unwrap(), pts.last().unwrap());
+        ((b.0 - a.0) / (b.1 - a.1)).abs()
+    };
+    let mut xs: Vec<(f64, f64)> = ticks
+        .iter()
+        .filter(|t| t.1 == row_y)
+        .map(|t| (t.0, t.2))
+        .collect();
+    let mut ys: Vec<(f64, f64)> = ticks
+        .iter()
+        .filter(|t| t.0 == col_x)
+        .map(|t| (t.1, t.2))
+        .collect();
+    xs.sort_by(|a, b| a.1.total_cmp(&b.1));
+    ys.sort_by(|a, b| a.1.total_cmp(&b.1));
+    assert!(xs.len() >= 3 && ys.len() >= 3, "ticks {xs:?} {ys:?}");
+    (slope(xs), slope(ys))
+}
+
+/// The built-in microturbine: its first forward mode's peak near 3,800 rpm at each bearing with
+/// an amplification factor and the API 684 margin beside it; both plots complete.
+#[test]
+fn response_json_and_plots_for_the_builtin_machine() {
+    let prefix = std::env::temp_dir().join(format!("rotor-twin-response-{}", std::process::id()));
+    let (ok, out, err) = run_cli(&[
+        "response",
+        "--json",
+        "--from-rpm",
+        "1000",
+        "--to-rpm",
+        "12000",
+        "--step-rpm",
+        "100",
+        "--plot",
+        prefix.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let stations = v["stations"].as_array().unwrap();
+    assert_eq!(stations.len(), 4);
+    for s in stations {
+        let peak = &s["peaks"][0];
+        let nc = peak["speed_rpm"].as_f64().unwrap();
+        assert!((3500.0..4100.0).contains(&nc), "{}: peak {nc}", s["name"]);
+        for key in [
+            "amplification_factor",
+            "separation_margin_pct",
+            "required_margin_pct",
+            "meets_api_684",
+        ] {
+            assert!(peak.get(key).is_some(), "peak lacks {key}");
+        }
+        assert_eq!(s["response"].as_array().unwrap().len(), 111);
+    }
+    let bode = svg_check::read(&prefix.with_file_name(format!(
+        "{}_bode.svg",
+        prefix.file_name().unwrap().to_str().unwrap()
+    )));
+    bode.assert_texts(&[
+        "Unbalance response (Bode): orc_microturbine_100kw",
+        "speed (rpm)",
+        "1X semi-major axis (µm)",
+        "phase lag of x (deg)",
+        "legend",
+        "bearing_pulley_end",
+        "probe_outboard",
+    ]);
+    let legend_x = bode.text("legend").unwrap().x;
+    // the curves are polylines of many points; the legend's swatches have two
+    let data_right = bode
+        .polylines
+        .iter()
+        .filter(|l| l.len() > 2)
+        .flatten()
+        .map(|p| p.0)
+        .fold(f64::MIN, f64::max);
+    assert!(
+        legend_x > data_right,
+        "legend {legend_x} px, data to {data_right} px"
+    );
+    let polar_path = prefix.with_file_name(format!(
+        "{}_polar.svg",
+        prefix.file_name().unwrap().to_str().unwrap()
+    ));
+    let polar = svg_check::read(&polar_path);
+    polar.assert_texts(&[
+        "Re X, in phase with the keyphasor (µm)",
+        "Im X (µm)",
+        "legend",
+    ]);
+    let (px_x, px_y) = px_per_unit(&polar);
+    assert!(
+        (px_x / px_y - 1.0).abs() < 0.01,
+        "polar aspect {px_x} vs {px_y} px/µm"
+    );
+    for suffix in ["_bode.svg", "_polar.svg"] {
+        let mut p = prefix.clone().into_os_string();
+        p.push(suffix);
+        std::fs::remove_file(p).ok();
+    }
+}
+
+#[test]
+fn bad_response_input_is_named() {
+    for (args, word) in [
+        (vec!["response", "--from-rpm", "-5"], "--from-rpm"),
+        (
+            vec!["response", "--from-rpm", "5000", "--to-rpm", "4000"],
+            "--to-rpm",
+        ),
+        (vec!["response", "--step-rpm", "0"], "--step-rpm"),
+        (
+            vec!["response", "--min-operating-rpm", "-1"],
+            "--min-operating-rpm",
+        ),
+    ] {
+        let (ok, _, err) = run_cli(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(word), "{args:?}: '{err}' does not name {word}");
+    }
+}

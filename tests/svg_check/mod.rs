@@ -1,0 +1,104 @@
+//! Reading an SVG written by rotor-twin's plots back (plotters' SVG backend): its texts with their
+//! positions, its data markers and lines, so that a test can check titles, axis labels, legends
+//! and aspect ratios.
+#![allow(dead_code)]
+
+/// A `<text>` element: anchor position (px) and content.
+#[derive(Debug, Clone)]
+pub struct SvgText {
+    pub x: f64,
+    pub y: f64,
+    pub text: String,
+}
+
+/// The parts of a plot's SVG that the checks need.
+#[derive(Debug, Default)]
+pub struct Svg {
+    pub texts: Vec<SvgText>,
+    /// `<circle>` elements: centre x, y and radius (px).
+    pub circles: Vec<(f64, f64, f64)>,
+    /// Points of `<polyline>` elements (px), one list each.
+    pub polylines: Vec<Vec<(f64, f64)>>,
+    /// `<rect>` elements: x, y, width, height (px).
+    pub rects: Vec<[f64; 4]>,
+}
+
+fn attr(tag: &str, name: &str) -> Option<f64> {
+    let key = format!(" {name}=\"");
+    let start = tag.find(&key)? + key.len();
+    let end = tag[start..].find('"')? + start;
+    tag[start..end].parse().ok()
+}
+
+/// Parses the file at `path`.
+pub fn read(path: &std::path::Path) -> Svg {
+    let text = std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    assert!(text.starts_with("<svg"), "{} is not an SVG", path.display());
+    let mut svg = Svg::default();
+    let mut rest = text.as_str();
+    while let Some(i) = rest.find('<') {
+        rest = &rest[i..];
+        let Some(close) = rest.find('>') else { break };
+        let tag = &rest[..=close];
+        if tag.starts_with("<text") {
+            let body_end = rest.find("</text>").unwrap_or(close + 1);
+            let body = rest[close + 1..body_end].trim().to_string();
+            svg.texts.push(SvgText {
+                x: attr(tag, "x").unwrap_or(0.0),
+                y: attr(tag, "y").unwrap_or(0.0),
+                text: body
+                    .replace("&lt;", "<")
+                    .replace("&gt;", ">")
+                    .replace("&amp;", "&"),
+            });
+        } else if tag.starts_with("<circle") {
+            svg.circles.push((
+                attr(tag, "cx").unwrap_or(0.0),
+                attr(tag, "cy").unwrap_or(0.0),
+                attr(tag, "r").unwrap_or(0.0),
+            ));
+        } else if tag.starts_with("<polyline") {
+            let key = " points=\"";
+            if let Some(s) = tag.find(key) {
+                let s = s + key.len();
+                let e = tag[s..].find('"').map_or(tag.len(), |e| e + s);
+                let pts = tag[s..e]
+                    .split_whitespace()
+                    .filter_map(|p| {
+                        let (a, b) = p.split_once(',')?;
+                        Some((a.parse().ok()?, b.parse().ok()?))
+                    })
+                    .collect();
+                svg.polylines.push(pts);
+            }
+        } else if tag.starts_with("<rect") {
+            svg.rects.push([
+                attr(tag, "x").unwrap_or(0.0),
+                attr(tag, "y").unwrap_or(0.0),
+                attr(tag, "width").unwrap_or(0.0),
+                attr(tag, "height").unwrap_or(0.0),
+            ]);
+        }
+        rest = &rest[close + 1..];
+    }
+    svg
+}
+
+impl Svg {
+    /// The text element whose content is exactly `s`, if any.
+    pub fn text(&self, s: &str) -> Option<&SvgText> {
+        self.texts.iter().find(|t| t.text == s)
+    }
+
+    /// Asserts that each of `labels` is a text of the plot.
+    pub fn assert_texts(&self, labels: &[&str]) {
+        for l in labels {
+            assert!(
+                self.text(l).is_some(),
+                "no text '{l}' in the plot; texts: {:?}",
+                self.texts.iter().map(|t| &t.text).collect::<Vec<_>>()
+            );
+        }
+    }
+}
