@@ -147,7 +147,14 @@ impl Scan<'_> {
                 }
                 // a loose record after damage: no CRC vouches for it
                 OP_SCHEMA | OP_CHANNEL | OP_MESSAGE => Ok(()),
-                OP_DATA_END | OP_FOOTER => return,
+                OP_DATA_END => return,
+                // the header belongs at the start, the summary records after DataEnd: one of
+                // them here is a damaged opcode (a chunk whose opcode flipped would otherwise be
+                // skipped as a record the replay does not use)
+                0x01 if at != MAGIC.len() => Err(format!("a header record at byte {at}")),
+                OP_FOOTER | 0x08 | 0x0A | 0x0B | 0x0D | 0x0E => Err(format!(
+                    "a summary record (opcode 0x{opcode:02x}) inside the data section at byte {at}"
+                )),
                 _ => Ok(()),
             };
             match used {
@@ -243,15 +250,34 @@ impl Scan<'_> {
         Ok(())
     }
 
-    /// Chunks the index lists that the walk did not reach.
+    /// Chunks the index lists that the walk did not reach; one that cannot be read is damage
+    /// (unless it lies in a range already reported).
     fn chunks_from_index(&mut self) {
         let missed: Vec<usize> = self.index.difference(&self.done).copied().collect();
         for at in missed {
-            if let Some((OP_CHUNK, _, end)) =
-                frame(self.bytes, at, self.data_end, self.record_limit)
-            {
-                // a chunk that fails here lies in a range already reported
-                let _ = self.take_chunk(at, end);
+            let framed = frame(self.bytes, at, self.data_end, self.record_limit);
+            let (end, result) = match framed {
+                Some((OP_CHUNK, _, end)) => (end, self.take_chunk(at, end)),
+                Some((op, _, end)) => (
+                    end,
+                    Err(format!(
+                        "the summary's chunk index lists a chunk at byte {at}, but the record there has opcode 0x{op:02x}"
+                    )),
+                ),
+                None => (
+                    at + 1,
+                    Err(format!(
+                        "the summary's chunk index lists a chunk at byte {at} that does not frame"
+                    )),
+                ),
+            };
+            let known = self
+                .content
+                .damage
+                .iter()
+                .any(|d| d.start <= at && at < d.end);
+            if let (Err(why), false) = (result, known) {
+                self.note(at, end, why);
             }
         }
     }

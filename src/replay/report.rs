@@ -112,8 +112,10 @@ pub struct ReplayReport {
     pub messages_in: u64,
     /// Messages written to the output bag.
     pub messages_out: u64,
-    /// Damage found in the bag (the replay covers what came before it).
+    /// Damage found in the bag (each damaged range named; every intact message is replayed).
     pub damage: Vec<String>,
+    /// What the bag's metadata got wrong, and receive-time outliers left out of the span.
+    pub notes: Vec<String>,
     /// Inputs refused, per topic.
     pub rejected: Vec<Rejections>,
     /// Predicted against measured, per probe station with measurements.
@@ -134,6 +136,7 @@ impl ReplayReport {
             messages_in: 0,
             messages_out: 0,
             damage: bag.damage.iter().map(|d| d.to_string()).collect(),
+            notes: bag.notes.clone(),
             rejected: Vec::new(),
             stations: Vec::new(),
             onset: OnsetReport::default(),
@@ -272,7 +275,7 @@ impl ReplayReport {
             self.messages_out
         );
         for d in &self.damage {
-            s += &format!("DAMAGED BAG: {d}; replayed what came before\n");
+            s += &format!("DAMAGED BAG: {d}; every intact message replayed\n");
         }
         for r in &self.rejected {
             s += &format!(

@@ -222,7 +222,7 @@ async fn run_async(
         inbox,
         clock,
         rec,
-        counters,
+        counters: counters.clone(),
     };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
@@ -246,11 +246,20 @@ async fn run_async(
         );
     }
 
-    // until SIGINT or SIGTERM
+    // until SIGINT or SIGTERM; a recording that stops before (a full disk) is an ERROR
+    let watch = watch_recording(&counters, &recorder_thread);
     let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
     tokio::select! {
         _ = tokio::signal::ctrl_c() => {},
         _ = term.recv() => {},
+        _ = watch => {
+            // keep the twin running: the bus still gets its outputs
+            let mut term2 = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {},
+                _ = term2.recv() => {},
+            }
+        }
     }
     if ros.log_level <= LogLevel::Info {
         eprintln!("rotor_twin: shutting down");
@@ -259,10 +268,30 @@ async fn run_async(
     let _ = model_thread.join();
     let _ = publish_thread.join();
     drop(node);
-    if let Some(t) = recorder_thread {
-        finish_recording(t, &ros);
+    match recorder_thread {
+        Some(t) => finish_recording(t, &ros),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// Resolves when the recorder thread has ended before the node (its error is reported when the
+/// node stops): the diagnostics turn ERROR and the log says so at once. Never resolves without a
+/// recording.
+async fn watch_recording(
+    counters: &model::NodeCounters,
+    thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
+) {
+    if thread.is_none() {
+        return futures::future::pending().await;
+    }
+    loop {
+        tokio::time::sleep(std::time::Duration::from_millis(200)).await;
+        if thread.as_ref().is_some_and(|t| t.is_finished()) {
+            counters.recording_failed.store(true, Ordering::Relaxed);
+            eprintln!("rotor_twin: ERROR: the recording stopped before the node; nothing more is recorded");
+            return;
+        }
+    }
 }
 
 /// The recorder thread and its queue, when `--record` asks for one.
@@ -291,15 +320,21 @@ fn start_recorder(
 }
 
 /// Waits for the recorder: the subscription tasks hold senders, so it stops after its last
-/// flush once the runtime's tasks are gone.
-fn finish_recording(t: std::thread::JoinHandle<anyhow::Result<PathBuf>>, ros: &RosArgs) {
+/// flush once the runtime's tasks are gone. A failed recording is the node's error (non-zero
+/// exit): data was lost.
+fn finish_recording(
+    t: std::thread::JoinHandle<anyhow::Result<PathBuf>>,
+    ros: &RosArgs,
+) -> anyhow::Result<()> {
     match t.join() {
-        Ok(Ok(dir)) if ros.log_level <= LogLevel::Info => {
-            eprintln!("rotor_twin: recording finished in {}", dir.display())
+        Ok(Ok(dir)) => {
+            if ros.log_level <= LogLevel::Info {
+                eprintln!("rotor_twin: recording finished in {}", dir.display());
+            }
+            Ok(())
         }
-        Ok(Ok(_)) => {}
-        Ok(Err(e)) => eprintln!("rotor_twin: recording failed: {e:#}"),
-        Err(_) => eprintln!("rotor_twin: recorder thread panicked"),
+        Ok(Err(e)) => Err(e.context("the recording failed (what was written stays readable; `rotor-twin bag recover` completes it)")),
+        Err(_) => anyhow::bail!("the recorder thread panicked"),
     }
 }
 

@@ -51,6 +51,8 @@ impl Inbox {
 pub struct NodeCounters {
     /// Messages the recorder could not take (its queue was full): lost from the recording.
     pub recording_dropped: AtomicU64,
+    /// The recording stopped before the node (e.g. a full disk): what follows is not recorded.
+    pub recording_failed: AtomicBool,
 }
 
 impl NodeCounters {
@@ -392,7 +394,12 @@ impl ModelLoop {
             ),
             kv("time_step_us", format!("{:.2}", h * 1e6)),
         ];
-        let (level, message) = if failures > 0 {
+        let (level, message) = if self.counters.recording_failed.load(Ordering::Relaxed) {
+            (
+                DiagnosticStatus::ERROR,
+                "the recording stopped (see the node's log): outputs are no longer recorded".into(),
+            )
+        } else if failures > 0 {
             (
                 DiagnosticStatus::ERROR,
                 format!("{failures} step(s) failed; the twin restarts"),

@@ -282,7 +282,7 @@ impl Rotor {
                 .collect(),
             gravity_m_s2: desc.gravity_m_s2,
             rated_speed_rad_s: rpm_to_rad_s(desc.rated_speed_rpm),
-            alarm_levels: desc.alarm_levels.clone(),
+            alarm_levels: desc.alarm_levels,
             node_z_m,
             elements,
             discs,
