@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 enum Workload {
     /// ORC-9000: the microturbine at 9,000 rpm, 30 elements, 60 × 10 film grids, 128 steps a
     /// revolution, nonlinear coupling: the cost of one twin step.
+    #[value(alias = "orc-9000")]
     Orc9000,
     /// One film solve of the seed's bearing (9,000 rpm, 275 N) on a 60 × 10 half-grid.
     Film,

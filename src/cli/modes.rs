@@ -71,10 +71,7 @@ struct ModesReport {
 }
 
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
-    let desc = match &args.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
+    let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
     let rated = desc.rated_speed_rpm;
     let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));

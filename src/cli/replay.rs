@@ -1,15 +1,15 @@
 //! `rotor-twin replay`: a recorded bag through the twin, predicted against measured orbits.
 
 use crate::bag::Bag;
-use crate::dynamics::Coupling;
+use crate::driver::{ModelKind, SpeedUnit};
 use crate::record::resolved_path;
 use crate::replay::{replay, ReplayOptions};
-use crate::ros::SpeedUnit;
 use crate::rotor::{MachineDescription, Rotor};
 use crate::session::SessionSettings;
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 /// The bag shipped with the project (a synthetic run-up of the built-in microturbine).
 pub const SAMPLE_BAG: &str = "bags/orc_runup_synthetic";
@@ -37,20 +37,20 @@ pub struct ReplayArgs {
     #[arg(long, value_parser = parse_remap)]
     pub remap: Vec<(String, String)>,
     /// Unit of a std_msgs/Float64 speed topic: rpm, rad_s or hz.
-    #[arg(long, default_value = "rpm", value_parser = parse_unit)]
+    #[arg(long, default_value = "rpm", value_parser = SpeedUnit::from_str)]
     pub speed_unit: SpeedUnit,
     /// A geometry_msgs/PointStamped probe pair (x, y in m): STATION=TOPIC (repeatable).
     #[arg(long, value_parser = parse_probe_point)]
     pub probe_point: Vec<(String, String)>,
     /// Bearing coupling: nonlinear (reference), linear or prehistory.
-    #[arg(long, default_value = "nonlinear")]
-    pub model: String,
+    #[arg(long, default_value = "nonlinear", value_parser = ModelKind::from_str)]
+    pub model: ModelKind,
     /// Film evaluation: table (tabulated finite-length solutions, interpolated; plain bearings)
     /// or direct (the finite solver at every evaluation, the reference).
     #[arg(long, value_enum, default_value_t = super::simulate::FilmArg::Table)]
     pub film: super::simulate::FilmArg,
     /// Prehistory relaxation factor δ in (0, 1].
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = crate::driver::settings::DEFAULT_DELTA)]
     pub delta: f64,
     /// Time steps per revolution at rated speed (64, the node's default: in the whip within
     /// 0.07 % of 128).
@@ -92,15 +92,6 @@ fn parse_probe_point(s: &str) -> Result<(String, String), String> {
     Ok((topic.into(), station.into()))
 }
 
-fn parse_unit(s: &str) -> Result<SpeedUnit, String> {
-    match s {
-        "rpm" => Ok(SpeedUnit::Rpm),
-        "rad_s" => Ok(SpeedUnit::RadPerS),
-        "hz" => Ok(SpeedUnit::Hz),
-        _ => Err(format!("--speed-unit '{s}': must be rpm, rad_s or hz")),
-    }
-}
-
 /// The main job: the shipped sample bag through the built-in machine, the summary printed, the
 /// output in `replay_orc_runup_synthetic/`.
 pub fn run_sample() -> anyhow::Result<()> {
@@ -122,15 +113,12 @@ pub fn run_sample() -> anyhow::Result<()> {
 
 /// Runs `rotor-twin replay`.
 pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
-    let coupling = match args.model.as_str() {
-        "nonlinear" => Coupling::Nonlinear,
-        "linear" => Coupling::Linear,
-        "prehistory" if args.delta > 0.0 && args.delta <= 1.0 => {
-            Coupling::Prehistory { delta: args.delta }
-        }
-        "prehistory" => anyhow::bail!("--delta {}: must be in (0, 1]", args.delta),
-        other => anyhow::bail!("--model '{other}': must be nonlinear, linear or prehistory"),
-    };
+    anyhow::ensure!(
+        args.delta > 0.0 && args.delta <= 1.0,
+        "--delta {}: must be in (0, 1]",
+        args.delta
+    );
+    let coupling = args.model.coupling(args.delta);
     if let Some(r) = args.rate {
         anyhow::ensure!(r.is_finite() && r > 0.0, "--rate {r}: must be positive");
     }
@@ -150,10 +138,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         "--steps-per-rev {}: must be 16 to 4096",
         args.steps_per_rev
     );
-    let desc = match &args.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
+    let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
     let out_dir = args.out.clone().unwrap_or_else(|| {
         let stem = args

@@ -84,10 +84,7 @@ fn speed_grid(args: &ResponseArgs, rated: f64) -> anyhow::Result<Vec<f64>> {
 }
 
 pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
-    let desc = match &args.config {
-        Some(p) => MachineDescription::from_file(p)?,
-        None => MachineDescription::builtin_default(),
-    };
+    let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
     let rated = desc.rated_speed_rpm;
     let speeds = speed_grid(args, rated)?;

@@ -17,7 +17,8 @@ pub(crate) enum ModelArg {
     Linear,
     /// Reynolds film force at every Newton iteration (the reference).
     Nonlinear,
-    /// One film solve a step, relaxed coefficients (seed eq. 8).
+    /// Reynolds film force at every iteration, relaxed coefficients as the iteration matrix
+    /// (seed eq. 8).
     Prehistory,
 }
 
@@ -83,10 +84,7 @@ impl RunOptions {
     }
 
     fn machine(&self) -> anyhow::Result<(MachineDescription, Rotor)> {
-        let desc = match &self.config {
-            Some(p) => MachineDescription::from_file(p)?,
-            None => MachineDescription::builtin_default(),
-        };
+        let desc = MachineDescription::load(self.config.as_deref())?;
         let rotor = Rotor::from_description(&desc);
         Ok((desc, rotor))
     }

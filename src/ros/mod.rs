@@ -487,7 +487,7 @@ impl Publishers {
             .spawn(move || {
                 for item in out {
                     let t = now_ns();
-                    let _sent = match &item {
+                    let sent = match &item {
                         Outgoing::Journal(m) => self.journal.publish(m.clone()).is_ok(),
                         Outgoing::Film(m) => self.film.publish(m.clone()).is_ok(),
                         Outgoing::Orbit(m) => self.orbit.publish(m.clone()).is_ok(),
@@ -496,6 +496,9 @@ impl Publishers {
                         Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
                         Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
                     };
+                    if !sent {
+                        counters.publish_failed.fetch_add(1, Ordering::Relaxed);
+                    }
                     if let Some(rec) = &rec {
                         counters.record(rec, ToRecord::Out(item, t));
                     }

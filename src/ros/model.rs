@@ -51,6 +51,8 @@ impl Inbox {
 pub struct NodeCounters {
     /// Messages the recorder could not take (its queue was full): lost from the recording.
     pub recording_dropped: AtomicU64,
+    /// Messages the bus refused to take (a full send window).
+    pub publish_failed: AtomicU64,
     /// The recording stopped before the node (e.g. a full disk): what follows is not recorded.
     pub recording_failed: AtomicBool,
 }
@@ -381,6 +383,13 @@ impl ModelLoop {
             kv("step_overruns", t.overruns.to_string()),
             kv("worst_step_us", format!("{:.1}", t.worst_step_us)),
             kv("dropped_messages", self.dropped_out.to_string()),
+            kv(
+                "publish_failed",
+                self.counters
+                    .publish_failed
+                    .load(Ordering::Relaxed)
+                    .to_string(),
+            ),
             kv(
                 "recording_dropped",
                 self.counters

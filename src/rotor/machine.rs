@@ -534,11 +534,13 @@ impl MachineDescription {
         for (i, u) in self.unbalance.iter().enumerate() {
             node_ok(format!("unbalance[{i}].node"), u.node)?;
             non_negative(format!("unbalance[{i}].magnitude_g_mm"), u.magnitude_g_mm)?;
-            if u.magnitude_g_mm > 1e6 {
+            // the one bound on an unbalance, as for one received on the bus
+            let max_g_mm = crate::driver::inputs::MAX_UNBALANCE_KG_M * 1e6;
+            if u.magnitude_g_mm > max_g_mm {
                 return Err(err(
                     format!("unbalance[{i}].magnitude_g_mm"),
                     u.magnitude_g_mm.to_string(),
-                    "is absurd (more than 1 kg·m)",
+                    &format!("is absurd (more than {max_g_mm} g·mm)"),
                 ));
             }
             if !u.phase_deg.is_finite() {

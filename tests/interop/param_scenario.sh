@@ -9,7 +9,9 @@ ip link set lo up
 # discovery on this host only (the loopback-only participant)
 ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST "$bin" node > "$out/node.out" 2> "$out/node.err" &
 node=$!
-sleep 3
+# the node joins the bus once its film tables are built (seconds, more on a loaded machine)
+for _ in $(seq 240); do grep -q "up on ROS domain" "$out/node.err" 2>/dev/null && break; sleep 0.5; done
+sleep 1
 {
   "$bin" param --timeout 10 set state_rate_hz:=50; echo "rc=$?"
   "$bin" param --timeout 10 get state_rate_hz model; echo "rc=$?"

@@ -171,11 +171,12 @@ impl Twin {
                 rule: "must be a plane of the machine",
             });
         }
-        if !(magnitude_kg_m.is_finite() && (0.0..=1.0).contains(&magnitude_kg_m)) {
+        let max = crate::driver::inputs::MAX_UNBALANCE_KG_M;
+        if !(magnitude_kg_m.is_finite() && (0.0..=max).contains(&magnitude_kg_m)) {
             return Err(TwinError::InvalidInput {
                 name: "unbalance (kg·m)",
                 value: magnitude_kg_m,
-                rule: "must be finite, 0 to 1 kg·m",
+                rule: "must be finite, 0 to MAX_UNBALANCE_KG_M (0.01 kg·m)",
             });
         }
         if !phase_rad.is_finite() {
