@@ -40,6 +40,7 @@ fn track(points: &[CampbellPoint], id: usize) -> Vec<(f64, Mode)> {
 /// (negative log decrement) in red; the running frequency 1X and 0.5X as labelled lines; the
 /// forward critical speeds as diamonds on 1X; the stability threshold (rpm) as a vertical line.
 /// The lower panel shows the logarithmic decrements, unclipped. The legend has its own panel.
+// Long (≈145 lines): one drawing of three panels in sequence; to be split per panel.
 pub fn campbell_svg(
     path: &Path,
     title: &str,

@@ -94,6 +94,9 @@ impl Twin {
 
     /// One Newmark step with factor `level` (h / 2^level) to `speed` (rad/s). Ok(iterations);
     /// Err(None) if Newton did not converge (retry smaller); Err(Some) for a hard failure.
+    // Long (≈230 lines): predictor, condensed Newton loop and corrector share the step's
+    // scratch state, kept in one function so the hot path allocates nothing; splitting it into
+    // predictor / iteration / corrector methods on that scratch is open in issue 10.
     fn advance(
         &mut self,
         level: usize,
