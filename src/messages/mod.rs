@@ -4,6 +4,7 @@
 //! which a test checks against the `.msg` files. Units: SI (REP 103), stated in the `.msg` files.
 
 mod standard;
+pub mod type_hash;
 
 pub use standard::{
     Clock, DiagnosticArray, DiagnosticStatus, Float64, KeyValue, Point, PointStamped,
@@ -33,6 +34,12 @@ pub trait RosMessage: Serialize + for<'de> Deserialize<'de> {
             s.push_str(text.trim_end());
         }
         s
+    }
+
+    /// The type's RIHS01 hash (REP 2016), from its definition and dependencies.
+    fn type_hash() -> String {
+        type_hash::rihs01(Self::TYPE_NAME, &Self::schema())
+            .expect("the crate's own message definitions parse (tests/messages.rs checks each)")
     }
 }
 

@@ -1,6 +1,7 @@
 //! Recording to MCAP in the rosbag2 conventions: a bag directory with `<name>_0.mcap` (profile
-//! `ros2`, CDR messages, `ros2msg` schemas, each channel's `offered_qos_profiles`) and
-//! `metadata.yaml` (rosbag2 version 9). metadata.yaml is written when the recording starts and
+//! `ros2`, CDR messages, `ros2msg` schemas, each channel's `offered_qos_profiles` and RIHS01
+//! `topic_type_hash`) and `metadata.yaml` (rosbag2 version 9, with each type's
+//! `type_description_hash`). metadata.yaml is written when the recording starts and
 //! rewritten at every flush (the node flushes at least every second), so a killed process loses at
 //! most the last chunk and leaves a bag directory that [`recover`] (`rotor-twin bag recover`)
 //! makes whole; [`Recorder::finish`] writes the summary and the final metadata. A write that fails
@@ -75,6 +76,8 @@ impl TopicQos {
 struct TopicEntry {
     name: String,
     type_name: String,
+    /// RIHS01 type hash ('' where the schema could not be hashed).
+    type_hash: String,
     qos: TopicQos,
     channel: u16,
     count: u64,
@@ -221,27 +224,21 @@ impl Recorder {
         name: &str,
         qos: TopicQos,
     ) -> Result<usize, RecordError> {
-        if let Some(i) = self.topics.iter().position(|t| t.name == name) {
-            return Ok(i);
-        }
-        let schema = self
-            .writer
-            .add_schema(T::TYPE_NAME, "ros2msg", T::schema().as_bytes())?;
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), qos.rosbag2_yaml())]);
-        let channel = self.writer.add_channel(schema, name, "cdr", &metadata)?;
-        self.topics.push(TopicEntry {
-            name: name.into(),
-            type_name: T::TYPE_NAME.into(),
+        let schema = T::schema();
+        self.add_channel(
+            name,
+            T::TYPE_NAME,
+            "ros2msg",
+            schema.as_bytes(),
+            T::type_hash(),
             qos,
-            channel,
-            count: 0,
-        });
-        Ok(self.topics.len() - 1)
+        )
     }
 
     /// Adds topic `name` with a schema given as is (to copy a topic from another bag): ROS type
-    /// `type_name`, schema `encoding` and `schema` text. Returns its handle; adding the same name
-    /// twice returns the first handle.
+    /// `type_name`, schema `encoding` and `schema` text. Its RIHS01 hash is computed from a
+    /// `ros2msg` schema ('' for another encoding or a schema that does not parse). Returns its
+    /// handle; adding the same name twice returns the first handle.
     pub fn add_topic_raw(
         &mut self,
         name: &str,
@@ -250,15 +247,39 @@ impl Recorder {
         schema: &[u8],
         qos: TopicQos,
     ) -> Result<usize, RecordError> {
+        let hash = match (encoding, std::str::from_utf8(schema)) {
+            ("ros2msg", Ok(text)) => {
+                crate::messages::type_hash::rihs01(type_name, text).unwrap_or_default()
+            }
+            _ => String::new(),
+        };
+        self.add_channel(name, type_name, encoding, schema, hash, qos)
+    }
+
+    /// The channel (and its schema) of a new topic, with the metadata rosbag2 Jazzy writes:
+    /// `offered_qos_profiles` and `topic_type_hash`.
+    fn add_channel(
+        &mut self,
+        name: &str,
+        type_name: &str,
+        encoding: &str,
+        schema: &[u8],
+        type_hash: String,
+        qos: TopicQos,
+    ) -> Result<usize, RecordError> {
         if let Some(i) = self.topics.iter().position(|t| t.name == name) {
             return Ok(i);
         }
         let schema = self.writer.add_schema(type_name, encoding, schema)?;
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), qos.rosbag2_yaml())]);
+        let metadata = BTreeMap::from([
+            ("offered_qos_profiles".to_string(), qos.rosbag2_yaml()),
+            ("topic_type_hash".to_string(), type_hash.clone()),
+        ]);
         let channel = self.writer.add_channel(schema, name, "cdr", &metadata)?;
         self.topics.push(TopicEntry {
             name: name.into(),
             type_name: type_name.into(),
+            type_hash,
             qos,
             channel,
             count: 0,
@@ -375,8 +396,11 @@ impl Recorder {
                 .map(|l| format!("        {l}\n"))
                 .collect();
             topics.push_str(&format!(
-                "  - message_count: {}\n    topic_metadata:\n      name: {}\n      offered_qos_profiles:\n{qos}      serialization_format: cdr\n      type: {}\n      type_description_hash: ''\n",
-                t.count, t.name, t.type_name
+                "  - message_count: {}\n    topic_metadata:\n      name: {}\n      offered_qos_profiles:\n{qos}      serialization_format: cdr\n      type: {}\n      type_description_hash: {}\n",
+                t.count,
+                t.name,
+                t.type_name,
+                if t.type_hash.is_empty() { "''" } else { &t.type_hash }
             ));
         }
         format!(
