@@ -5,36 +5,6 @@ mod common;
 mod svg_check;
 use common::run_cli;
 
-/// Pixels per unit of the x and y axes, from the numeric tick labels (plotters puts the x-axis
-/// labels on one row and the y-axis labels in one column).
-fn px_per_unit(svg: &svg_check::Svg) -> (f64, f64) {
-    let ticks: Vec<(f64, f64, f64)> = svg
-        .texts
-        .iter()
-        .filter_map(|t| Some((t.x, t.y, t.text.parse::<f64>().ok()?)))
-        .collect();
-    let row_y = ticks.iter().map(|t| t.1).fold(f64::MIN, f64::max);
-    let col_x = ticks.iter().map(|t| t.0).fold(f64::MAX, f64::min);
-    let slope = |pts: Vec<(f64, f64)>| {
-        let (a, b) = (pts.first().unwrap(), pts.last().unwrap());
-        ((b.0 - a.0) / (b.1 - a.1)).abs()
-    };
-    let mut xs: Vec<(f64, f64)> = ticks
-        .iter()
-        .filter(|t| t.1 == row_y)
-        .map(|t| (t.0, t.2))
-        .collect();
-    let mut ys: Vec<(f64, f64)> = ticks
-        .iter()
-        .filter(|t| t.0 == col_x)
-        .map(|t| (t.1, t.2))
-        .collect();
-    xs.sort_by(|a, b| a.1.total_cmp(&b.1));
-    ys.sort_by(|a, b| a.1.total_cmp(&b.1));
-    assert!(xs.len() >= 3 && ys.len() >= 3, "ticks {xs:?} {ys:?}");
-    (slope(xs), slope(ys))
-}
-
 /// The built-in microturbine: its first forward mode's peak near 3,800 rpm at each bearing with
 /// an amplification factor and the API 684 margin beside it; both plots complete.
 #[test]
@@ -106,7 +76,7 @@ fn response_json_and_plots_for_the_builtin_machine() {
         "Im X (µm)",
         "legend",
     ]);
-    let (px_x, px_y) = px_per_unit(&polar);
+    let (px_x, px_y) = polar.px_per_unit();
     assert!(
         (px_x / px_y - 1.0).abs() < 0.01,
         "polar aspect {px_x} vs {px_y} px/µm"

@@ -1,6 +1,7 @@
 //! The `simulate` and `sweep` command-line contracts: JSON keys, plot files, CSV, errors.
 
 mod common;
+mod svg_check;
 use common::run_cli;
 
 use serde_json::Value;
@@ -56,6 +57,33 @@ fn simulate_json_and_plots() {
         let text = std::fs::read_to_string(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         assert!(text.starts_with("<svg"));
     }
+    // the orbit is drawn 1:1 (a circle is a circle), its legend beside the chart
+    let orbit = svg_check::read(&dir.join("orbit_bearing_outboard.svg"));
+    orbit.assert_texts(&["x (µm)", "y (µm)", "legend", "clearance circle (40 µm)"]);
+    let (px_x, px_y) = orbit.px_per_unit();
+    assert!(
+        (px_x / px_y - 1.0).abs() < 0.005,
+        "orbit aspect {px_x} vs {px_y} px/µm"
+    );
+    // the curves are polylines of many points; the legend's swatches have two
+    let right_of_data = orbit
+        .polylines
+        .iter()
+        .filter(|l| l.len() > 2)
+        .flatten()
+        .map(|p| p.0)
+        .fold(f64::MIN, f64::max);
+    assert!(orbit.text("legend").unwrap().x > right_of_data);
+    // the pressure map: degrees of shaft rotation and of the bearing, a scale in MPa
+    let map = svg_check::read(&dir.join("pressure_bearing_outboard.svg"));
+    map.assert_texts(&[
+        "shaft rotation over the last two revolutions (deg)",
+        "bearing angle from +x (deg)",
+        "pressure (MPa)",
+        // degree ticks, not step numbers
+        "700",
+        "350",
+    ]);
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -22,10 +22,11 @@ pub fn orbit_comparison_svg(
         .map(|p| p[0].hypot(p[1]))
         .fold(clearance_m, f64::max);
     let lim = 1.1 * extent * 1e6;
-    let root = SVGBackend::new(path, (640, 640)).into_drawing_area();
+    let root = SVGBackend::new(path, (640, 660)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
+    let titled = root.titled(title, ("sans-serif", 18))?;
+    let area = super::square_chart_area(titled, 15, 40, 50);
+    let mut chart = ChartBuilder::on(&area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(50)

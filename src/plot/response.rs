@@ -129,11 +129,8 @@ pub fn polar_svg(
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 22))?;
     let (plot_area, legend_area) = root.split_horizontally(730);
-    // a square plotting area (equal pixels per µm on both axes): the frame less its margins
-    // (15 px a side) and label areas (70 px left, 40 px below)
-    let (w, h) = plot_area.dim_in_pixel();
-    let side = (w as i32 - 100).min(h as i32 - 70).max(10);
-    let plot_area = plot_area.shrink((0, 0), ((side + 100) as u32, (side + 70) as u32));
+    // a square plotting area: equal pixels per µm on both axes
+    let plot_area = super::square_chart_area(plot_area, 15, 40, 70);
     let mut chart = ChartBuilder::on(&plot_area)
         .margin(15)
         .x_label_area_size(40)

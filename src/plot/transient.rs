@@ -1,11 +1,13 @@
 //! Plots of a transient run: orbit in the clearance circle, order spectrum, pressure map, and the
 //! amplitude–speed characteristic of a sweep.
 
+use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::monitor::OrderComponent;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// The orbit (last two revolutions) of a journal inside its clearance circle, 1:1, in µm.
+/// The orbit (last two revolutions) of a journal inside its clearance circle, 1:1, in µm, with
+/// the legend in a panel of its own (a whip orbit fills the clearance circle).
 pub fn orbit_svg(
     path: &Path,
     title: &str,
@@ -13,11 +15,13 @@ pub fn orbit_svg(
     clearance_m: f64,
 ) -> anyhow::Result<()> {
     let c = clearance_m * 1e6;
-    let root = SVGBackend::new(path, (640, 640)).into_drawing_area();
+    let root = SVGBackend::new(path, (900, 660)).into_drawing_area();
     root.fill(&WHITE)?;
     let lim = 1.1 * c;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
+    let titled = root.titled(title, ("sans-serif", 18))?;
+    let (chart_area, legend_area) = titled.split_horizontally(640);
+    let area = super::square_chart_area(chart_area, 15, 40, 50);
+    let mut chart = ChartBuilder::on(&area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(50)
@@ -27,29 +31,24 @@ pub fn orbit_svg(
         .x_desc("x (µm)")
         .y_desc("y (µm)")
         .draw()?;
-    let circle: Vec<(f64, f64)> = (0..=360)
-        .map(|k| {
-            let a = (k as f64).to_radians();
-            (c * a.cos(), c * a.sin())
-        })
-        .collect();
-    chart
-        .draw_series(LineSeries::new(circle, BLACK))?
-        .label("clearance circle")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
-    chart
-        .draw_series(LineSeries::new(
-            orbit_m.iter().map(|p| (p[0] * 1e6, p[1] * 1e6)),
-            BLUE,
-        ))?
-        .label("journal centre, last two revolutions")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    let circle = (0..=360).map(|k| {
+        let a = (k as f64).to_radians();
+        (c * a.cos(), c * a.sin())
+    });
+    chart.draw_series(LineSeries::new(circle, BLACK))?;
+    chart.draw_series(LineSeries::new(
+        orbit_m.iter().map(|p| (p[0] * 1e6, p[1] * 1e6)),
+        BLUE,
+    ))?;
+    let entries = [
+        Entry::new(
+            Swatch::Line(BLACK, 1),
+            format!("clearance circle ({c:.0} µm)"),
+        ),
+        Entry::new(Swatch::Line(BLUE, 1), "journal centre,"),
+        Entry::new(Swatch::Line(WHITE, 1), "last two revolutions"),
+    ];
+    draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())
 }
@@ -90,39 +89,125 @@ pub fn spectrum_svg(path: &Path, title: &str, spectrum: &[OrderComponent]) -> an
     Ok(())
 }
 
-/// Mid-plane film pressure over the last two revolutions: angle against step, colour = pressure.
+/// Quantile of the pressure map that sets the colour scale when the map holds spikes.
+const PRESSURE_SCALE_QUANTILE: f64 = 0.995;
+
+/// A map whose maximum exceeds its [`PRESSURE_SCALE_QUANTILE`] by this factor holds spikes
+/// (contact: a node or two near ε → 1 at several times the film's working pressure) that would
+/// set the scale and wash the film's field out: the scale then tops at the quantile and the
+/// cells above are drawn red and counted. Otherwise the scale tops at the maximum.
+const PRESSURE_SPIKE_FACTOR: f64 = 1.5;
+
+/// Cells above the colour scale.
+const ABOVE_SCALE: RGBColor = RGBColor(220, 30, 30);
+
+/// The grey of pressure `p` on a scale topping out at `top` (white 0 → black `top`).
+fn pressure_shade(p: f64, top: f64) -> RGBColor {
+    let g = (255.0 * (1.0 - (p / top).clamp(0.0, 1.0))) as u8;
+    RGBColor(g, g, g)
+}
+
+/// Mid-plane film pressure over the last two revolutions at constant speed: bearing angle
+/// against shaft rotation (degrees), grey = pressure, with a colour bar in MPa.
 pub fn pressure_map_svg(path: &Path, title: &str, map_pa: &[Vec<f64>]) -> anyhow::Result<()> {
     let steps = map_pa.len().max(1);
     let points = map_pa.first().map_or(1, Vec::len).max(1);
-    let p_max = map_pa.iter().flatten().fold(1e-9, |a: f64, &b| a.max(b));
-    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
+    let mut sorted: Vec<f64> = map_pa
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|p| p.is_finite())
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    let p_max = sorted.last().copied().unwrap_or(0.0).max(1e-9);
+    let quantile = sorted
+        .get(((sorted.len() as f64 - 1.0) * PRESSURE_SCALE_QUANTILE) as usize)
+        .copied()
+        .unwrap_or(p_max)
+        .max(1e-9);
+    let top = if p_max > PRESSURE_SPIKE_FACTOR * quantile {
+        quantile
+    } else {
+        p_max
+    };
+    let above = sorted.iter().filter(|&&p| p > top).count();
+    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
     root.fill(&WHITE)?;
-    let caption = format!("{title} (white 0 → black {:.2} MPa)", p_max * 1e-6);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(caption, ("sans-serif", 18))
+    let caption = if above > 0 {
+        format!(
+            "{title}: red = {above} cells above the scale, up to {:.1} MPa",
+            p_max * 1e-6
+        )
+    } else {
+        title.to_string()
+    };
+    let root = root.titled(&caption, ("sans-serif", 18))?;
+    let (map_area, bar_area) = root.split_horizontally(790);
+    let mut chart = ChartBuilder::on(&map_area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..steps as f64, 0.0..360.0)?;
+        .build_cartesian_2d(0.0..720.0, 0.0..360.0)?;
     chart
         .configure_mesh()
-        .x_desc("step in the last two revolutions")
-        .y_desc("angle from +x (deg)")
+        .x_desc("shaft rotation over the last two revolutions (deg)")
+        .y_desc("bearing angle from +x (deg)")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
         .draw()?;
-    let dy = 360.0 / points as f64;
+    let (dx, dy) = (720.0 / steps as f64, 360.0 / points as f64);
     chart.draw_series(map_pa.iter().enumerate().flat_map(|(t, row)| {
         row.iter().enumerate().map(move |(k, &p)| {
-            let shade = (255.0 * (1.0 - (p / p_max).clamp(0.0, 1.0))) as u8;
+            let colour = if p > top {
+                ABOVE_SCALE
+            } else {
+                pressure_shade(p, top)
+            };
+            let x = t as f64 * dx;
             Rectangle::new(
-                [
-                    (t as f64, k as f64 * dy),
-                    (t as f64 + 1.0, (k + 1) as f64 * dy),
-                ],
-                RGBColor(shade, shade, shade).filled(),
+                [(x, k as f64 * dy), (x + dx, (k + 1) as f64 * dy)],
+                colour.filled(),
             )
         })
     }))?;
+    colour_bar(&bar_area, top)?;
     root.present()?;
+    Ok(())
+}
+
+/// The pressure scale beside the map: grey 0 → `top` (MPa).
+fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    top: f64,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let top_mpa = top * 1e-6;
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(15)
+        .margin_bottom(55)
+        .margin_right(10)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..1.0, 0.0..top_mpa)?;
+    bar.configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .y_desc("pressure (MPa)")
+        .y_label_style(("sans-serif", 12))
+        .axis_desc_style(("sans-serif", 13))
+        .draw()?;
+    let n = 100;
+    bar.draw_series((0..n).map(|i| {
+        let (p0, p1) = (
+            top_mpa * i as f64 / n as f64,
+            top_mpa * (i + 1) as f64 / n as f64,
+        );
+        Rectangle::new(
+            [(0.0, p0), (1.0, p1)],
+            pressure_shade(p0 * 1e6, top).filled(),
+        )
+    }))?;
     Ok(())
 }
 

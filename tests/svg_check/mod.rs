@@ -101,4 +101,34 @@ impl Svg {
             );
         }
     }
+
+    /// Pixels per unit of the x and y axes, from the numeric tick labels (plotters puts the x-axis
+    /// labels on one row and the y-axis labels in one column).
+    pub fn px_per_unit(&self) -> (f64, f64) {
+        let ticks: Vec<(f64, f64, f64)> = self
+            .texts
+            .iter()
+            .filter_map(|t| Some((t.x, t.y, t.text.parse::<f64>().ok()?)))
+            .collect();
+        let row_y = ticks.iter().map(|t| t.1).fold(f64::MIN, f64::max);
+        let col_x = ticks.iter().map(|t| t.0).fold(f64::MAX, f64::min);
+        let slope = |pts: Vec<(f64, f64)>| {
+            let (a, b) = (pts.first().unwrap(), pts.last().unwrap());
+            ((b.0 - a.0) / (b.1 - a.1)).abs()
+        };
+        let mut xs: Vec<(f64, f64)> = ticks
+            .iter()
+            .filter(|t| t.1 == row_y)
+            .map(|t| (t.0, t.2))
+            .collect();
+        let mut ys: Vec<(f64, f64)> = ticks
+            .iter()
+            .filter(|t| t.0 == col_x)
+            .map(|t| (t.1, t.2))
+            .collect();
+        xs.sort_by(|a, b| a.1.total_cmp(&b.1));
+        ys.sort_by(|a, b| a.1.total_cmp(&b.1));
+        assert!(xs.len() >= 3 && ys.len() >= 3, "ticks {xs:?} {ys:?}");
+        (slope(xs), slope(ys))
+    }
 }
