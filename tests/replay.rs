@@ -5,6 +5,7 @@
 //! replays are deterministic.
 
 mod common;
+mod svg_check;
 
 use common::run_cli;
 use rotor_twin::bag::Bag;
@@ -278,7 +279,8 @@ fn the_shipped_sample_bag_replays() {
         let speed = s["window_speed_rpm"].as_f64().unwrap();
         assert!((8000.0..8200.0).contains(&speed), "{speed} rpm");
     }
-    let r = replay_json(&bag, &scratch("sample-full"), &["--no-bag"]);
+    let full_out = scratch("sample-full");
+    let r = replay_json(&bag, &full_out, &["--no-bag"]);
     let onset = &r["onset"];
     let observed = onset["observed_speed_rpm"].as_f64().unwrap();
     let predicted = onset["predicted_speed_rpm"].as_f64().unwrap();
@@ -301,6 +303,43 @@ fn the_shipped_sample_bag_replays() {
         .collect();
     let mut seen = std::collections::HashSet::new();
     assert!(states.iter().all(|s| seen.insert(*s)), "{states:?}");
+    check_amplitude_plots(&full_out);
+}
+
+/// The amplitude plot has a speed panel and a bag-time panel, its legend beside the data; the
+/// waterfall has an amplitude scale bar labelled in µm.
+fn check_amplitude_plots(out: &Path) {
+    let a = svg_check::read(&out.join("amplitude_speed_probe_outboard.svg"));
+    a.assert_texts(&[
+        "speed (rpm)",
+        "bag time (s)",
+        "semi-major axis (µm)",
+        "legend",
+    ]);
+    let right_of_data = a
+        .polylines
+        .iter()
+        .filter(|l| l.len() > 2)
+        .flatten()
+        .chain(
+            // data dots are 3 px, the legend's dots 4 px
+            a.circles
+                .iter()
+                .filter(|c| c.2 < 3.5)
+                .map(|c| (c.0, c.1))
+                .collect::<Vec<_>>()
+                .iter(),
+        )
+        .map(|p| p.0)
+        .fold(f64::MIN, f64::max);
+    let legend_x = a.text("legend").unwrap().x;
+    assert!(
+        legend_x > right_of_data,
+        "legend {legend_x} px, data to {right_of_data} px"
+    );
+    let w = svg_check::read(&out.join("waterfall_probe_outboard.svg"));
+    let bar = w.texts.iter().filter(|t| t.text.ends_with(" µm")).count();
+    assert_eq!(bar, 2, "one scale bar in each half");
 }
 
 /// A bag cut off part-way replays what comes before the cut, and says where it is damaged.

@@ -1,6 +1,7 @@
 //! Plots of a replay: predicted over measured orbit at a probe station, their order spectra,
 //! and 1X and sub-synchronous amplitude against speed over the bag.
 
+use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::monitor::OrderComponent;
 use crate::replay::compare::{BlockSpectra, Sample, WindowComparison, BLOCK_REVS};
 use plotters::prelude::*;
@@ -128,107 +129,125 @@ pub fn spectrum_comparison_svg(
     Ok(())
 }
 
-/// 1X and sub-synchronous semi-major axes (µm) against speed (rpm), block by block.
+/// The four amplitude series of the amplitude plots: label, value, colour, line (or dots).
+type AmplitudeSeries = (&'static str, fn(&WindowComparison) -> f64, RGBColor, bool);
+
+const AMPLITUDE_SERIES: [AmplitudeSeries; 4] = [
+    (
+        "1X measured",
+        |b| b.measured.one_x_amplitude_m,
+        MEASURED,
+        true,
+    ),
+    (
+        "1X predicted",
+        |b| b.predicted.one_x_amplitude_m,
+        PREDICTED,
+        true,
+    ),
+    (
+        "sub-synchronous measured",
+        |b| b.measured.subsync_amplitude_m,
+        MEASURED,
+        false,
+    ),
+    (
+        "sub-synchronous predicted",
+        |b| b.predicted.subsync_amplitude_m,
+        PREDICTED,
+        false,
+    ),
+];
+
+/// 1X and sub-synchronous semi-major axes (µm), block by block: against speed (rpm; the range
+/// padded so that a hold at the top speed stands inside the frame) and, below, against bag time
+/// (s), where a hold at one speed — the seed's whip at 9,000 rpm — unfolds. Legend beside.
 pub fn amplitude_speed_svg(
     path: &Path,
     title: &str,
     blocks: &[WindowComparison],
 ) -> anyhow::Result<()> {
-    let (lo, hi) = blocks
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, b| {
-            (a.0.min(b.speed_rpm), a.1.max(b.speed_rpm))
-        });
-    let (lo, hi) = if lo.is_finite() && hi > lo + 1.0 {
-        (lo, hi)
-    } else {
-        (lo.min(0.0) - 10.0, hi.max(0.0) + 10.0)
+    let range = |pick: fn(&WindowComparison) -> f64| {
+        let (lo, hi) = blocks
+            .iter()
+            .map(pick)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
+                (a.0.min(v), a.1.max(v))
+            });
+        if lo.is_finite() && hi > lo {
+            let pad = 0.04 * (hi - lo);
+            (lo - pad, hi + pad)
+        } else {
+            (lo.min(0.0) - 10.0, hi.max(0.0) + 10.0)
+        }
     };
     let top = blocks
         .iter()
-        .flat_map(|b| {
-            [
-                b.measured.one_x_amplitude_m,
-                b.predicted.one_x_amplitude_m,
-                b.measured.subsync_amplitude_m,
-                b.predicted.subsync_amplitude_m,
-            ]
-        })
+        .flat_map(|b| AMPLITUDE_SERIES.map(|s| s.1(b)))
         .fold(1e-9, f64::max)
         * 1e6
         * 1.1;
-    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
+    let root = SVGBackend::new(path, (1000, 760)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(lo..hi, 0.0..top)?;
-    chart
-        .configure_mesh()
-        .x_desc("speed (rpm)")
-        .y_desc("semi-major axis (µm)")
-        .draw()?;
-    type Pick = fn(&WindowComparison) -> f64;
-    let series: [(&str, Pick, RGBColor, bool); 4] = [
-        (
-            "1X measured",
-            |b| b.measured.one_x_amplitude_m,
-            MEASURED,
-            true,
-        ),
-        (
-            "1X predicted",
-            |b| b.predicted.one_x_amplitude_m,
-            PREDICTED,
-            true,
-        ),
-        (
-            "sub-synchronous measured",
-            |b| b.measured.subsync_amplitude_m,
-            MEASURED,
-            false,
-        ),
-        (
-            "sub-synchronous predicted",
-            |b| b.predicted.subsync_amplitude_m,
-            PREDICTED,
-            false,
-        ),
+    let root = root.titled(title, ("sans-serif", 18))?;
+    let (plots, legend_area) = root.split_horizontally(780);
+    let (upper, lower) = plots.split_vertically(370);
+    type Abscissa = fn(&WindowComparison) -> f64;
+    let panels: [(&str, Abscissa); 2] = [
+        ("speed (rpm)", |b| b.speed_rpm),
+        ("bag time (s)", |b| 0.5 * (b.start_s + b.end_s)),
     ];
-    for (label, pick, color, solid) in series {
-        let points: Vec<(f64, f64)> = blocks
-            .iter()
-            .map(|b| (b.speed_rpm, pick(b) * 1e6))
-            .collect();
-        if solid {
-            chart
-                .draw_series(LineSeries::new(points, color.stroke_width(2)))?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-        } else {
-            chart
-                .draw_series(points.iter().map(|p| Circle::new(*p, 3, color.filled())))?
-                .label(label)
-                .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+    for (area, (x_desc, x_of)) in [&upper, &lower].into_iter().zip(panels) {
+        let (lo, hi) = range(x_of);
+        let mut chart = ChartBuilder::on(area)
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(lo..hi, 0.0..top)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc("semi-major axis (µm)")
+            .draw()?;
+        for (_, pick, color, solid) in AMPLITUDE_SERIES {
+            let points = blocks.iter().map(|b| (x_of(b), pick(b) * 1e6));
+            if solid {
+                chart.draw_series(LineSeries::new(points, color.stroke_width(2)))?;
+            } else {
+                chart.draw_series(points.map(|p| Circle::new(p, 3, color.filled())))?;
+            }
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    let entries: Vec<Entry> = AMPLITUDE_SERIES
+        .iter()
+        .map(|(label, _, color, solid)| {
+            let swatch = if *solid {
+                Swatch::Line(*color, 2)
+            } else {
+                Swatch::Dot(*color)
+            };
+            Entry::new(swatch, *label)
+        })
+        .collect();
+    draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())
 }
 
+/// A round amplitude for a scale bar: 1, 2 or 5 × 10ⁿ, at most `v`.
+fn round_down_125(v: f64) -> f64 {
+    let e = 10f64.powf(v.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * e)
+        .find(|&r| r <= v)
+        .unwrap_or(e)
+}
+
 /// Waterfall (cascade) of the order spectra of the bag's blocks of 8 revolutions, measured on
 /// the left and predicted on the right: one trace per block (at most 60, evenly chosen), raised
-/// by its time in the bag, semi-major axis scaled so that the largest peak spans 3 traces.
+/// by its time in the bag, semi-major axis scaled so that the largest peak spans 3 traces; a
+/// scale bar of a round amplitude (µm) at the top right of each half.
 pub fn waterfall_svg(path: &Path, title: &str, blocks: &[BlockSpectra]) -> anyhow::Result<()> {
     let root = SVGBackend::new(path, (1000, 640)).into_drawing_area();
     root.fill(&WHITE)?;
@@ -261,8 +280,23 @@ pub fn waterfall_svg(path: &Path, title: &str, blocks: &[BlockSpectra]) -> anyho
         chart
             .configure_mesh()
             .x_desc("order (frequency / running frequency)")
-            .y_desc("bag time (s); traces: semi-major axis")
+            .y_desc("bag time (s); trace height: semi-major axis (scale bar)")
             .draw()?;
+        // the amplitude scale: a bar of a round amplitude at the top right, labelled in µm
+        let bar_m = round_down_125(peak);
+        let (x_bar, y_bar) = (1.95, t_end + 0.3 * spacing);
+        chart.draw_series(LineSeries::new(
+            [(x_bar, y_bar), (x_bar, y_bar + scale * bar_m)],
+            BLACK.stroke_width(3),
+        ))?;
+        chart.draw_series(std::iter::once(Text::new(
+            match bar_m * 1e6 {
+                um if um >= 1.0 => format!("{um:.0} µm"),
+                um => format!("{um:.2} µm"),
+            },
+            (1.50, y_bar + 0.5 * scale * bar_m),
+            ("sans-serif", 13).into_font(),
+        )))?;
         for b in &picked {
             let values = if measured {
                 &b.measured_m
