@@ -2,6 +2,7 @@
 
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::rotor::{CampbellPoint, CriticalSpeed, Mode, WhirlDirection};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
@@ -35,12 +36,50 @@ fn track(points: &[CampbellPoint], id: usize) -> Vec<(f64, Mode)> {
         .collect()
 }
 
+/// The extent of the diagram: speeds (rpm), frequencies (Hz), log decrements, mode tracks.
+struct Extent {
+    x0: f64,
+    x1: f64,
+    f_max: f64,
+    d_lo: f64,
+    d_hi: f64,
+    ids: Vec<usize>,
+}
+
+impl Extent {
+    fn of(points: &[CampbellPoint]) -> Self {
+        let (x0, x1) = (
+            points.first().map_or(0.0, |p| p.speed_rpm),
+            points.last().map_or(1.0, |p| p.speed_rpm),
+        );
+        let modes = || points.iter().flat_map(|p| p.modes.iter());
+        let f_max = modes().map(|m| m.frequency_hz).fold(x1 / 60.0, f64::max) * 1.05;
+        let (d_min, d_max) = modes()
+            .map(|m| m.log_dec)
+            .fold((0.0_f64, 0.1_f64), |(a, b), d| (a.min(d), b.max(d)));
+        let span = (d_max - d_min).max(0.1);
+        let mut ids: Vec<usize> = points
+            .iter()
+            .flat_map(|p| p.tracks.iter().copied())
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        Self {
+            x0,
+            x1,
+            f_max,
+            d_lo: d_min - 0.05 * span,
+            d_hi: d_max + 0.05 * span,
+            ids,
+        }
+    }
+}
+
 /// Writes a Campbell diagram to `path`: damped natural frequencies against speed, each mode a line
 /// (followed by shape) with its points, forward whirl in blue, backward in green, unstable points
 /// (negative log decrement) in red; the running frequency 1X and 0.5X as labelled lines; the
 /// forward critical speeds as diamonds on 1X; the stability threshold (rpm) as a vertical line.
 /// The lower panel shows the logarithmic decrements, unclipped. The legend has its own panel.
-// Long (≈145 lines): one drawing of three panels in sequence; to be split per panel.
 pub fn campbell_svg(
     path: &Path,
     title: &str,
@@ -48,38 +87,48 @@ pub fn campbell_svg(
     threshold_rpm: Option<f64>,
     critical_speeds: &[CriticalSpeed],
 ) -> anyhow::Result<()> {
-    let (x0, x1) = (
-        points.first().map_or(0.0, |p| p.speed_rpm),
-        points.last().map_or(1.0, |p| p.speed_rpm),
-    );
-    let f_max = points
-        .iter()
-        .flat_map(|p| p.modes.iter().map(|m| m.frequency_hz))
-        .fold(x1 / 60.0, f64::max)
-        * 1.05;
-    let (d_min, d_max) = points
-        .iter()
-        .flat_map(|p| p.modes.iter().map(|m| m.log_dec))
-        .fold((0.0_f64, 0.1_f64), |(a, b), d| (a.min(d), b.max(d)));
-    let ids: Vec<usize> = {
-        let mut v: Vec<usize> = points
-            .iter()
-            .flat_map(|p| p.tracks.iter().copied())
-            .collect();
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
+    let e = Extent::of(points);
     let root = SVGBackend::new(path, (1100, 900)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 22))?;
     let (plots, legend_area) = root.split_horizontally(860);
     let (upper, lower) = plots.split_vertically(560);
-    let mut chart = ChartBuilder::on(&upper)
+    frequency_panel(&upper, &e, points, threshold_rpm, critical_speeds)?;
+    log_dec_panel(&lower, &e, points, threshold_rpm)?;
+    let mut entries = vec![
+        Entry::new(Swatch::Dot(FORWARD), "forward whirl"),
+        Entry::new(Swatch::Dot(BACKWARD), "backward whirl"),
+        Entry::new(Swatch::Dot(UNSTABLE), "unstable (log dec < 0)"),
+        Entry::new(Swatch::Line(BLACK, 2), "1X running speed"),
+        Entry::new(Swatch::Line(RGBColor(140, 140, 140), 1), "0.5X"),
+        Entry::new(Swatch::Diamond(BLACK), "forward critical speed"),
+    ];
+    if let Some(t) = threshold_rpm {
+        entries.push(Entry::new(
+            Swatch::Line(UNSTABLE, 2),
+            format!("threshold {t:.0} rpm"),
+        ));
+    }
+    draw_side_legend(&legend_area, &entries, 30)?;
+    root.present()?;
+    Ok(())
+}
+
+type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
+
+/// The upper panel: frequencies, the 1X and 0.5X lines, critical speeds, the threshold.
+fn frequency_panel(
+    area: &Area,
+    e: &Extent,
+    points: &[CampbellPoint],
+    threshold_rpm: Option<f64>,
+    critical_speeds: &[CriticalSpeed],
+) -> anyhow::Result<()> {
+    let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, 0.0..f_max)?;
+        .build_cartesian_2d(e.x0..e.x1, 0.0..e.f_max)?;
     chart
         .configure_mesh()
         .x_desc("speed (rpm)")
@@ -87,9 +136,9 @@ pub fn campbell_svg(
         .draw()?;
     for (ratio, label, shade) in [(1.0, "1X", 0.9), (0.5, "0.5X", 0.45)] {
         // the line ends where it leaves the frame; its label sits at its end
-        let x_end = x1.min(f_max * 60.0 / ratio);
+        let x_end = e.x1.min(e.f_max * 60.0 / ratio);
         chart.draw_series(LineSeries::new(
-            [(x0, x0 * ratio / 60.0), (x_end, x_end * ratio / 60.0)],
+            [(e.x0, e.x0 * ratio / 60.0), (x_end, x_end * ratio / 60.0)],
             BLACK
                 .mix(shade)
                 .stroke_width(if ratio == 1.0 { 2 } else { 1 }),
@@ -103,19 +152,7 @@ pub fn campbell_svg(
                 .pos(Pos::new(HPos::Right, VPos::Bottom)),
         )))?;
     }
-    for &id in &ids {
-        let t = track(points, id);
-        chart.draw_series(t.windows(2).map(|w| {
-            PathElement::new(
-                [(w[0].0, w[0].1.frequency_hz), (w[1].0, w[1].1.frequency_hz)],
-                colour(&w[1].1).mix(0.6).stroke_width(1),
-            )
-        }))?;
-        chart.draw_series(
-            t.iter()
-                .map(|(s, m)| Circle::new((*s, m.frequency_hz), 3, colour(m).filled())),
-        )?;
-    }
+    draw_tracks(&mut chart, &e.ids, points, |m| m.frequency_hz)?;
     for c in critical_speeds {
         let (x, y) = (c.speed_rpm, c.speed_rpm / 60.0);
         // the label above and left of its marker, clear of the 1X line below it
@@ -133,57 +170,60 @@ pub fn campbell_svg(
     }
     if let Some(t) = threshold_rpm {
         chart.draw_series(LineSeries::new(
-            [(t, 0.0), (t, f_max)],
+            [(t, 0.0), (t, e.f_max)],
             UNSTABLE.stroke_width(2),
         ))?;
     }
+    Ok(())
+}
 
-    let span = (d_max - d_min).max(0.1);
-    let mut decs = ChartBuilder::on(&lower)
+/// The lower panel: logarithmic decrements, the zero line, the threshold.
+fn log_dec_panel(
+    area: &Area,
+    e: &Extent,
+    points: &[CampbellPoint],
+    threshold_rpm: Option<f64>,
+) -> anyhow::Result<()> {
+    let mut decs = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, (d_min - 0.05 * span)..(d_max + 0.05 * span))?;
+        .build_cartesian_2d(e.x0..e.x1, e.d_lo..e.d_hi)?;
     decs.configure_mesh()
         .x_desc("speed (rpm)")
         .y_desc("logarithmic decrement (–)")
         .draw()?;
-    decs.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK))?;
+    decs.draw_series(LineSeries::new([(e.x0, 0.0), (e.x1, 0.0)], BLACK))?;
     if let Some(t) = threshold_rpm {
         decs.draw_series(LineSeries::new(
-            [(t, d_min - 0.05 * span), (t, d_max + 0.05 * span)],
+            [(t, e.d_lo), (t, e.d_hi)],
             UNSTABLE.stroke_width(2),
         ))?;
     }
-    for &id in &ids {
+    draw_tracks(&mut decs, &e.ids, points, |m| m.log_dec)?;
+    Ok(())
+}
+
+/// Each mode track as a line through its points, the value `y` of each mode against speed.
+fn draw_tracks<'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ids: &[usize],
+    points: &[CampbellPoint],
+    y: fn(&Mode) -> f64,
+) -> anyhow::Result<()> {
+    for &id in ids {
         let t = track(points, id);
-        decs.draw_series(t.windows(2).map(|w| {
+        chart.draw_series(t.windows(2).map(|w| {
             PathElement::new(
-                [(w[0].0, w[0].1.log_dec), (w[1].0, w[1].1.log_dec)],
+                [(w[0].0, y(&w[0].1)), (w[1].0, y(&w[1].1))],
                 colour(&w[1].1).mix(0.6).stroke_width(1),
             )
         }))?;
-        decs.draw_series(
+        chart.draw_series(
             t.iter()
-                .map(|(s, m)| Circle::new((*s, m.log_dec), 3, colour(m).filled())),
+                .map(|(s, m)| Circle::new((*s, y(m)), 3, colour(m).filled())),
         )?;
     }
-    let mut entries = vec![
-        Entry::new(Swatch::Dot(FORWARD), "forward whirl"),
-        Entry::new(Swatch::Dot(BACKWARD), "backward whirl"),
-        Entry::new(Swatch::Dot(UNSTABLE), "unstable (log dec < 0)"),
-        Entry::new(Swatch::Line(BLACK, 2), "1X running speed"),
-        Entry::new(Swatch::Line(RGBColor(140, 140, 140), 1), "0.5X"),
-        Entry::new(Swatch::Diamond(BLACK), "forward critical speed"),
-    ];
-    if let Some(t) = threshold_rpm {
-        entries.push(Entry::new(
-            Swatch::Line(UNSTABLE, 2),
-            format!("threshold {t:.0} rpm"),
-        ));
-    }
-    draw_side_legend(&legend_area, &entries, 30)?;
-    root.present()?;
     Ok(())
 }
 
