@@ -1,9 +1,10 @@
 """Drives a fleet of rotor-twin nodes and collects their own account of keeping up.
 
 Usage: fleet_peer.py N SECONDS SPEED_RAD_S
-Publishes rotor_twin_msgs/RotorSpeed at 100 Hz to /fleet1 … /fleetN (each node's namespace), reads
+Publishes rotor_twin_msgs/RotorSpeed at 20 Hz to /fleet1 … /fleetN (each node's namespace), reads
 /diagnostics (the status `fleetK/rotor_twin: model` of each node: real_time_factor, lag_s) and each
-node's latched warning topic (falling_behind). Prints one JSON object per node. Run it only inside
+node's latched warning topic (falling_behind). The statistics leave out the reports of the first
+WARMUP_S = 5 s (discovery, and windows in which the twin had not started yet). Prints one JSON object per node. Run it only inside
 the private network namespace of the nodes (unshare -n), as scripts/fleet.sh does.
 """
 import json
@@ -62,6 +63,7 @@ def main():
     warnings = [DataReader(dp, Topic(dp, f"rt/{ns}/rotor_twin/warning", InstabilityWarning), qos=latched)
                 for ns in names]
     diagnostics = DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=reliable)
+    warmup_s = 5.0
     out = {ns: {"reports": 0, "rtf": [], "lag_s": [], "falling_behind": 0, "warn_levels": 0} for ns in names}
     start = time.time()
     while time.time() - start < seconds:
@@ -72,29 +74,33 @@ def main():
         for m in diagnostics.take(N=1000):
             for s in m.status:
                 ns = s.name.split("/")[0]
-                if ns in out and s.name.endswith(": model"):
+                if ns in out and s.name.endswith(": model") and time.time() - start > warmup_s:
                     v = {kv.key: kv.value for kv in s.values}
                     o = out[ns]
                     o["reports"] += 1
                     o["rtf"].append(float(v["real_time_factor"]))
+                    o.setdefault("raw", []).append((round(time.time() - start, 2), v["real_time_factor"], v["lag_s"], v["step_overruns"], v["worst_step_us"]))
                     o["lag_s"].append(float(v["lag_s"]))
                     o["warn_levels"] += int(s.level != 0)
         for ns, r in zip(names, warnings):
             for m in r.take(N=100):
                 if m.kind == "falling_behind":
                     out[ns]["falling_behind"] += 1
-        time.sleep(0.01)
+                kinds = out[ns].setdefault("warnings", {})
+                kinds[m.kind] = kinds.get(m.kind, 0) + 1
+        time.sleep(0.05)
     for ns in names:
         o = out[ns]
-        # the first report covers the start (twin not yet running): keep the steady ones
-        rtf = o["rtf"][1:] or o["rtf"]
-        lag = o["lag_s"][1:] or o["lag_s"]
+        rtf, lag = o["rtf"], o["lag_s"]
         print(json.dumps({
             "twin": ns, "reports": o["reports"],
             "rtf_min": min(rtf) if rtf else None,
             "rtf_median": sorted(rtf)[len(rtf) // 2] if rtf else None,
+            "rtf_below_0_99": sum(r < 0.99 for r in rtf),
             "lag_max_s": max(lag) if lag else None,
             "non_ok_reports": o["warn_levels"], "falling_behind": o["falling_behind"],
+            "warnings": o.get("warnings", {}),
+            "raw": o.get("raw", []) if os.environ.get("FLEET_RAW") else None,
         }))
 
 

@@ -185,6 +185,15 @@ impl TableCache {
                     "cannot write in the directory ({e}); table not cached"
                 ))
             })?;
+        // readable by other users' twins, as a file written the usual way would be
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let readable = std::fs::Permissions::from_mode(0o644);
+            tmp.as_file()
+                .set_permissions(readable)
+                .map_err(|e| warn(format!("cannot set the file's permissions ({e})")))?;
+        }
         tmp.write_all(&bytes)
             .and_then(|()| tmp.as_file().sync_all())
             .map_err(|e| warn(format!("cannot write the table ({e}); table not cached")))?;
