@@ -257,7 +257,7 @@ impl Session {
         self.twin.step(input)?;
         self.step_index += 1;
         let stamp = self.stamp_ns();
-        if self.step_index % self.decimation == 0 {
+        if self.step_index.is_multiple_of(self.decimation) {
             self.emit_states(stamp, emit);
         }
         if self.monitor.record(&self.twin).is_some() {
@@ -309,7 +309,7 @@ impl Session {
     }
 
     fn emit_states(&mut self, stamp: i64, emit: &mut impl FnMut(Outgoing)) {
-        let with_map = self.step_index % self.map_decimation == 0;
+        let with_map = self.step_index.is_multiple_of(self.map_decimation);
         for k in 0..self.names.len() {
             let o = self.twin.output();
             let b = o.bearings[k];

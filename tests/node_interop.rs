@@ -26,6 +26,10 @@ fn node_talks_to_an_independent_peer_and_records() {
     let out = std::env::temp_dir().join(format!("rotor-twin-node-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
     let status = Command::new("unshare")
+        .env(
+            "ROTOR_TWIN_CACHE_DIR",
+            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
+        )
         .arg("-n")
         .arg("bash")
         .arg(root.join("tests/interop/node_scenario.sh"))
@@ -170,6 +174,10 @@ fn node_follows_simulation_time() {
     let out = std::env::temp_dir().join(format!("rotor-twin-sim-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
     let status = Command::new("unshare")
+        .env(
+            "ROTOR_TWIN_CACHE_DIR",
+            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
+        )
         .args(["-n", "bash"])
         .arg(root.join("tests/interop/sim_time_scenario.sh"))
         .arg(env!("CARGO_BIN_EXE_rotor-twin"))
@@ -199,6 +207,10 @@ fn parameters_are_set_over_the_bus_where_safe() {
     let out = std::env::temp_dir().join(format!("rotor-twin-param-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
     let status = Command::new("unshare")
+        .env(
+            "ROTOR_TWIN_CACHE_DIR",
+            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
+        )
         .args(["-n", "bash"])
         .arg(root.join("tests/interop/param_scenario.sh"))
         .arg(env!("CARGO_BIN_EXE_rotor-twin"))

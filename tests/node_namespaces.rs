@@ -23,6 +23,10 @@ fn two_twins_in_two_namespaces_each_follow_their_own_speed() {
     let out = std::env::temp_dir().join(format!("rotor-twin-ns-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
     let status = Command::new("unshare")
+        .env(
+            "ROTOR_TWIN_CACHE_DIR",
+            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
+        )
         .args(["-n", "bash"])
         .arg(root.join("tests/interop/namespace_scenario.sh"))
         .arg(env!("CARGO_BIN_EXE_rotor-twin"))

@@ -211,7 +211,7 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
     let start = Instant::now();
     let mut k = 0usize;
     while start.elapsed() < budget && times.len() < (1 << 20) {
-        let q = if k % 2 == 0 { moved } else { q0 };
+        let q = if k.is_multiple_of(2) { moved } else { q0 };
         let t = Instant::now();
         let (r, c) = tabulated.solve_with_coefficients(&at(q))?;
         times.push(t.elapsed().as_secs_f64() * 1e6);

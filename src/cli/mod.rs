@@ -45,6 +45,31 @@ mod synth;
 pub struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Directory of the film-table cache [default: $ROTOR_TWIN_CACHE_DIR, else
+    /// $XDG_CACHE_HOME/rotor-twin, else ~/.cache/rotor-twin].
+    #[arg(long, global = true, value_name = "DIR")]
+    film_cache_dir: Option<std::path::PathBuf>,
+    /// Build the film tables at every start, without reading or writing the cache.
+    #[arg(long, global = true)]
+    no_film_cache: bool,
+}
+
+/// The film-table cache the command line asks for (None: off, or no directory to put it in).
+fn film_cache(cli: &Cli) -> Option<crate::film::TableCache> {
+    if cli.no_film_cache {
+        return None;
+    }
+    let dir = cli
+        .film_cache_dir
+        .clone()
+        .or_else(crate::film::TableCache::default_dir);
+    if dir.is_none() {
+        eprintln!(
+            "warning: no film-table cache directory (set ROTOR_TWIN_CACHE_DIR, XDG_CACHE_HOME or \
+             HOME, or --film-cache-dir): tables are built at every start"
+        );
+    }
+    dir.map(crate::film::TableCache::new)
 }
 
 #[derive(Debug, Subcommand)]
@@ -77,6 +102,7 @@ enum Command {
 /// Runs the command line; with no subcommand, the main job: the shipped sample bag replayed on
 /// the built-in default machine.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    crate::film::set_disk_cache(film_cache(&cli));
     match run_command(cli) {
         Err(e) if e.downcast_ref::<StdoutClosed>().is_some() => Ok(()),
         result => result,

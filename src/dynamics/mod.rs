@@ -52,17 +52,23 @@ pub enum FilmEvaluation {
     Table,
 }
 
-/// Builds (or finds) the film tables of every plain finite-film bearing of `rotor`, so that a
-/// twin with [`FilmEvaluation::Table`] starts without delay.
-pub fn prepare_film_tables(rotor: &crate::rotor::Rotor) -> Result<(), crate::film::FilmError> {
+/// Builds (or finds: in the process, in the disk cache) the film tables of every plain
+/// finite-film bearing of `rotor`, so that a twin with [`FilmEvaluation::Table`] starts without
+/// delay; where each came from, bearing by bearing.
+pub fn prepare_film_tables(
+    rotor: &crate::rotor::Rotor,
+) -> Result<Vec<crate::film::TableOrigin>, crate::film::FilmError> {
+    let mut origins = Vec::new();
     for b in &rotor.bearings {
         if let crate::rotor::BearingModel::Film(f) = &b.model {
             if !f.short && f.geometry.grooves.is_empty() {
-                crate::film::FilmTable::shared(&f.geometry, f.lubricant, f.grid)?;
+                let (_, origin) =
+                    crate::film::FilmTable::shared_with_origin(&f.geometry, f.lubricant, f.grid)?;
+                origins.push(origin);
             }
         }
     }
-    Ok(())
+    Ok(origins)
 }
 
 /// Settings of the twin core.

@@ -31,6 +31,10 @@ pub use error::FilmError;
 pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
 pub use short::ShortFilm;
+pub use table::{
+    disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,
+    FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,
+};
 pub use table::{FilmTable, TabulatedFilm};
 
 /// Position and velocity of the journal centre relative to the bearing centre, and its speed.

@@ -145,6 +145,7 @@ fn domain_id() -> anyhow::Result<u16> {
 
 /// Runs the node until SIGINT or SIGTERM.
 pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
+    let started = std::time::Instant::now();
     let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
     let mut params = NodeParams::default();
     for (k, v) in &ros.params {
@@ -152,22 +153,58 @@ pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     }
     let desc = MachineDescription::load(setup.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
-    if params.film == crate::dynamics::FilmEvaluation::Table
-        && params.model != crate::driver::ModelKind::Linear
-    {
-        // the film tables are built before the node joins the bus, so that the first speed
-        // starts the twin at once
-        if ros.log_level <= LogLevel::Info {
-            eprintln!("rotor_twin: tabulating the bearing films…");
-        }
-        crate::dynamics::prepare_film_tables(&rotor)?;
-    }
+    prepare_tables(&params, &ros, &rotor)?;
     let domain = domain_id()?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(1)
         .enable_all()
         .build()?;
-    runtime.block_on(run_async(setup, ros, params, rotor, domain))
+    runtime.block_on(run_async(setup, ros, params, rotor, domain, started))
+}
+
+/// The film tables, before the node joins the bus (so that the first speed starts the twin at
+/// once): from the cache (`film_cache`, `film_cache_dir`) or built and stored there.
+fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::Result<()> {
+    if !params.film_cache {
+        crate::film::set_disk_cache(None);
+    } else if !params.film_cache_dir.is_empty() {
+        let dir = crate::film::TableCache::new(&params.film_cache_dir);
+        crate::film::set_disk_cache(Some(dir));
+    }
+    if params.film != crate::dynamics::FilmEvaluation::Table
+        || params.model == crate::driver::ModelKind::Linear
+    {
+        return Ok(());
+    }
+    let info = ros.log_level <= LogLevel::Info;
+    if info {
+        let cache = crate::film::disk_cache().map(|c| c.dir().display().to_string());
+        eprintln!(
+            "rotor_twin: film tables (cache: {}): read, or built in about 11 s on 2 idle cores…",
+            cache.as_deref().unwrap_or("off")
+        );
+    }
+    let start = std::time::Instant::now();
+    let origins = crate::dynamics::prepare_film_tables(rotor)?;
+    if info {
+        let said: Vec<String> = origins
+            .iter()
+            .map(|o| match o {
+                crate::film::TableOrigin::InProcess => "shared".to_string(),
+                crate::film::TableOrigin::Loaded(p) => format!("loaded from {}", p.display()),
+                crate::film::TableOrigin::Built(Some(p)) => {
+                    format!("built, stored in {}", p.display())
+                }
+                crate::film::TableOrigin::Built(None) => "built, not cached".to_string(),
+            })
+            .collect();
+        eprintln!(
+            "rotor_twin: film tables ready in {:.2} s ({})",
+            start.elapsed().as_secs_f64(),
+            said.join("; ")
+        );
+    }
+    Ok(())
 }
 
 async fn run_async(
@@ -176,6 +213,7 @@ async fn run_async(
     params: NodeParams,
     rotor: Rotor,
     domain: u16,
+    started: std::time::Instant,
 ) -> anyhow::Result<()> {
     let context = dds_context(domain)?;
     // parameters that may change at run time are shared with the model thread
@@ -234,8 +272,9 @@ async fn run_async(
     });
     if ros.log_level <= LogLevel::Info {
         eprintln!(
-            "rotor_twin: node {} up on ROS domain {domain}; waiting for {}",
+            "rotor_twin: node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
             ros.fully_qualified_name(),
+            started.elapsed().as_secs_f64(),
             speed_topic_label(&ros)
         );
     }
@@ -426,6 +465,8 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
         ("speed_unit", text(params.speed_unit.to_string())),
         ("probe_point_topics", text(probe_points)),
         ("use_sim_time", ParameterValue::Boolean(params.use_sim_time)),
+        ("film_cache", ParameterValue::Boolean(params.film_cache)),
+        ("film_cache_dir", text(params.film_cache_dir.clone())),
         (
             "warning_amplitude_ratio",
             ParameterValue::Double(params.warning_amplitude_ratio),

@@ -70,6 +70,13 @@ pub struct NodeParams {
     pub warning_amplitude_ratio: f64,
     /// `probe_point_topics`: probe pairs as geometry_msgs/PointStamped, `station=topic,…`.
     pub probe_point_topics: Vec<(String, String)>,
+    /// `film_cache`: read and store the film tables in the cache directory (false: build them
+    /// at every start).
+    pub film_cache: bool,
+    /// `film_cache_dir`: the film-table cache directory; empty for the command line's (its
+    /// `--film-cache-dir`, else $ROTOR_TWIN_CACHE_DIR, $XDG_CACHE_HOME/rotor-twin,
+    /// ~/.cache/rotor-twin).
+    pub film_cache_dir: String,
 }
 
 impl Default for NodeParams {
@@ -90,6 +97,8 @@ impl Default for NodeParams {
             use_sim_time: false,
             warning_amplitude_ratio: session.warning_amplitude_ratio,
             probe_point_topics: Vec::new(),
+            film_cache: true,
+            film_cache_dir: String::new(),
         }
     }
 }
@@ -169,20 +178,21 @@ impl NodeParams {
                     .parse()
                     .map_err(|e| format!("parameter speed_unit: {e}"))?
             }
-            "use_sim_time" => {
-                self.use_sim_time = match value {
-                    "true" | "True" | "1" => true,
-                    "false" | "False" | "0" => false,
-                    _ => {
-                        return Err(format!(
-                            "parameter use_sim_time: '{value}' must be true or false"
-                        ))
-                    }
-                }
-            }
+            "use_sim_time" => self.use_sim_time = boolean(name, value)?,
+            "film_cache" => self.film_cache = boolean(name, value)?,
+            "film_cache_dir" => self.film_cache_dir = value.trim().to_string(),
             _ => return Err(format!("unknown parameter '{name}'")),
         }
         Ok(())
+    }
+}
+
+/// A boolean parameter's value.
+fn boolean(name: &str, value: &str) -> Result<bool, String> {
+    match value.trim() {
+        "true" | "True" | "1" => Ok(true),
+        "false" | "False" | "0" => Ok(false),
+        _ => Err(format!("parameter {name}: '{value}' must be true or false")),
     }
 }
 

@@ -87,6 +87,7 @@ pub fn short_bearing_coefficients(e: f64) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
 pub fn run_cli(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
         .args(args)
+        .env("ROTOR_TWIN_CACHE_DIR", test_cache_dir())
         .output()
         .expect("run rotor-twin");
     (
@@ -94,6 +95,12 @@ pub fn run_cli(args: &[&str]) -> (bool, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// The film-table cache of the CLI runs of the tests: in the build's own temporary directory
+/// (never the user's home), shared by the test runs.
+pub fn test_cache_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("film-cache")
 }
 
 /// The interop venv (created on first use by tests/interop/setup-venv.sh).

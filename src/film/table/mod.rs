@@ -24,13 +24,27 @@ use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
 
+mod cache;
 mod tabulated;
+pub use cache::{
+    disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,
+    FORMAT_VERSION, SOLVER_VERSION,
+};
 pub use tabulated::TabulatedFilm;
 
 /// Table nodes along u = −ln(1 − ε), from ε = 0 to [`MAX_ECCENTRICITY_RATIO`].
 const N_ECC: usize = 160;
 /// Table nodes around ψ (periodic).
 const N_PSI: usize = 192;
+/// Largest ε of the solves on the last row (the row itself sits at [`MAX_ECCENTRICITY_RATIO`]).
+const ROW_ECC_CAP: f64 = 0.9989;
+/// The source of everything that computes a table's numbers: part of the cache key.
+const TABLE_SOURCES: [&str; 4] = [
+    include_str!("../finite.rs"),
+    include_str!("../finite/outputs.rs"),
+    include_str!("../banded.rs"),
+    include_str!("mod.rs"),
+];
 
 /// Quantities tabulated at each node, per unit V (1/s) unless said otherwise.
 #[derive(Debug, Clone, Copy, Default)]
@@ -59,6 +73,9 @@ type Row = (usize, Vec<Node>, Vec<f64>);
 /// The film functions of one bearing over (ε, ψ).
 pub struct FilmTable {
     geometry: BearingGeometry,
+    /// The lubricant and grid it was built with (its cache key, with the geometry).
+    lubricant: Lubricant,
+    grid: FilmGrid,
     nodes: Vec<Node>,
     /// mid-plane pressure per unit V at the grid's n_θ angles from the line of centres (Pa·s)
     profiles: Vec<f64>,
@@ -68,25 +85,54 @@ pub struct FilmTable {
 
 impl FilmTable {
     /// The table of a plain bearing (no grooves) on `grid`, shared between all users of the same
-    /// bearing in this process: built on first use (about N_ECC × N_PSI × 2 film solves, on all
-    /// cores), then reused.
+    /// bearing in this process: on first use read from the disk cache ([`set_disk_cache`]) or
+    /// built (N_ECC × N_PSI × 9 film solves, on all cores) and stored there, then reused.
     pub fn shared(
         geometry: &BearingGeometry,
         lubricant: Lubricant,
         grid: FilmGrid,
     ) -> Result<Arc<FilmTable>, FilmError> {
+        Self::shared_with_origin(geometry, lubricant, grid).map(|(t, _)| t)
+    }
+
+    /// [`FilmTable::shared`], saying where the table came from. Cache problems are printed to
+    /// standard error as warnings (and the table built); they are never errors.
+    pub fn shared_with_origin(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+    ) -> Result<(Arc<FilmTable>, TableOrigin), FilmError> {
         static CACHE: OnceLock<Mutex<HashMap<String, Arc<FilmTable>>>> = OnceLock::new();
         let key = format!("{geometry:?}|{lubricant:?}|{grid:?}");
         let cache = CACHE.get_or_init(Default::default);
         if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(t.clone());
+            return Ok((t.clone(), TableOrigin::InProcess));
         }
-        let table = Arc::new(Self::build(geometry, lubricant, grid)?);
+        let (table, origin) = match disk_cache() {
+            Some(disk) => disk.load_or_build(geometry, lubricant, grid, &mut |w| {
+                eprintln!("rotor-twin: warning: {w}")
+            })?,
+            None => (
+                Self::build(geometry, lubricant, grid)?,
+                TableOrigin::Built(None),
+            ),
+        };
+        let table = Arc::new(table);
         cache
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .insert(key, table.clone());
-        Ok(table)
+        Ok((table, origin))
+    }
+
+    /// Every tabulated number (the nodes' values, then the mid-plane profiles), in the cache
+    /// file's order: for comparing two tables bit for bit.
+    pub fn values(&self) -> Vec<f64> {
+        self.nodes
+            .iter()
+            .flat_map(cache::node_values)
+            .chain(self.profiles.iter().copied())
+            .collect()
     }
 
     /// Builds the table with the direct solver.
@@ -118,7 +164,7 @@ impl FilmTable {
                         for &i in chunk.iter() {
                             let eps = 1.0 - (-(i as f64) * u_max / (N_ECC - 1) as f64).exp();
                             let (nodes, profiles) =
-                                row(&mut film, &geometry, eps.min(0.9989), n_theta)?;
+                                row(&mut film, &geometry, eps.min(ROW_ECC_CAP), n_theta)?;
                             out.push((i, nodes, profiles));
                         }
                         Ok(out)
@@ -141,6 +187,8 @@ impl FilmTable {
         }
         Ok(FilmTable {
             geometry: geometry.clone(),
+            lubricant,
+            grid,
             nodes,
             profiles,
             n_theta,
