@@ -18,9 +18,9 @@ pa=$!
 timeout 60 "$py" "$here/peer.py" 6 890.12 --ns /line2 > "$out/peer_b.json" 2> "$out/peer_b.err"
 wait "$pa"
 {
-  "$bin" param --node /line1/twin_a --timeout 10 set state_rate_hz:=50; echo "rc=$?"
-  "$bin" param --node /line1/twin_a --timeout 10 get state_rate_hz; echo "rc=$?"
-  "$bin" param --node /line2/twin_b --timeout 10 get state_rate_hz; echo "rc=$?"
+  "$bin" param --node /line1/twin_a --timeout 30 set state_rate_hz:=50; echo "rc=$?"
+  "$bin" param --node /line1/twin_a --timeout 30 get state_rate_hz; echo "rc=$?"
+  "$bin" param --node /line2/twin_b --timeout 30 get state_rate_hz; echo "rc=$?"
 } > "$out/param.out" 2>&1
 kill -INT "$a" "$b"
 wait "$a"; echo "node exit $?" >> "$out/a.err"
