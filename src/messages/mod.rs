@@ -6,7 +6,7 @@
 mod standard;
 
 pub use standard::{
-    Clock, DiagnosticArray, DiagnosticStatus, Float64, KeyValue, Point, PointStamped,
+    Clock, DiagnosticArray, DiagnosticStatus, Float64, KeyValue, Point, PointStamped, Temperature,
 };
 
 use serde::{Deserialize, Serialize};
