@@ -30,8 +30,8 @@ pub use modal::{
 };
 pub use statics::{static_solution, StaticSolution};
 pub use unbalance_response::{
-    required_separation_margin_pct, response_peaks, response_stations, unbalance_response,
-    ResponsePeak, Station, StationResponse, UnbalanceResponse,
+    influence_coefficients, required_separation_margin_pct, response_peaks, response_stations,
+    unbalance_response, ResponsePeak, Station, StationResponse, UnbalanceResponse,
 };
 
 use crate::film::{
