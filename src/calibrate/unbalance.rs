@@ -148,7 +148,7 @@ fn solve(
                 .sqrt()
         })
         .collect();
-    if norms.iter().any(|n| !(*n > 0.0)) {
+    if norms.iter().any(|n| n.is_nan() || *n <= 0.0) {
         return Err(CalibrationError::Singular(
             "a plane moves no probe at these speeds".into(),
         ));
