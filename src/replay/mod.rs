@@ -5,6 +5,7 @@
 //! so a replay predicts what the node would have published, and two replays of one bag are
 //! identical.
 
+pub mod calibration;
 pub mod compare;
 mod report;
 
