@@ -5,6 +5,7 @@
 //! SI units everywhere inside; names carry the unit where it is not SI.
 
 pub mod bag;
+pub mod calibrate;
 pub mod cli;
 pub mod driver;
 pub mod dynamics;

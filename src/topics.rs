@@ -7,6 +7,8 @@ use crate::record::TopicQos;
 pub const SPEED: &str = "/rotor_twin/speed";
 /// Residual unbalance in (rotor_twin_msgs/Unbalance).
 pub const UNBALANCE: &str = "/rotor_twin/unbalance";
+/// Oil supply temperature in (sensor_msgs/Temperature, °C), best effort (a sensor).
+pub const OIL_TEMPERATURE: &str = "/rotor_twin/oil_temperature";
 /// Measured probe displacements in (rotor_twin_msgs/ProbeDisplacement).
 pub const PROBE: &str = "/rotor_twin/probe";
 /// Predicted minus measured at a probe station, out.

@@ -60,9 +60,46 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
         "must name an entry of materials",
     );
     says(
-        &error_of(&with("viscosity_pa_s: 0.0008}", "viscosity_pa_s: .nan}")),
+        &error_of(&with("viscosity_pa_s: 0.0008\n", "viscosity_pa_s: .nan\n")),
         "bearings[0].lubricant.viscosity_pa_s",
         "NaN",
+        "finite",
+    );
+    // the viscosity–temperature law (issue 12): points, range, agreement at the design point
+    says(
+        &error_of(&with(
+            "kinematic_viscosities_mm2_s: [0.889, 0.60]",
+            "kinematic_viscosities_mm2_s: [0.60, 0.889]",
+        )),
+        "bearings[0].lubricant.viscosity_temperature.(law)",
+        "[0.6, 0.889]",
+        "must fall as the temperature rises",
+    );
+    says(
+        &error_of(&with(
+            "kinematic_viscosities_mm2_s: [0.889, 0.60]",
+            "kinematic_viscosities_mm2_s: [0.95, 0.60]",
+        )),
+        "bearings[0].lubricant.viscosity_temperature.kinematic_viscosities_mm2_s",
+        "[0.95, 0.6]",
+        "agree within 1 %",
+    );
+    says(
+        &error_of(&with(
+            "design_supply_temperature_c: 40.0",
+            "design_supply_temperature_c: 150.0",
+        )),
+        "bearings[0].lubricant.viscosity_temperature.design_supply_temperature_c",
+        "150",
+        "inside valid_range_c",
+    );
+    says(
+        &error_of(&with(
+            "valid_range_c: [10.0, 120.0]",
+            "valid_range_c: [.nan, 120.0]",
+        )),
+        "bearings[0].lubricant.viscosity_temperature.(law)",
+        "range",
         "finite",
     );
     says(

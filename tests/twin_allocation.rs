@@ -1,6 +1,7 @@
 //! The guide's rule "the time step allocates nothing", checked with a counting allocator: after
 //! the twin is built, a thousand steps of the microturbine (direct and tabulated film, in oil
-//! whip with wall contact for the tabulated one) make no heap allocation.
+//! whip with wall contact for the tabulated one) make no heap allocation, a change of the films'
+//! viscosity (a live oil temperature) among them.
 
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::rotor::{MachineDescription, Rotor};
@@ -43,7 +44,12 @@ fn allocations_in_steps(film: FilmEvaluation, warmup: usize, steps: usize) -> us
         twin.step(&input).unwrap();
     }
     let before = ALLOCATIONS.load(Ordering::SeqCst);
-    for _ in 0..steps {
+    for k in 0..steps {
+        if k % 250 == 100 {
+            // a live oil temperature changes the films' viscosity (issue 12): no allocation
+            twin.set_viscosity_scale(if k % 500 == 100 { 1.05 } else { 1.0 })
+                .unwrap();
+        }
         twin.step(&input).unwrap();
     }
     ALLOCATIONS.load(Ordering::SeqCst) - before

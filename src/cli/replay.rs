@@ -69,6 +69,32 @@ pub struct ReplayArgs {
     /// Print the JSON report to standard output instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Fit the oil viscosity and the unbalance to the bag first (issue 12), then replay with the
+    /// machine file's values and with the fitted ones, and compare.
+    #[arg(long)]
+    pub calibrate: bool,
+    /// Bag time the fit uses, START:END (s from the bag's first message; default the whole bag;
+    /// windows with non-synchronous motion are left out).
+    #[arg(long, value_parser = parse_window, requires = "calibrate")]
+    pub calibrate_window: Option<(f64, f64)>,
+}
+
+fn parse_window(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("--calibrate-window '{s}': expected START:END (s)"))?;
+    let (a, b): (f64, f64) = (
+        a.trim()
+            .parse()
+            .map_err(|e| format!("--calibrate-window start '{a}': {e}"))?,
+        b.trim()
+            .parse()
+            .map_err(|e| format!("--calibrate-window end '{b}': {e}"))?,
+    );
+    if !(a.is_finite() && b.is_finite() && 0.0 <= a && a < b) {
+        return Err(format!("--calibrate-window '{s}': needs 0 <= START < END"));
+    }
+    Ok((a, b))
 }
 
 fn parse_remap(s: &str) -> Result<(String, String), String> {
@@ -176,6 +202,9 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     };
     crate::replay::check_mapping(&bag, &rotor, &options)?;
     prepare_out_dir(&out_dir)?;
+    if args.calibrate {
+        return run_calibrated(args, &bag, &rotor, &options, &out_dir);
+    }
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -276,3 +305,107 @@ fn prepare_out_dir(dir: &Path) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+// --- calibration from measurements (issue 12) ---
+
+/// `--calibrate`: fit on the bag, replay before (machine file) and after (fitted values), write
+/// `calibration.json` (estimates and both reports) and print the comparison.
+fn run_calibrated(
+    args: &ReplayArgs,
+    bag: &Bag,
+    rotor: &Rotor,
+    options: &ReplayOptions,
+    out_dir: &Path,
+) -> anyhow::Result<()> {
+    let span = bag
+        .time_span_ns()
+        .map_or(0.0, |(a, b)| (b - a) as f64 * 1e-9);
+    let window = args.calibrate_window.map_or([0.0, span], |(a, b)| [a, b]);
+    let (cal, calibrated) =
+        crate::replay::calibration::calibrate_bag(bag, rotor, &options.remaps, window)
+            .context("calibration")?;
+    let (before, _) = replay(bag, rotor, options, &mut |_| {})?;
+    let mut after_options = options.clone();
+    after_options.out_bag = None;
+    // the fitted unbalance replaces the one the bag carries
+    after_options.remaps.insert(
+        0,
+        (
+            crate::topics::UNBALANCE.into(),
+            "/rotor_twin/unbalance_recorded".into(),
+        ),
+    );
+    let (after, _) = replay(bag, &calibrated, &after_options, &mut |_| {})?;
+    let json = serde_json::json!({ "calibration": cal, "before": before, "after": after });
+    let text = serde_json::to_string_pretty(&json)?;
+    std::fs::write(out_dir.join("calibration.json"), &text)?;
+    if args.json {
+        return super::print_out(&format!("{text}\n"));
+    }
+    super::print_out(&format!(
+        "{}output: {}\n",
+        calibration_summary(&cal, &before, &after),
+        out_dir.display()
+    ))
+}
+
+/// The estimates and the before/after comparison, as text.
+fn calibration_summary(
+    cal: &crate::replay::calibration::BagCalibration,
+    before: &crate::replay::ReplayReport,
+    after: &crate::replay::ReplayReport,
+) -> String {
+    let v = &cal.viscosity;
+    let mut s = format!(
+        "calibration on bag time {:.2}-{:.2} s ({} windows of {} revolutions, {} left out)\n  viscosity x{:.4} +- {:.4} of the machine file's",
+        cal.window_s[0],
+        cal.window_s[1],
+        cal.windows_used,
+        crate::replay::calibration::CALIBRATION_WINDOW_REVS,
+        cal.windows_skipped,
+        v.scale,
+        v.scale_std
+    );
+    if let (Some(t), Some(dt), Some(off)) =
+        (v.temperature_c, v.temperature_std_k, v.temperature_offset_k)
+    {
+        s += &format!(" (oil {t:.1} +- {dt:.1} degC, {off:+.1} K from the design point)");
+    }
+    s += "\n";
+    let u = &cal.unbalance;
+    for p in &u.planes {
+        s += &format!(
+            "  unbalance at node {}: {:.1} g.mm at {:.1} deg; correction {:.3} g at {:.0} mm, {:.1} deg\n",
+            p.node, p.magnitude_g_mm, p.phase_deg, p.correction.mass_g,
+            p.correction.radius_m * 1e3, p.correction.angle_deg
+        );
+    }
+    s += &format!(
+        "  1X residual {:.3} um RMS ({:.1} %), condition number {:.2}\n",
+        u.residual_rms_m * 1e6,
+        100.0 * u.relative_residual,
+        u.condition_number
+    );
+    for (b, a) in before.stations.iter().zip(&after.stations) {
+        let pct = |r: &crate::replay::StationReport| {
+            r.one_x_amplitude_error_m
+                .zip(r.one_x_amplitude_measured_m)
+                .map_or("-".into(), |(e, m)| format!("{:+.1} %", 100.0 * e / m))
+        };
+        s += &format!(
+            "  {}: 1X amplitude error before {}, after {}\n",
+            b.station,
+            pct(b),
+            pct(a)
+        );
+    }
+    let rpm = |x: Option<f64>| x.map_or("-".into(), |v| format!("{v:.0} rpm"));
+    s += &format!(
+        "  onset: observed {}, predicted before {}, after {}\n",
+        rpm(before.onset.observed_speed_rpm),
+        rpm(before.onset.predicted_speed_rpm),
+        rpm(after.onset.predicted_speed_rpm)
+    );
+    s
+}
+// --- end calibration from measurements ---

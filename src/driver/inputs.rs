@@ -107,7 +107,46 @@ pub enum Input {
         /// Header stamp (ns since the epoch; 0: unstamped).
         stamp_ns: i64,
     },
+    // --- oil supply temperature (issue 12) ---
+    /// The oil supply temperature (sensor_msgs/Temperature, °C on the wire): sets the films'
+    /// viscosity through the machine file's viscosity–temperature law.
+    OilTemperature {
+        /// Temperature (K).
+        temperature_k: f64,
+        /// Header stamp (ns since the epoch; 0: unstamped).
+        stamp_ns: i64,
+    },
+    // --- end oil supply temperature ---
 }
+
+// --- oil supply temperature (issue 12) ---
+impl From<&messages::Temperature> for Input {
+    fn from(m: &messages::Temperature) -> Self {
+        Input::OilTemperature {
+            temperature_k: m.temperature + crate::film::ZERO_CELSIUS_K,
+            stamp_ns: m.header.stamp.as_nanos(),
+        }
+    }
+}
+
+/// The viscosity scale (µ(T) / µ_reference) an oil supply temperature `t_k` (K) gives through the
+/// first film bearing's law that `rotor` has (one oil supply), or why the temperature is refused:
+/// not finite, outside the law's range, or no law in the machine file.
+pub fn oil_viscosity_scale(rotor: &Rotor, t_k: f64) -> Result<f64, String> {
+    let Some((law, reference)) = rotor.bearings.iter().find_map(|b| match &b.model {
+        crate::rotor::BearingModel::Film(f) => f.viscosity_law.map(|l| (l, f.lubricant)),
+        _ => None,
+    }) else {
+        return Err(
+            "an oil temperature needs a viscosity–temperature law (lubricant.viscosity_temperature in the machine file); this machine has none"
+                .into(),
+        );
+    };
+    let mu = law.checked_viscosity_pa_s(t_k)?;
+    let scale = mu / reference.viscosity_pa_s;
+    crate::film::check_viscosity_scale(scale).map_err(|e| format!("oil temperature: {e}"))
+}
+// --- end oil supply temperature ---
 
 impl From<&messages::RotorSpeed> for Input {
     fn from(m: &messages::RotorSpeed) -> Self {

@@ -96,6 +96,8 @@ pub struct Driver {
     last_refusal_warning_ns: Option<i64>,
     last_refusal: String,
     counts: DriverCounts,
+    /// the last accepted oil supply temperature (K)
+    oil_temperature_k: Option<f64>,
 }
 
 impl Driver {
@@ -119,6 +121,7 @@ impl Driver {
             last_refusal_warning_ns: None,
             last_refusal: String::new(),
             counts: DriverCounts::default(),
+            oil_temperature_k: None,
         }
     }
 
@@ -207,6 +210,7 @@ impl Driver {
                 y_m,
                 stamp_ns,
             } => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+            Input::OilTemperature { temperature_k, .. } => self.take_oil_temperature(temperature_k),
         };
         if let Fed::Refused(why) = &fed {
             self.note_refused(now_ns, why, emit);
@@ -324,6 +328,37 @@ impl Driver {
         self.counts.starts += 1;
         Fed::Started { speed_rad_s: w }
     }
+
+    // --- oil supply temperature (issue 12) ---
+    /// An oil supply temperature (K): the viscosity scale of its law, applied to the running
+    /// twin and kept for later starts; a refused one leaves the last good value in force.
+    fn take_oil_temperature(&mut self, t_k: f64) -> Fed {
+        let scale = match inputs::oil_viscosity_scale(&self.rotor, t_k) {
+            Ok(s) => s,
+            Err(why) => return Fed::Refused(why),
+        };
+        if let Err(e) = self.rotor.set_viscosity_scale(scale) {
+            return Fed::Refused(format!("oil temperature: {e}"));
+        }
+        if let Some(s) = self.session.as_mut() {
+            if let Err(e) = s.twin_mut().set_viscosity_scale(scale) {
+                return Fed::Refused(format!("oil temperature: {e}"));
+            }
+        }
+        self.oil_temperature_k = Some(t_k);
+        Fed::Taken
+    }
+
+    /// The last accepted oil supply temperature (K), if any.
+    pub fn oil_temperature_k(&self) -> Option<f64> {
+        self.oil_temperature_k
+    }
+
+    /// The viscosity scale in force (µ / µ_reference of the machine file).
+    pub fn viscosity_scale(&self) -> f64 {
+        self.rotor.viscosity_scale()
+    }
+    // --- end oil supply temperature ---
 
     fn take_unbalance(&mut self, plane: u32, me: f64, phase: f64) -> Fed {
         match check_unbalance(plane, me, phase, self.limits.planes) {

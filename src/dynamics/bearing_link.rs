@@ -1,7 +1,9 @@
 //! A film bearing inside the time step: the film force on the journal, its stiffness and damping,
 //! and the contact with the bearing wall when the film can no longer hold the journal.
 
-use crate::film::{FilmCoefficients, FilmError, FilmModel, FilmResult, JournalKinematics};
+use crate::film::{
+    FilmCoefficients, FilmError, FilmModel, FilmResult, JournalKinematics, ViscosityScaledFilm,
+};
 
 /// Contact with the bearing wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,8 +66,11 @@ pub(crate) struct BearingLink {
     pub b_offset: usize,
     pub clearance_m: f64,
     pub radius_m: f64,
+    /// The reference viscosity the film is solved at (Pa·s); the running one is
+    /// [`viscosity`](Self::viscosity).
     pub viscosity_pa_s: f64,
-    pub film: Box<dyn FilmModel + Send>,
+    /// The film, scaled to the running viscosity.
+    pub film: ViscosityScaledFilm,
     /// Linear coupling: the static equilibrium (relative position, film force) and its coefficients.
     pub linear_reference: Option<LinearReference>,
     /// Prehistory: the raw coefficients of the previous step, c(k−1) of seed eq. 8.
@@ -75,6 +80,11 @@ pub(crate) struct BearingLink {
 }
 
 impl BearingLink {
+    /// The running viscosity (Pa·s).
+    pub fn viscosity(&self) -> f64 {
+        self.viscosity_pa_s * self.film.scale()
+    }
+
     /// Number of condensed DOFs of this bearing (journal, and pedestal if any).
     pub fn width(&self) -> usize {
         if self.pedestal.is_some() {

@@ -21,6 +21,7 @@ mod finite;
 mod geometry;
 mod short;
 mod table;
+mod viscosity;
 
 pub use coefficients::FilmCoefficients;
 pub use equilibrium::{
@@ -36,6 +37,10 @@ pub use table::{
     FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,
 };
 pub use table::{FilmTable, TabulatedFilm};
+pub use viscosity::{
+    check_viscosity_scale, ViscosityScaledFilm, WaltherLaw, MAX_VISCOSITY_SCALE,
+    MIN_VISCOSITY_SCALE, ZERO_CELSIUS_K,
+};
 
 /// Position and velocity of the journal centre relative to the bearing centre, and its speed.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -7,7 +7,7 @@ mod standard;
 pub mod type_hash;
 
 pub use standard::{
-    Clock, DiagnosticArray, DiagnosticStatus, Float64, KeyValue, Point, PointStamped,
+    Clock, DiagnosticArray, DiagnosticStatus, Float64, KeyValue, Point, PointStamped, Temperature,
 };
 
 use serde::{Deserialize, Serialize};

@@ -128,3 +128,31 @@ impl RosMessage for DiagnosticArray {
         ("status", "DiagnosticStatus[]"),
     ];
 }
+
+// --- oil supply temperature (issue 12) ---
+
+/// sensor_msgs/Temperature: the oil supply temperature (°C on the wire, as the type defines it).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Temperature {
+    /// Time and frame.
+    pub header: Header,
+    /// Temperature (°C).
+    pub temperature: f64,
+    /// Variance (°C²); 0: unknown.
+    pub variance: f64,
+}
+
+impl RosMessage for Temperature {
+    const TYPE_NAME: &'static str = "sensor_msgs/msg/Temperature";
+    const DEFINITION: &'static str =
+        "std_msgs/Header header\nfloat64 temperature\nfloat64 variance\n";
+    const DEPENDENCIES: &'static [(&'static str, &'static str)] = &[
+        ("std_msgs/Header", HEADER_DEFINITION),
+        ("builtin_interfaces/Time", TIME_DEFINITION),
+    ];
+    const FIELDS: &'static [(&'static str, &'static str)] = &[
+        ("header", "std_msgs/Header"),
+        ("temperature", "float64"),
+        ("variance", "float64"),
+    ];
+}

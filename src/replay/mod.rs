@@ -5,6 +5,7 @@
 //! so a replay predicts what the node would have published, and two replays of one bag are
 //! identical.
 
+pub mod calibration;
 pub mod compare;
 mod report;
 
@@ -136,6 +137,8 @@ enum Role {
     Unbalance,
     Probe,
     ProbePoint(usize),
+    /// sensor_msgs/Temperature on the oil temperature topic (issue 12).
+    OilTemperature,
     Other,
 }
 
@@ -288,6 +291,7 @@ fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, 
         Role::Unbalance => Input::from(&from_cdr::<messages::Unbalance>(payload)?),
         Role::Probe => Input::from(&from_cdr::<messages::ProbeDisplacement>(payload)?),
         Role::ProbePoint(k) => Input::probe_point(&from_cdr::<messages::PointStamped>(payload)?, k),
+        Role::OilTemperature => Input::from(&from_cdr::<messages::Temperature>(payload)?),
         Role::Other => return Ok(None),
     }))
 }
@@ -349,6 +353,11 @@ fn map_topics(
                 return Err(wrong(messages::ProbeDisplacement::TYPE_NAME));
             }
             Role::Probe
+        } else if name == crate::topics::OIL_TEMPERATURE {
+            if t.type_name != messages::Temperature::TYPE_NAME {
+                return Err(wrong(messages::Temperature::TYPE_NAME));
+            }
+            Role::OilTemperature
         } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| *tp == name) {
             if t.type_name != messages::PointStamped::TYPE_NAME {
                 return Err(wrong(messages::PointStamped::TYPE_NAME));

@@ -7,6 +7,8 @@
 //! - in  `/rotor_twin/unbalance` rotor_twin_msgs/Unbalance, reliable;
 //! - in  `/rotor_twin/probe` rotor_twin_msgs/ProbeDisplacement (m), best effort;
 //!   out `/rotor_twin/residual` OrbitResidual: predicted minus measured at that station;
+//! - in  `/rotor_twin/oil_temperature` sensor_msgs/Temperature (°C), best effort: the films' viscosity
+//!   through the machine file's viscosity–temperature law (issue 12);
 //! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
@@ -591,6 +593,15 @@ fn subscribe_inputs(
         |m| Ok(Input::from(m)),
         ToRecord::Probe,
     )?;
+    // --- oil supply temperature (issue 12): sensor_msgs/Temperature (°C), best effort ---
+    route.subscribe::<messages::Temperature>(
+        node,
+        &topic_name(ros, crate::topics::OIL_TEMPERATURE)?,
+        qos::SENSOR_READER,
+        |m| Ok(Input::from(m)),
+        ToRecord::Temperature,
+    )?;
+    // --- end oil supply temperature ---
     // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
     for (i, (station, topic_text)) in params.probe_point_topics.iter().enumerate() {
         let k = rotor

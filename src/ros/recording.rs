@@ -23,6 +23,8 @@ pub(super) enum ToRecord {
     Probe(messages::ProbeDisplacement, i64),
     /// A PointStamped probe pair of the `usize`-th `probe_point_topics` entry.
     Point(usize, messages::PointStamped, i64),
+    /// The oil supply temperature (issue 12).
+    Temperature(messages::Temperature, i64),
 }
 
 /// Starts recording to bag directory `dir` what arrives on `rx` (the speed as std_msgs/Float64
@@ -51,6 +53,7 @@ pub(super) fn spawn(
     let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input)?;
     let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos::STATE)?;
     let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, qos::MARGIN_QOS)?;
+    let h_oil = rec.add_topic::<messages::Temperature>(crate::topics::OIL_TEMPERATURE, input)?;
     let h_points = points
         .iter()
         .map(|(_, topic)| rec.add_topic::<messages::PointStamped>(topic, input))
@@ -66,6 +69,7 @@ pub(super) fn spawn(
                         ToRecord::Unbalance(m, ns) => rec.write(h_unb, m, t(ns), t(ns))?,
                         ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
                         ToRecord::Point(i, m, ns) => rec.write(h_points[*i], m, t(ns), t(ns))?,
+                        ToRecord::Temperature(m, ns) => rec.write(h_oil, m, t(ns), t(ns))?,
                         ToRecord::Out(o, ns) => match o {
                             Outgoing::Journal(m) => rec.write(h_journal, m, t(ns), t(ns))?,
                             Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,

@@ -151,9 +151,113 @@ pub enum GroovesSpec {
 pub struct LubricantSpec {
     /// Density ρ (kg/m³).
     pub density_kg_m3: f64,
-    /// Dynamic viscosity µ (Pa·s).
+    /// Dynamic viscosity µ (Pa·s); with a `viscosity_temperature` law, at its design supply
+    /// temperature (the viscosity the films are solved, and tabulated, at).
     pub viscosity_pa_s: f64,
+    /// Optional viscosity–temperature law: an oil temperature received on the bus then sets the
+    /// viscosity of the running twin's films.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscosity_temperature: Option<ViscosityTemperatureSpec>,
 }
+
+// --- oil supply temperature (issue 12) ---
+
+/// Walther's viscosity–temperature law (ASTM D341-09) through two kinematic viscosities, with
+/// the lubricant's density (`crate::film::WaltherLaw`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViscosityTemperatureSpec {
+    /// The two temperatures of the measured viscosities (°C).
+    pub temperatures_c: [f64; 2],
+    /// Kinematic viscosities there (mm²/s = cSt), at least 0.21 (D341-09's range).
+    pub kinematic_viscosities_mm2_s: [f64; 2],
+    /// The design oil supply temperature (°C), where the law must give `viscosity_pa_s` within 1 %.
+    pub design_supply_temperature_c: f64,
+    /// Oil temperatures accepted (°C), lowest and highest; others are refused as bad input.
+    pub valid_range_c: [f64; 2],
+}
+
+/// How far the law may miss `viscosity_pa_s` at the design supply temperature (relative).
+pub const LAW_DESIGN_TOLERANCE: f64 = 0.01;
+
+impl ViscosityTemperatureSpec {
+    /// The law, with density `density_kg_m3` (kg/m³), or the broken rule.
+    pub fn law(&self, density_kg_m3: f64) -> Result<crate::film::WaltherLaw, String> {
+        let k = |c: f64| c + crate::film::ZERO_CELSIUS_K;
+        if let Some(bad) = self
+            .valid_range_c
+            .iter()
+            .chain(&self.temperatures_c)
+            .chain([&self.design_supply_temperature_c])
+            .find(|t| !(t.is_finite() && (-100.0..=500.0).contains(*t)))
+        {
+            return Err(format!(
+                "temperature {bad} °C must be finite, between -100 and 500 °C"
+            ));
+        }
+        let [t1, t2] = self.temperatures_c;
+        let [nu1, nu2] = self.kinematic_viscosities_mm2_s;
+        crate::film::WaltherLaw::through(
+            [(k(t1), nu1), (k(t2), nu2)],
+            density_kg_m3,
+            self.valid_range_c.map(k),
+        )
+    }
+}
+
+impl MachineDescription {
+    /// Checks every bearing's viscosity–temperature law: valid points and range, the design
+    /// supply temperature inside the range, and `viscosity_pa_s` there within 1 %.
+    fn validate_viscosity_laws(&self, file: &str) -> Result<(), ConfigError> {
+        for (i, b) in self.bearings.iter().enumerate() {
+            let Some(lub) = b.lubricant else { continue };
+            let Some(spec) = lub.viscosity_temperature else {
+                continue;
+            };
+            let field =
+                |name: &str| format!("bearings[{i}].lubricant.viscosity_temperature.{name}");
+            let err = |field: String, value: String, rule: String| ConfigError {
+                file: file.to_string(),
+                field,
+                value,
+                rule,
+            };
+            let law = spec.law(lub.density_kg_m3).map_err(|rule| {
+                err(
+                    field("(law)"),
+                    format!(
+                        "{:?} °C, {:?} mm²/s, range {:?} °C",
+                        spec.temperatures_c, spec.kinematic_viscosities_mm2_s, spec.valid_range_c
+                    ),
+                    rule,
+                )
+            })?;
+            let td = spec.design_supply_temperature_c;
+            let [lo, hi] = spec.valid_range_c;
+            if td < lo || td > hi {
+                return Err(err(
+                    field("design_supply_temperature_c"),
+                    td.to_string(),
+                    format!("must lie inside valid_range_c [{lo}, {hi}] °C"),
+                ));
+            }
+            let mu = law.viscosity_pa_s(td + crate::film::ZERO_CELSIUS_K);
+            if (mu / lub.viscosity_pa_s - 1.0).abs() > LAW_DESIGN_TOLERANCE {
+                return Err(err(
+                    field("kinematic_viscosities_mm2_s"),
+                    format!("{:?}", spec.kinematic_viscosities_mm2_s),
+                    format!(
+                        "the law gives {mu:.4e} Pa·s at the design supply temperature {td} °C; bearings[{i}].lubricant.viscosity_pa_s is {:.4e}: they must agree within 1 %",
+                        lub.viscosity_pa_s
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+// --- end oil supply temperature ---
 
 /// A bearing at a shaft node.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -554,6 +658,7 @@ impl MachineDescription {
                 ));
             }
         }
+        self.validate_viscosity_laws(file)?;
         for (i, p) in self.probes.iter().enumerate() {
             node_ok(format!("probes[{i}].node"), p.node)?;
             if p.angles_deg.iter().any(|a| !a.is_finite()) {

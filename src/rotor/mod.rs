@@ -20,7 +20,7 @@ pub use forces::unbalance_force;
 pub use machine::{
     AlarmLevelsSpec, BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec,
     MachineDescription, MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec,
-    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
+    ViscosityTemperatureSpec, DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
     campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
@@ -30,8 +30,8 @@ pub use modal::{
 };
 pub use statics::{static_solution, StaticSolution};
 pub use unbalance_response::{
-    required_separation_margin_pct, response_peaks, response_stations, unbalance_response,
-    ResponsePeak, Station, StationResponse, UnbalanceResponse,
+    influence_coefficients, required_separation_margin_pct, response_peaks, response_stations,
+    unbalance_response, ResponsePeak, Station, StationResponse, UnbalanceResponse,
 };
 
 use crate::film::{
@@ -62,11 +62,61 @@ pub struct FilmBearing {
     pub grid: FilmGrid,
     /// Short-bearing closed form instead of the finite solver.
     pub short: bool,
+    /// The oil's viscosity–temperature law, if the machine file gives one.
+    pub viscosity_law: Option<crate::film::WaltherLaw>,
+    /// The running oil's viscosity over `lubricant.viscosity_pa_s` (1: the machine file's).
+    /// The films are solved (and tabulated) at `lubricant` and scaled: exact for the isoviscous
+    /// film without supply pressure ([`crate::film::ViscosityScaledFilm`]).
+    pub viscosity_scale: f64,
 }
 
+// --- oil supply temperature (issue 12) ---
 impl FilmBearing {
-    /// A film solver for this bearing (each user owns one: it carries the warm start).
+    /// The viscosity of the running oil (Pa·s): the reference times the scale.
+    pub fn viscosity_pa_s(&self) -> f64 {
+        self.lubricant.viscosity_pa_s * self.viscosity_scale
+    }
+
+    /// A film solver at the running viscosity (each user owns one: it carries the warm start).
     pub fn solver(&self) -> Box<dyn FilmModel + Send> {
+        Box::new(self.scaled(self.reference_solver()))
+    }
+
+    /// `inner` (solved at the reference viscosity) scaled to the running one.
+    pub fn scaled(&self, inner: Box<dyn FilmModel + Send>) -> crate::film::ViscosityScaledFilm {
+        crate::film::ViscosityScaledFilm::new(inner, self.viscosity_scale)
+            .expect("the scale is checked when it is set")
+    }
+}
+
+impl Rotor {
+    /// Sets the viscosity scale (µ / µ_reference) of every film bearing (checked).
+    pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), crate::film::FilmError> {
+        let scale = crate::film::check_viscosity_scale(scale)?;
+        for b in &mut self.bearings {
+            if let BearingModel::Film(f) = &mut b.model {
+                f.viscosity_scale = scale;
+            }
+        }
+        Ok(())
+    }
+
+    /// The viscosity scale of the first film bearing (1 without one).
+    pub fn viscosity_scale(&self) -> f64 {
+        self.bearings
+            .iter()
+            .find_map(|b| match &b.model {
+                BearingModel::Film(f) => Some(f.viscosity_scale),
+                _ => None,
+            })
+            .unwrap_or(1.0)
+    }
+}
+// --- end oil supply temperature ---
+
+impl FilmBearing {
+    /// A film solver at the reference viscosity `lubricant` (unscaled).
+    pub fn reference_solver(&self) -> Box<dyn FilmModel + Send> {
         if self.short {
             Box::new(
                 ShortFilm::new(self.geometry.clone(), self.lubricant)
@@ -85,6 +135,13 @@ impl FilmBearing {
     /// The tabulated film of this bearing (the table shared in the process, built on first use):
     /// for plain bearings on the finite model.
     pub fn tabulated_solver(&self) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        Ok(Box::new(self.scaled(self.reference_tabulated_solver()?)))
+    }
+
+    /// The tabulated film at the reference viscosity `lubricant` (unscaled).
+    pub fn reference_tabulated_solver(
+        &self,
+    ) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
         if self.short {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "film model (tabulated film)",
@@ -355,6 +412,10 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                     .map(|g| FilmGrid::parse(g).expect("checked by MachineDescription::validate"))
                     .unwrap_or_default(),
                 short: b.model == BearingModelKind::Short,
+                viscosity_law: lub
+                    .viscosity_temperature
+                    .map(|v| v.law(lub.density_kg_m3).expect("checked by validate")),
+                viscosity_scale: 1.0,
             })
         }
         BearingModelKind::Linear => BearingModel::Linear(FilmCoefficients {

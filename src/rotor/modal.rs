@@ -463,7 +463,7 @@ impl BearingSolvers {
                     } else {
                         let eq = equilibrium_under_load(
                             s.as_mut(),
-                            f.lubricant.viscosity_pa_s,
+                            f.viscosity_pa_s(),
                             *load,
                             speed_rad_s,
                         )

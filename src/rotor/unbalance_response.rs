@@ -124,11 +124,61 @@ pub fn unbalance_response(
     })
 }
 
+// --- calibration from measurements (issue 12) ---
+/// Influence coefficients of the linear model at `speed_rpm` (rpm): `h[plane][station]` is the
+/// complex 1X displacement `[X, Y]` (m per kg·m) of probe station `station` (machine frame,
+/// x = Re(X e^{iΩt}), the rotor's angle-0 mark as phase reference) to a unit unbalance m·e =
+/// 1 kg·m with its heavy spot at angle 0 in unbalance plane `plane` (the machine's list). The
+/// response is linear in the unbalance: Σ_p h[p] u_p with u_p = m e e^{iφ_p}.
+pub fn influence_coefficients(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speed_rpm: f64,
+) -> Result<Vec<Vec<[c64; 2]>>, RotorError> {
+    if !(speed_rpm.is_finite() && speed_rpm > 0.0) {
+        return Err(RotorError::InvalidInput {
+            name: "influence-coefficient speed (rpm)",
+            value: speed_rpm,
+            rule: "must be finite and above zero",
+        });
+    }
+    let omega = rpm_to_rad_s(speed_rpm);
+    let mut solvers = BearingSolvers::new(rotor);
+    let (coefs, _) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;
+    let mut out = Vec::with_capacity(rotor.unbalance.len());
+    for u in &rotor.unbalance {
+        let unit = [super::Unbalance {
+            node: u.node,
+            magnitude_kg_m: 1.0,
+            phase_rad: 0.0,
+        }];
+        let q = harmonic_solution_for(rotor, omega, &coefs, &unit)?;
+        let per_station = rotor
+            .probes
+            .iter()
+            .map(|p| [q[4 * p.node], q[4 * p.node + 1]])
+            .collect();
+        out.push(per_station);
+    }
+    Ok(out)
+}
+// --- end calibration from measurements ---
+
 /// Complex 1X amplitudes of every global DOF (held DOFs zero) at spin `omega` (rad/s).
 fn harmonic_solution(
     rotor: &Rotor,
     omega: f64,
     coefs: &[crate::film::FilmCoefficients],
+) -> Result<Vec<c64>, RotorError> {
+    harmonic_solution_for(rotor, omega, coefs, &rotor.unbalance)
+}
+
+/// The same for the unbalances `unbalance` instead of the machine's.
+fn harmonic_solution_for(
+    rotor: &Rotor,
+    omega: f64,
+    coefs: &[crate::film::FilmCoefficients],
+    unbalance: &[super::Unbalance],
 ) -> Result<Vec<c64>, RotorError> {
     let (k, c, dofs) = assembled_matrices(rotor, omega, coefs);
     let n = dofs.len();
@@ -138,7 +188,7 @@ fn harmonic_solution(
         c64::new(k[(di, dj)] - w2 * rotor.mass[(di, dj)], omega * c[(di, dj)])
     });
     let mut f_full = vec![c64::new(0.0, 0.0); rotor.n_dof()];
-    for u in &rotor.unbalance {
+    for u in unbalance {
         let f = c64::new(u.phase_rad.cos(), u.phase_rad.sin()) * (u.magnitude_kg_m * w2);
         f_full[4 * u.node] += f;
         f_full[4 * u.node + 1] += f * c64::new(0.0, -1.0);

@@ -36,7 +36,7 @@ impl State {
 /// A saved twin state: restoring it makes the following steps repeat exactly.
 pub struct Checkpoint {
     state: State,
-    films: Vec<Box<dyn FilmModel + Send>>,
+    films: Vec<crate::film::ViscosityScaledFilm>,
     previous_raw: Vec<Option<FilmCoefficients>>,
     linear_reference: Vec<Option<LinearReference>>,
     last: Vec<LinkEvaluation>,
@@ -156,6 +156,34 @@ impl Twin {
         self.links[bearing].film.midplane_pressure(out);
     }
 
+    // --- oil supply temperature (issue 12) ---
+    /// Sets the viscosity of every film to `scale` × its reference viscosity (the machine
+    /// file's): exact for the isoviscous film ([`crate::film::ViscosityScaledFilm`]). Takes effect
+    /// at the next step and allocates nothing; the linear coupling is re-linearised about the
+    /// equilibrium at the new viscosity at once.
+    pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), TwinError> {
+        let scale =
+            crate::film::check_viscosity_scale(scale).map_err(|_| TwinError::InvalidInput {
+                name: "viscosity scale (µ / µ_reference)",
+                value: scale,
+                rule: "must be finite, between 0.02 and 50",
+            })?;
+        for l in &mut self.links {
+            // checked above: cannot fail
+            let _ = l.film.set_scale(scale);
+        }
+        if self.config.coupling == crate::dynamics::Coupling::Linear {
+            self.relinearise_films(self.state.speed_rad_s);
+        }
+        Ok(())
+    }
+
+    /// The viscosity scale of the films (µ / µ_reference; 1 without a film).
+    pub fn viscosity_scale(&self) -> f64 {
+        self.links.first().map_or(1.0, |l| l.film.scale())
+    }
+    // --- end oil supply temperature ---
+
     /// Sets unbalance plane `plane` (index in the machine's list): m·e (kg·m) and heavy-spot
     /// angle (rad). Takes effect at the next step.
     pub fn set_unbalance(
@@ -220,7 +248,7 @@ impl Twin {
     pub fn checkpoint(&self) -> Checkpoint {
         Checkpoint {
             state: self.state.clone(),
-            films: self.links.iter().map(|l| l.film.clone_box()).collect(),
+            films: self.links.iter().map(|l| l.film.clone()).collect(),
             previous_raw: self.links.iter().map(|l| l.previous_raw).collect(),
             linear_reference: self.links.iter().map(|l| l.linear_reference).collect(),
             last: self.links.iter().map(|l| l.last).collect(),
@@ -233,7 +261,7 @@ impl Twin {
     pub fn restore(&mut self, cp: &Checkpoint) {
         self.state = cp.state.clone();
         for (i, l) in self.links.iter_mut().enumerate() {
-            l.film = cp.films[i].clone_box();
+            l.film = cp.films[i].clone();
             l.previous_raw = cp.previous_raw[i];
             l.linear_reference = cp.linear_reference[i];
             l.last = cp.last[i];

@@ -78,12 +78,12 @@ impl Twin {
                     radius_m: f.geometry.radius_m(),
                     viscosity_pa_s: f.lubricant.viscosity_pa_s,
                     // the linear coupling evaluates films only to re-linearise: direct
-                    film: match (config.film, config.coupling) {
-                        (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.solver(),
+                    film: f.scaled(match (config.film, config.coupling) {
+                        (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.reference_solver(),
                         (FilmEvaluation::Table, _) => f
-                            .tabulated_solver()
+                            .reference_tabulated_solver()
                             .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", b.name)))?,
-                    },
+                    }),
                     linear_reference: None,
                     previous_raw: None,
                     last: LinkEvaluation::default(),
@@ -104,17 +104,13 @@ impl Twin {
                 BearingModel::Film(_) => {
                     let link = &mut links[link_index];
                     link_index += 1;
-                    let eq = equilibrium_under_load(
-                        link.film.as_mut(),
-                        link.viscosity_pa_s,
-                        *load,
-                        speed_rad_s,
-                    )
-                    .map_err(|source| TwinError::Film {
-                        bearing: link.name.clone(),
-                        time_s: 0.0,
-                        source,
-                    })?;
+                    let mu = link.viscosity();
+                    let eq = equilibrium_under_load(&mut link.film, mu, *load, speed_rad_s)
+                        .map_err(|source| TwinError::Film {
+                            bearing: link.name.clone(),
+                            time_s: 0.0,
+                            source,
+                        })?;
                     link.linear_reference = Some(LinearReference {
                         position_m: eq.position_m,
                         force_n: eq.film.force_n,

@@ -73,20 +73,24 @@ impl Twin {
                 f.refactor(&self.m, &self.c, &self.g, &self.k, speed, &self.b_dofs);
             }
             if self.config.coupling == Coupling::Linear {
-                // re-linearise each film about its equilibrium under the same load at the new speed
-                for l in &mut self.links {
-                    if let Some(r) = l.linear_reference {
-                        let load = [-r.force_n[0], -r.force_n[1]];
-                        if let Ok(eq) =
-                            equilibrium_under_load(l.film.as_mut(), l.viscosity_pa_s, load, speed)
-                        {
-                            l.linear_reference = Some(LinearReference {
-                                position_m: eq.position_m,
-                                force_n: eq.film.force_n,
-                                coefficients: eq.coefficients,
-                            });
-                        }
-                    }
+                self.relinearise_films(speed);
+            }
+        }
+    }
+
+    /// Linear coupling: re-linearises each film about its equilibrium under the same load at
+    /// `speed` (rad/s) and the running viscosity.
+    pub(super) fn relinearise_films(&mut self, speed: f64) {
+        for l in &mut self.links {
+            if let Some(r) = l.linear_reference {
+                let load = [-r.force_n[0], -r.force_n[1]];
+                let mu = l.viscosity();
+                if let Ok(eq) = equilibrium_under_load(&mut l.film, mu, load, speed) {
+                    l.linear_reference = Some(LinearReference {
+                        position_m: eq.position_m,
+                        force_n: eq.film.force_n,
+                        coefficients: eq.coefficients,
+                    });
                 }
             }
         }

@@ -1,0 +1,304 @@
+//! The oil's effective viscosity from measured mean journal positions (DC-coupled probes: the
+//! shaft centreline against speed), fitted to the film's static equilibrium: the journal finds
+//! the eccentricity and attitude where the film carries the static load, and at fixed geometry
+//! that position depends on µΩ only (the Sommerfeld number, seed eq. 2 isoviscous), so the
+//! positions over a speed range fix µ. The scale s = µ / µ_reference is fitted by Gauss–Newton
+//! in ln s; its standard uncertainty is σ_r / |∂d/∂s| from the residual σ_r and the slope
+//! (the usual linearised least-squares covariance). The probe's zero is taken to be the
+//! bearing centre's axis (probes referenced to the bearing; the synthetic plant's are).
+
+use super::linalg::solve_spd;
+use super::{CalibrationError, MeanPosition};
+use crate::film::{equilibrium_under_load, FilmModel, ViscosityScaledFilm, ZERO_CELSIUS_K};
+use crate::rotor::{static_solution, BearingModel, Rotor, StaticSolution};
+use serde::Serialize;
+
+/// The viscosity estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ViscosityEstimate {
+    /// µ / µ_reference (the machine file's viscosity_pa_s).
+    pub scale: f64,
+    /// Its standard uncertainty (1σ).
+    pub scale_std: f64,
+    /// The effective viscosity µ (Pa·s) of the first film bearing.
+    pub viscosity_pa_s: f64,
+    /// The oil temperature the law gives for it (°C), if the machine file has a law and the
+    /// viscosity lies in its range.
+    pub temperature_c: Option<f64>,
+    /// Its standard uncertainty (K).
+    pub temperature_std_k: Option<f64>,
+    /// The offset from the law's design supply temperature (K).
+    pub temperature_offset_k: Option<f64>,
+    /// RMS of measured minus modelled position, per coordinate (m).
+    pub residual_rms_m: f64,
+    /// Mean positions used.
+    pub points: usize,
+    /// Gauss–Newton iterations.
+    pub iterations: usize,
+}
+
+/// The film solvers reused from evaluation to evaluation (warm starts).
+struct Films(Vec<Option<ViscosityScaledFilm>>);
+
+impl Films {
+    fn of(rotor: &Rotor) -> Self {
+        Self(
+            rotor
+                .bearings
+                .iter()
+                .map(|b| match &b.model {
+                    BearingModel::Film(f) => Some(f.scaled(f.reference_solver())),
+                    _ => None,
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The static position `[x, y]` (m) of every probe station of `rotor` at `speed_rad_s` with the
+/// films at `scale` × their reference viscosity: each journal at its film's equilibrium under
+/// its static load, the shaft statically deflected and moved rigidly onto the journals (as the
+/// twin starts, `Twin::new`).
+pub fn static_probe_positions(
+    rotor: &Rotor,
+    scale: f64,
+    speed_rad_s: f64,
+) -> Result<Vec<[f64; 2]>, CalibrationError> {
+    let statics = static_solution(rotor).map_err(|e| CalibrationError::Model(e.to_string()))?;
+    positions(rotor, &statics, &mut Films::of(rotor), scale, speed_rad_s)
+}
+
+fn positions(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    films: &mut Films,
+    scale: f64,
+    speed: f64,
+) -> Result<Vec<[f64; 2]>, CalibrationError> {
+    let mut journals = Vec::new();
+    for ((b, load), film) in rotor
+        .bearings
+        .iter()
+        .zip(&statics.bearing_loads_n)
+        .zip(&mut films.0)
+    {
+        let d = match (&b.model, film) {
+            (BearingModel::Film(f), Some(film)) => {
+                film.set_scale(scale)
+                    .map_err(|e| CalibrationError::Model(e.to_string()))?;
+                let mu = f.lubricant.viscosity_pa_s * scale;
+                let eq = equilibrium_under_load(film as &mut dyn FilmModel, mu, *load, speed)
+                    .map_err(|e| CalibrationError::Model(format!("bearing '{}': {e}", b.name)))?;
+                eq.position_m
+            }
+            (BearingModel::Linear(c), _) => {
+                let k = c.stiffness_n_per_m;
+                let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
+                [
+                    (k[1][1] * load[0] - k[0][1] * load[1]) / det,
+                    (-k[1][0] * load[0] + k[0][0] * load[1]) / det,
+                ]
+            }
+            _ => continue,
+        };
+        journals.push((rotor.node_z_m[b.node], d));
+    }
+    let line = straight_lines(&journals);
+    Ok(rotor
+        .probes
+        .iter()
+        .map(|p| {
+            let z = rotor.node_z_m[p.node];
+            [0, 1].map(|a| statics.displacement[4 * p.node + a] + line[a][0] + line[a][1] * z)
+        })
+        .collect())
+}
+
+/// Least-squares lines v(z) = a + b z through the journal positions, per axis: [[a, b]; 2].
+fn straight_lines(points: &[(f64, [f64; 2])]) -> [[f64; 2]; 2] {
+    let n = points.len() as f64;
+    if points.is_empty() {
+        return [[0.0; 2]; 2];
+    }
+    let zm = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let szz: f64 = points.iter().map(|p| (p.0 - zm).powi(2)).sum();
+    [0, 1].map(|a| {
+        let vm = points.iter().map(|p| p.1[a]).sum::<f64>() / n;
+        let slope = if szz > 0.0 {
+            points
+                .iter()
+                .map(|p| (p.0 - zm) * (p.1[a] - vm))
+                .sum::<f64>()
+                / szz
+        } else {
+            0.0
+        };
+        [vm - slope * zm, slope]
+    })
+}
+
+/// Estimates the viscosity scale from `measured` mean positions (module documentation).
+pub fn estimate_viscosity(
+    rotor: &Rotor,
+    measured: &[MeanPosition],
+) -> Result<ViscosityEstimate, CalibrationError> {
+    let Some(reference) = rotor.bearings.iter().find_map(|b| match &b.model {
+        BearingModel::Film(f) => Some(f),
+        _ => None,
+    }) else {
+        return Err(CalibrationError::NothingToCalibrate(
+            "the machine has no film bearing".into(),
+        ));
+    };
+    if measured.len() < 2 {
+        return Err(CalibrationError::TooFewMeasurements(format!(
+            "{} mean position(s); at least 2",
+            measured.len()
+        )));
+    }
+    for m in measured {
+        let ok = m.station < rotor.probes.len()
+            && m.speed_rad_s.is_finite()
+            && m.speed_rad_s > 0.0
+            && m.position_m.iter().all(|v| v.is_finite() && v.abs() < 0.01);
+        if !ok {
+            return Err(CalibrationError::BadMeasurement(format!("{m:?}")));
+        }
+    }
+    let statics = static_solution(rotor).map_err(|e| CalibrationError::Model(e.to_string()))?;
+    let mut films = Films::of(rotor);
+    let (x, slope, rss, iterations) = gauss_newton(rotor, &statics, &mut films, measured)?;
+    let scale = x.exp();
+    let dof = (2 * measured.len()).saturating_sub(1).max(1) as f64;
+    let sigma_r = (rss / dof).sqrt();
+    // d(model)/d(ln s) = s d(model)/ds: σ_s = s σ_ln s
+    let scale_std = scale * sigma_r / slope.sqrt().max(f64::MIN_POSITIVE);
+    let mu = reference.lubricant.viscosity_pa_s * scale;
+    let (temperature_c, temperature_std_k, temperature_offset_k) =
+        temperature_of(reference, mu, scale_std / scale);
+    Ok(ViscosityEstimate {
+        scale,
+        scale_std,
+        viscosity_pa_s: mu,
+        temperature_c,
+        temperature_std_k,
+        temperature_offset_k,
+        residual_rms_m: (rss / (2 * measured.len()) as f64).sqrt(),
+        points: measured.len(),
+        iterations,
+    })
+}
+
+/// Residuals measured − model at ln s = `x`, in the order of `measured`, both axes.
+fn residuals(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    films: &mut Films,
+    measured: &[MeanPosition],
+    x: f64,
+) -> Result<Vec<f64>, CalibrationError> {
+    let mut out = Vec::with_capacity(2 * measured.len());
+    let mut cache: Vec<(f64, Vec<[f64; 2]>)> = Vec::new();
+    for m in measured {
+        let at = match cache
+            .iter()
+            .position(|(w, _)| (w - m.speed_rad_s).abs() < 1e-6)
+        {
+            Some(i) => i,
+            None => {
+                let p = positions(rotor, statics, films, x.exp(), m.speed_rad_s)?;
+                cache.push((m.speed_rad_s, p));
+                cache.len() - 1
+            }
+        };
+        let model = cache[at].1[m.station];
+        out.extend([m.position_m[0] - model[0], m.position_m[1] - model[1]]);
+    }
+    Ok(out)
+}
+
+/// Gauss–Newton in x = ln s from s = 1: (x, Σ(∂r/∂x)², residual sum of squares, iterations).
+fn gauss_newton(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    films: &mut Films,
+    measured: &[MeanPosition],
+) -> Result<(f64, f64, f64, usize), CalibrationError> {
+    let ln_max = crate::film::MAX_VISCOSITY_SCALE.ln();
+    let (mut x, h) = (0.0_f64, 0.01);
+    for it in 1..=30 {
+        let r = residuals(rotor, statics, films, measured, x)?;
+        let rp = residuals(rotor, statics, films, measured, x + h)?;
+        let rm = residuals(rotor, statics, films, measured, x - h)?;
+        let g: Vec<f64> = rp
+            .iter()
+            .zip(&rm)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
+        let gg: f64 = g.iter().map(|v| v * v).sum();
+        let gr: f64 = g.iter().zip(&r).map(|(a, b)| a * b).sum();
+        let step = solve_spd(&[gg], &[-gr]).ok_or_else(|| {
+            CalibrationError::Singular("the positions do not depend on the viscosity".into())
+        })?[0]
+            .clamp(-0.5, 0.5);
+        x = (x + step).clamp(-ln_max, ln_max);
+        if step.abs() < 1e-6 {
+            let r = residuals(rotor, statics, films, measured, x)?;
+            return Ok((x, gg, r.iter().map(|v| v * v).sum(), it));
+        }
+    }
+    Err(CalibrationError::Model(
+        "the viscosity fit did not converge in 30 iterations".into(),
+    ))
+}
+
+/// The temperature (°C), its uncertainty (K) and offset from the design point (K) that give µ
+/// (Pa·s) through the bearing's law, with relative uncertainty `rel_std` of µ.
+fn temperature_of(
+    f: &crate::rotor::FilmBearing,
+    mu: f64,
+    rel_std: f64,
+) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let Some(law) = f.viscosity_law else {
+        return (None, None, None);
+    };
+    let [mut lo, mut hi] = law.range_k();
+    if !(law.viscosity_pa_s(lo) >= mu && law.viscosity_pa_s(hi) <= mu) {
+        return (None, None, None);
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if law.viscosity_pa_s(mid) > mu {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    // d ln µ / dT by central difference over ±0.5 K
+    let dlnmu = (law.viscosity_pa_s(t + 0.5).ln() - law.viscosity_pa_s(t - 0.5).ln()).abs();
+    let design = law_design_k(f, &law);
+    (
+        Some(t - ZERO_CELSIUS_K),
+        Some(rel_std / dlnmu.max(f64::MIN_POSITIVE)),
+        design.map(|d| t - d),
+    )
+}
+
+/// The design supply temperature (K): where the law gives the reference viscosity.
+fn law_design_k(f: &crate::rotor::FilmBearing, law: &crate::film::WaltherLaw) -> Option<f64> {
+    let target = f.lubricant.viscosity_pa_s;
+    let [mut lo, mut hi] = law.range_k();
+    if !(law.viscosity_pa_s(lo) >= target && law.viscosity_pa_s(hi) <= target) {
+        return None;
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if law.viscosity_pa_s(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}

@@ -1,0 +1,142 @@
+//! Calibration from measurements (issue 12) against a synthetic plant that differs from the
+//! twin: its unbalance is doubled (280 instead of 140 g·mm) and sits in another plane (stage 7,
+//! node 21, instead of stage 4, node 15) at another phase (120° instead of 0°), its oil is 10 %
+//! more viscous, and its films are solved on a finer grid (72 × 12 instead of 60 × 10). The
+//! plant runs the nonlinear transient (direct film) at three speeds below the onset; its probe
+//! displacements (static position included, as DC-coupled probes see it) get 0.3 µm of noise.
+//! The twin first fits the viscosity to the mean positions, then the unbalance to the 1X
+//! vectors with its own influence coefficients at the fitted viscosity. Targets (the issue's):
+//! viscosity within 3 %, unbalance within 10 % and 10°.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use rotor_twin::calibrate::{
+    estimate_unbalance, estimate_viscosity, fit_windows, AngleSample, WindowFit,
+};
+use rotor_twin::dynamics::{Coupling, StepInput, Twin, TwinConfig};
+use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor, UnbalanceSpec};
+
+/// The twin's machine: the built-in one with a second (empty) unbalance plane at stage 7.
+fn twin_rotor() -> Rotor {
+    let mut d = MachineDescription::builtin_default();
+    d.unbalance.push(UnbalanceSpec {
+        node: 21,
+        magnitude_g_mm: 0.0,
+        phase_deg: 0.0,
+    });
+    Rotor::from_description(&d)
+}
+
+fn plant_rotor(twin: &Rotor) -> Rotor {
+    let mut p = twin.clone();
+    p.unbalance[0].magnitude_kg_m = 0.0;
+    p.unbalance[1].magnitude_kg_m = 280e-6;
+    p.unbalance[1].phase_rad = 120f64.to_radians();
+    for b in &mut p.bearings {
+        if let BearingModel::Film(f) = &mut b.model {
+            f.lubricant.viscosity_pa_s *= 1.10;
+            f.grid.n_theta = 72;
+            f.grid.n_z = 12;
+        }
+    }
+    p
+}
+
+/// The plant at `rpm` for 8 revolutions to settle, then 16 measured: one window fit per station.
+fn measure(plant: &Rotor, rpm: f64, noise: &mut impl FnMut() -> f64) -> Vec<WindowFit> {
+    let w = rpm * std::f64::consts::PI / 30.0;
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64);
+    let mut twin = Twin::new(plant, config, w).unwrap();
+    let input = StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    };
+    let mut samples = vec![Vec::new(); plant.probes.len()];
+    for k in 0..64 * 24 {
+        twin.step(&input).unwrap();
+        if k >= 64 * 8 && k % 2 == 0 {
+            let out = twin.output();
+            for (s, p) in samples.iter_mut().zip(&out.probes) {
+                s.push(AngleSample {
+                    angle_rad: out.angle_rad,
+                    speed_rad_s: out.speed_rad_s,
+                    displacement_m: [p.displacement_m[0] + noise(), p.displacement_m[1] + noise()],
+                });
+            }
+        }
+    }
+    samples
+        .iter()
+        .map(|s| fit_windows(s, 15.9).remove(0))
+        .collect()
+}
+
+#[test]
+fn viscosity_then_unbalance_are_recovered_from_a_plant_that_differs() {
+    let mut twin = twin_rotor();
+    let plant = plant_rotor(&twin);
+    let normal = Normal::new(0.0, 0.3e-6).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+    let mut noise = || normal.sample(&mut rng);
+    let mut means = Vec::new();
+    let mut vectors = Vec::new();
+    for rpm in [5000.0, 6500.0, 8000.0] {
+        for (station, fit) in measure(&plant, rpm, &mut noise).iter().enumerate() {
+            means.push(fit.mean_position(station));
+            vectors.extend(fit.one_x(station));
+        }
+    }
+    let v = estimate_viscosity(&twin, &means).unwrap();
+    eprintln!("viscosity: {v:?}");
+    assert!(
+        (v.scale / 1.10 - 1.0).abs() < 0.03,
+        "scale {} (plant 1.10)",
+        v.scale
+    );
+    assert!(v.scale_std > 0.0 && v.scale_std < 0.03, "σ {}", v.scale_std);
+    // the built-in law: 10 % more viscous is a cooler oil, about 9 K below the 40 °C design
+    let offset = v.temperature_offset_k.unwrap();
+    assert!(offset < -5.0 && offset > -15.0, "offset {offset} K");
+
+    twin.set_viscosity_scale(v.scale).unwrap();
+    let u = estimate_unbalance(&twin, &vectors, 0.1).unwrap();
+    eprintln!("unbalance: {u:?}");
+    let (p15, p21) = (u.planes[0], u.planes[1]);
+    assert!((p21.magnitude_g_mm / 280.0 - 1.0).abs() < 0.10, "{p21:?}");
+    let dphi = (p21.phase_deg - 120.0 + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(dphi.abs() < 10.0, "phase {} (plant 120°)", p21.phase_deg);
+    assert!(p15.magnitude_g_mm < 28.0, "stage-4 plane: {p15:?}");
+    // the balancing weight: the same m·e opposite, at 100 mm
+    assert!((p21.correction.mass_g - p21.magnitude_g_mm / 100.0).abs() < 1e-9);
+    let opposite = (p21.correction.angle_deg - p21.phase_deg).rem_euclid(360.0);
+    assert!((opposite - 180.0).abs() < 1e-9);
+    assert!(u.condition_number.is_finite() && u.condition_number >= 1.0);
+    assert!(
+        u.relative_residual < 0.2,
+        "relative residual {}",
+        u.relative_residual
+    );
+}
+
+/// The shipped sample bag (bags/README.md: the plant's oil 5 % more viscous, 140 g·mm at 0° at
+/// node 15, films on 90 × 15), its stable first 4.5 s: the shaft angle integrated from the speed
+/// messages, the viscosity within 3 % of 1.05 and the unbalance within 10 % and 10°.
+#[test]
+fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/orc_runup_synthetic");
+    let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let (cal, calibrated) =
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], [0.0, 4.5]).unwrap();
+    eprintln!("{cal:?}");
+    assert!(
+        (cal.viscosity.scale / 1.05 - 1.0).abs() < 0.03,
+        "{:?}",
+        cal.viscosity
+    );
+    let p = cal.unbalance.planes[0];
+    assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
+    let dphi = (p.phase_deg + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(dphi.abs() < 10.0, "{p:?}");
+    assert!((calibrated.viscosity_scale() - cal.viscosity.scale).abs() < 1e-12);
+}

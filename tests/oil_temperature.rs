@@ -1,0 +1,228 @@
+//! Oil supply temperature (issue 12): a uniform viscosity scales the isoviscous film exactly
+//! (the direct solver and its table alike), and a temperature on the bus sets the running twin's
+//! viscosity through the machine file's law; bad temperatures are refused and reported, the last
+//! good value kept.
+
+use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind};
+use rotor_twin::dynamics::FilmEvaluation;
+use rotor_twin::film::{
+    BearingGeometry, FilmGrid, FilmModel, FilmTable, FiniteFilm, JournalKinematics, Lubricant,
+    TabulatedFilm, ViscosityScaledFilm, ZERO_CELSIUS_K,
+};
+use rotor_twin::messages::{self, Header, Time};
+use rotor_twin::rotor::{MachineDescription, Rotor};
+use rotor_twin::session::Outgoing;
+use std::sync::Arc;
+
+/// Journal states across the film: (ε, attitude, radial and tangential velocity over c ω).
+const STATES: [(f64, f64, f64, f64); 4] = [
+    (0.3, 0.4, 0.01, -0.02),
+    (0.6, 2.0, -0.05, 0.1),
+    (0.85, 4.0, 0.2, 0.05),
+    (0.5, 5.5, 0.0, 0.0),
+];
+
+fn kinematics(c: f64, w: f64, (eps, phi, vr, vt): (f64, f64, f64, f64)) -> JournalKinematics {
+    let (vr, vt) = (vr * c * w, vt * c * w);
+    JournalKinematics {
+        position_m: [eps * c * phi.cos(), eps * c * phi.sin()],
+        velocity_m_s: [
+            vr * phi.cos() - vt * phi.sin(),
+            vr * phi.sin() + vt * phi.cos(),
+        ],
+        speed_rad_s: w,
+    }
+}
+
+fn close(a: f64, b: f64, scale: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * scale
+}
+
+/// Reference: the direct finite-length solver run at the other viscosity. p = 6µ(R/c)²Π with Π
+/// independent of µ, so scaling the µ₀ solution by µ₁/µ₀ must reproduce it to round-off (1e-9
+/// of the force scale), coefficients and friction included; flows must not change. The table
+/// made at µ₀ and scaled must equal the table made at µ₁ to the same precision (its nodes are
+/// normalised per unit V and carry µ linearly).
+#[test]
+fn a_uniform_viscosity_scales_the_direct_and_the_tabulated_film_exactly() {
+    let g = BearingGeometry::plain(0.06, 0.03, 40e-6).unwrap();
+    let grid = FilmGrid::new(24, 4).unwrap();
+    let (mu0, s) = (0.0008, 1.37);
+    let lub = |mu| Lubricant::new(900.0, mu).unwrap();
+    let direct = |mu| -> Box<dyn FilmModel + Send> {
+        Box::new(FiniteFilm::new(g.clone(), lub(mu), grid).unwrap())
+    };
+    let table = |mu| -> Box<dyn FilmModel + Send> {
+        Box::new(TabulatedFilm::new(Arc::new(
+            FilmTable::build(&g, lub(mu), grid).unwrap(),
+        )))
+    };
+    for (name, mut scaled, mut reference) in [
+        (
+            "direct",
+            ViscosityScaledFilm::new(direct(mu0), s).unwrap(),
+            direct(s * mu0),
+        ),
+        (
+            "table",
+            ViscosityScaledFilm::new(table(mu0), s).unwrap(),
+            table(s * mu0),
+        ),
+    ] {
+        for st in STATES {
+            let kin = kinematics(40e-6, 942.0, st);
+            let (a, ca) = scaled.solve_with_coefficients(&kin).unwrap();
+            let (b, cb) = reference.solve_with_coefficients(&kin).unwrap();
+            let f = b.force_n[0].hypot(b.force_n[1]);
+            for i in 0..2 {
+                assert!(close(a.force_n[i], b.force_n[i], f, 1e-9), "{name} {st:?}");
+            }
+            let ks = cb
+                .stiffness_n_per_m
+                .iter()
+                .flatten()
+                .fold(0.0_f64, |m, v| m.max(v.abs()));
+            let ds = cb
+                .damping_n_s_per_m
+                .iter()
+                .flatten()
+                .fold(0.0_f64, |m, v| m.max(v.abs()));
+            for i in 0..2 {
+                for j in 0..2 {
+                    let (k1, k2) = (ca.stiffness_n_per_m[i][j], cb.stiffness_n_per_m[i][j]);
+                    let (d1, d2) = (ca.damping_n_s_per_m[i][j], cb.damping_n_s_per_m[i][j]);
+                    assert!(close(k1, k2, ks, 1e-8), "{name} {st:?} k[{i}][{j}]");
+                    assert!(close(d1, d2, ds, 1e-8), "{name} {st:?} c[{i}][{j}]");
+                }
+            }
+            assert!(close(
+                a.max_pressure_pa,
+                b.max_pressure_pa,
+                b.max_pressure_pa,
+                1e-9
+            ));
+            assert!(close(
+                a.power_loss_w,
+                b.power_loss_w,
+                b.power_loss_w.abs(),
+                1e-9
+            ));
+            assert!(close(
+                a.side_flow_m3_s,
+                b.side_flow_m3_s,
+                b.side_flow_m3_s.abs(),
+                1e-9
+            ));
+            let (mut pa, mut pb) = ([0.0; 16], [0.0; 16]);
+            scaled.midplane_pressure(&mut pa);
+            reference.midplane_pressure(&mut pb);
+            for (x, y) in pa.iter().zip(&pb) {
+                assert!(close(*x, *y, b.max_pressure_pa, 1e-9), "{name} profile");
+            }
+        }
+    }
+}
+
+fn rotor() -> Rotor {
+    Rotor::from_description(&MachineDescription::builtin_default())
+}
+
+fn temperature(celsius: f64) -> Input {
+    Input::from(&messages::Temperature {
+        header: Header {
+            stamp: Time::from_nanos(0),
+            frame_id: String::new(),
+        },
+        temperature: celsius,
+        variance: 0.0,
+    })
+}
+
+/// The built-in machine's law (config/orc_microturbine_100kw.yaml): ν 0.889 mm²/s at the 40 °C
+/// design temperature, 0.60 at 80 °C. At 40 °C the scale is 1 (within the 1 % the file is
+/// checked to); at 80 °C it is 0.60/0.889 (the law's own point, within the D341 inverse's
+/// 0.2 %); a twin running at 80 °C has films at that viscosity.
+#[test]
+fn a_temperature_sets_the_running_twin_and_bad_ones_are_refused() {
+    let r = rotor();
+    let settings = DriverSettings::new(
+        ModelKind::Nonlinear,
+        FilmEvaluation::Direct,
+        r.rated_speed_rad_s,
+    );
+    let mut d = Driver::new(r, settings);
+    let warnings = std::cell::RefCell::new(Vec::new());
+    let mut emit = |o: Outgoing| {
+        if let Outgoing::Warning(w) = o {
+            warnings.borrow_mut().push(w.evidence);
+        }
+    };
+    let t0 = 1_767_225_600_000_000_000_i64;
+    assert_eq!(d.feed(t0, temperature(40.0), &mut emit), Fed::Taken);
+    assert!(
+        (d.viscosity_scale() - 1.0).abs() < 0.01,
+        "{}",
+        d.viscosity_scale()
+    );
+    let w = 8000.0 * std::f64::consts::PI / 30.0;
+    let speed = Input::Speed {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+        stamp_ns: 0,
+    };
+    assert!(matches!(
+        d.feed(t0 + 1_000_000, speed, &mut emit),
+        Fed::Started { .. }
+    ));
+    assert_eq!(
+        d.feed(t0 + 2_000_000, temperature(80.0), &mut emit),
+        Fed::Taken
+    );
+    let expected = 0.60 / 0.889 * 1.0; // the law's 80 °C point over the 40 °C one
+    let twin_scale = d.session().unwrap().twin().viscosity_scale();
+    assert!(
+        (twin_scale / expected - 1.0).abs() < 0.003,
+        "{twin_scale} vs {expected}"
+    );
+    assert!((d.oil_temperature_k().unwrap() - (80.0 + ZERO_CELSIUS_K)).abs() < 1e-9);
+    // refused: NaN, absurd, outside the law's 10–120 °C; the 80 °C value stays
+    for bad in [f64::NAN, f64::INFINITY, 1.0e6, -300.0, 5.0, 150.0] {
+        let fed = d.feed(t0 + 3_000_000, temperature(bad), &mut emit);
+        assert!(matches!(fed, Fed::Refused(_)), "{bad} °C: {fed:?}");
+        assert!((d.session().unwrap().twin().viscosity_scale() - twin_scale).abs() < 1e-15);
+    }
+    let said = warnings.borrow().clone();
+    assert!(
+        said.iter()
+            .any(|w| w.contains("rejected") && w.contains("temperature")),
+        "{said:?}"
+    );
+    // the twin steps on at the new viscosity without a fault
+    d.advance_to(t0 + 20_000_000, usize::MAX, &mut emit);
+    let out = d.session().unwrap().twin().output();
+    assert!(out
+        .bearings
+        .iter()
+        .all(|b| b.eccentricity_ratio.is_finite()));
+}
+
+/// A machine without a law refuses a temperature and says why.
+#[test]
+fn a_machine_without_a_law_refuses_a_temperature() {
+    let yaml = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/test_rig_three_support.yaml"),
+    )
+    .unwrap();
+    let desc = MachineDescription::from_yaml(&yaml, "rig").unwrap();
+    let r = Rotor::from_description(&desc);
+    let settings = DriverSettings::new(
+        ModelKind::Nonlinear,
+        FilmEvaluation::Direct,
+        r.rated_speed_rad_s,
+    );
+    let mut d = Driver::new(r, settings);
+    match d.feed(0, temperature(40.0), &mut |_| {}) {
+        Fed::Refused(why) => assert!(why.contains("viscosity_temperature"), "{why}"),
+        other => panic!("{other:?}"),
+    }
+}
