@@ -38,6 +38,7 @@ fn recorded_type_hashes_equal_rosbags_hashes() {
         add::<messages::PointStamped>(&mut rec),
         add::<messages::Clock>(&mut rec),
         add::<messages::DiagnosticArray>(&mut rec),
+        add::<messages::Temperature>(&mut rec),
     ];
     rec.finish().unwrap();
 

@@ -344,7 +344,7 @@ impl serde_json::ser::Formatter for SpacedFormatter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::messages::{Clock, DiagnosticArray, Float64, PointStamped, RosMessage};
+    use crate::messages::{Clock, DiagnosticArray, Float64, PointStamped, RosMessage, Temperature};
 
     /// Jazzy's hashes of the standard types (as rosidl generates them; rosbags 0.11.9's
     /// `Typestore.hash_rihs01` over its ROS2_JAZZY store gives the same values).
@@ -379,6 +379,10 @@ mod tests {
         assert_eq!(
             Clock::type_hash(),
             "RIHS01_692f7a66e93a3c83e71765d033b60349ba68023a8c689a79e48078bcb5c58564"
+        );
+        assert_eq!(
+            Temperature::type_hash(),
+            "RIHS01_72514a14126ab9f8a9abec974c78e5610a367b59db5da355ff1fb982d5bad4b8"
         );
         // byte fields, constants and a sequence of a nested type of the same package
         assert_eq!(
