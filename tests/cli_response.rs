@@ -53,19 +53,7 @@ fn response_json_and_plots_for_the_builtin_machine() {
         "bearing_pulley_end",
         "probe_outboard",
     ]);
-    let legend_x = bode.text("legend").unwrap().x;
-    // the curves are polylines of many points; the legend's swatches have two
-    let data_right = bode
-        .polylines
-        .iter()
-        .filter(|l| l.len() > 2)
-        .flatten()
-        .map(|p| p.0)
-        .fold(f64::MIN, f64::max);
-    assert!(
-        legend_x > data_right,
-        "legend {legend_x} px, data to {data_right} px"
-    );
+    bode.assert_legend_right_of_data();
     let polar_path = prefix.with_file_name(format!(
         "{}_polar.svg",
         prefix.file_name().unwrap().to_str().unwrap()

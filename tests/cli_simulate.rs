@@ -65,15 +65,7 @@ fn simulate_json_and_plots() {
         (px_x / px_y - 1.0).abs() < 0.005,
         "orbit aspect {px_x} vs {px_y} px/µm"
     );
-    // the curves are polylines of many points; the legend's swatches have two
-    let right_of_data = orbit
-        .polylines
-        .iter()
-        .filter(|l| l.len() > 2)
-        .flatten()
-        .map(|p| p.0)
-        .fold(f64::MIN, f64::max);
-    assert!(orbit.text("legend").unwrap().x > right_of_data);
+    orbit.assert_legend_right_of_data();
     // the pressure map: degrees of shaft rotation and of the bearing, a scale in MPa
     let map = svg_check::read(&dir.join("pressure_bearing_outboard.svg"));
     map.assert_texts(&[

@@ -316,27 +316,7 @@ fn check_amplitude_plots(out: &Path) {
         "semi-major axis (µm)",
         "legend",
     ]);
-    let right_of_data = a
-        .polylines
-        .iter()
-        .filter(|l| l.len() > 2)
-        .flatten()
-        .chain(
-            // data dots are 3 px, the legend's dots 4 px
-            a.circles
-                .iter()
-                .filter(|c| c.2 < 3.5)
-                .map(|c| (c.0, c.1))
-                .collect::<Vec<_>>()
-                .iter(),
-        )
-        .map(|p| p.0)
-        .fold(f64::MIN, f64::max);
-    let legend_x = a.text("legend").unwrap().x;
-    assert!(
-        legend_x > right_of_data,
-        "legend {legend_x} px, data to {right_of_data} px"
-    );
+    a.assert_legend_right_of_data();
     let w = svg_check::read(&out.join("waterfall_probe_outboard.svg"));
     let bar = w.texts.iter().filter(|t| t.text.ends_with(" µm")).count();
     assert_eq!(bar, 2, "one scale bar in each half");

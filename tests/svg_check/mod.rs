@@ -131,4 +131,23 @@ impl Svg {
         assert!(xs.len() >= 3 && ys.len() >= 3, "ticks {xs:?} {ys:?}");
         (slope(xs), slope(ys))
     }
+
+    /// Asserts that the text "legend" stands right of every data curve (polylines of more than
+    /// two points; a legend swatch has two) and data dot (circles under 3.5 px; the legend's
+    /// dots are 4 px).
+    pub fn assert_legend_right_of_data(&self) {
+        let curves = self
+            .polylines
+            .iter()
+            .filter(|l| l.len() > 2)
+            .flatten()
+            .map(|p| p.0);
+        let dots = self.circles.iter().filter(|c| c.2 < 3.5).map(|c| c.0);
+        let data_right = curves.chain(dots).fold(f64::MIN, f64::max);
+        let legend_x = self.text("legend").expect("a legend").x;
+        assert!(
+            legend_x > data_right,
+            "legend {legend_x} px, data to {data_right} px"
+        );
+    }
 }
