@@ -21,6 +21,8 @@ use compare::{Sample, StationComparison};
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// The keyphasor and raw-probe input topics (issue 12).
+pub use crate::topics::{KEYPHASOR as KEYPHASOR_TOPIC, PROBE_SIGNAL as PROBE_SIGNAL_TOPIC};
 /// The twin's input topics (before remapping, the names the node uses).
 pub use crate::topics::{PROBE as PROBE_TOPIC, SPEED as SPEED_TOPIC, UNBALANCE as UNBALANCE_TOPIC};
 
@@ -43,6 +45,8 @@ pub struct ReplayOptions {
     pub speed_unit: SpeedUnit,
     /// geometry_msgs/PointStamped probe topics (after remapping) → probe station name.
     pub probe_points: Vec<(String, String)>,
+    /// std_msgs/Float64 raw-probe topics (after remapping) → raw probe name (issue 12).
+    pub probe_signals: Vec<(String, String)>,
     /// Bag time per wall time (None: as fast as the model runs).
     pub rate: Option<f64>,
     /// Replay only the first this many seconds of the bag.
@@ -65,6 +69,7 @@ impl Default for ReplayOptions {
             remaps: Vec::new(),
             speed_unit: SpeedUnit::Rpm,
             probe_points: Vec::new(),
+            probe_signals: Vec::new(),
             rate: None,
             duration_s: None,
             out_bag: None,
@@ -136,6 +141,11 @@ enum Role {
     Unbalance,
     Probe,
     ProbePoint(usize),
+    // plant signals (issue 12)
+    Keyphasor,
+    KeyphasorHeader,
+    ProbeSignal,
+    ProbeValue(usize),
     Other,
 }
 
@@ -150,7 +160,12 @@ pub fn replay(
 ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
     let wall = std::time::Instant::now();
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
-    let roles = map_topics(bag, options, &stations)?;
+    let raw: Vec<String> = rotor
+        .proximity_probes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let roles = map_topics(bag, options, &stations, &raw)?;
     let clearance = rotor
         .bearings
         .iter()
@@ -161,7 +176,8 @@ pub fn replay(
         .fold(f64::INFINITY, f64::min);
     let comparisons: Vec<StationComparison> = stations
         .iter()
-        .map(|s| StationComparison::new(s, clearance))
+        .zip(&rotor.probes)
+        .map(|(s, p)| StationComparison::new(s, clearance).with_axes(p.angles_rad))
         .collect();
     let mut out = match &options.out_bag {
         Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
@@ -181,6 +197,10 @@ pub fn replay(
     report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
     let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
     driver.set_threshold(crate::session::linear_threshold(rotor));
+    let keyphasor_role = |r: &Role| matches!(r, Role::Keyphasor | Role::KeyphasorHeader);
+    if bag.messages.iter().any(|m| keyphasor_role(&roles[m.topic])) {
+        driver.expect_keyphasor();
+    }
     let mut run = Replaying {
         driver,
         report,
@@ -272,6 +292,7 @@ impl Replaying {
                 speed_rad_s: c.speed_rad_s,
                 measured_m: c.measured_m,
                 predicted_m: c.predicted_m,
+                phase_reference: c.phase_reference,
             }),
             Fed::Refused(why) => self.report.note_rejection(topic, &why),
             Fed::Taken | Fed::Unused => {}
@@ -288,6 +309,10 @@ fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, 
         Role::Unbalance => Input::from(&from_cdr::<messages::Unbalance>(payload)?),
         Role::Probe => Input::from(&from_cdr::<messages::ProbeDisplacement>(payload)?),
         Role::ProbePoint(k) => Input::probe_point(&from_cdr::<messages::PointStamped>(payload)?, k),
+        Role::Keyphasor => Input::from(&from_cdr::<messages::Keyphasor>(payload)?),
+        Role::KeyphasorHeader => Input::from(&from_cdr::<messages::Header>(payload)?),
+        Role::ProbeSignal => Input::from(&from_cdr::<messages::ProbeSignal>(payload)?),
+        Role::ProbeValue(k) => Input::probe_value(from_cdr::<messages::Float64>(payload)?.data, k),
         Role::Other => return Ok(None),
     }))
 }
@@ -297,7 +322,12 @@ fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, 
 /// stations exist.
 pub fn check_mapping(bag: &Bag, rotor: &Rotor, options: &ReplayOptions) -> Result<(), ReplayError> {
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
-    map_topics(bag, options, &stations).map(|_| ())
+    let raw: Vec<String> = rotor
+        .proximity_probes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    map_topics(bag, options, &stations, &raw).map(|_| ())
 }
 
 /// The role of each bag topic, checking that the speed topic is there and the types fit.
@@ -305,7 +335,16 @@ fn map_topics(
     bag: &Bag,
     options: &ReplayOptions,
     stations: &[String],
+    rotor_probes: &[String],
 ) -> Result<Vec<Role>, ReplayError> {
+    for (_, probe) in &options.probe_signals {
+        if !rotor_probes.contains(probe) {
+            return Err(ReplayError::UnknownStation(
+                format!("raw probe {probe}"),
+                rotor_probes.join(", "),
+            ));
+        }
+    }
     let remap = |name: &str| -> String {
         options
             .remaps
@@ -349,6 +388,8 @@ fn map_topics(
                 return Err(wrong(messages::ProbeDisplacement::TYPE_NAME));
             }
             Role::Probe
+        } else if let Some(role) = plant_signal_role(&name, t, options, rotor_probes)? {
+            role
         } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| *tp == name) {
             if t.type_name != messages::PointStamped::TYPE_NAME {
                 return Err(wrong(messages::PointStamped::TYPE_NAME));
@@ -362,10 +403,13 @@ fn map_topics(
         }
         roles.push(role);
     }
-    if !roles
-        .iter()
-        .any(|r| matches!(r, Role::SpeedRotor | Role::SpeedFloat))
-    {
+    // the keyphasor's intervals give the speed where no speed topic does
+    if !roles.iter().any(|r| {
+        matches!(
+            r,
+            Role::SpeedRotor | Role::SpeedFloat | Role::Keyphasor | Role::KeyphasorHeader
+        )
+    }) {
         let present = bag
             .topics
             .iter()
@@ -374,7 +418,7 @@ fn map_topics(
             .join(", ");
         return Err(ReplayError::MissingTopic {
             topic: SPEED_TOPIC.into(),
-            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed".into(),
+            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed (or a keyphasor to /rotor_twin/keyphasor)".into(),
             present: if present.is_empty() {
                 "none".into()
             } else {
@@ -383,6 +427,44 @@ fn map_topics(
         });
     }
     Ok(roles)
+}
+
+/// The role of a keyphasor or raw-probe topic (issue 12), None for any other, or why its type
+/// does not fit.
+fn plant_signal_role(
+    name: &str,
+    t: &crate::bag::BagTopic,
+    options: &ReplayOptions,
+    rotor_probes: &[String],
+) -> Result<Option<Role>, ReplayError> {
+    let wrong = |expected: &str| ReplayError::WrongType {
+        topic: t.name.clone(),
+        found: t.type_name.clone(),
+        expected: expected.into(),
+    };
+    if name == KEYPHASOR_TOPIC {
+        return match t.type_name.as_str() {
+            messages::Keyphasor::TYPE_NAME => Ok(Some(Role::Keyphasor)),
+            messages::Header::TYPE_NAME => Ok(Some(Role::KeyphasorHeader)),
+            _ => Err(wrong(
+                "rotor_twin_msgs/msg/Keyphasor or std_msgs/msg/Header",
+            )),
+        };
+    }
+    if name == PROBE_SIGNAL_TOPIC {
+        if t.type_name != messages::ProbeSignal::TYPE_NAME {
+            return Err(wrong(messages::ProbeSignal::TYPE_NAME));
+        }
+        return Ok(Some(Role::ProbeSignal));
+    }
+    if let Some((_, probe)) = options.probe_signals.iter().find(|(tp, _)| tp == name) {
+        if t.type_name != messages::Float64::TYPE_NAME {
+            return Err(wrong(messages::Float64::TYPE_NAME));
+        }
+        let k = rotor_probes.iter().position(|p| p == probe).unwrap_or(0);
+        return Ok(Some(Role::ProbeValue(k)));
+    }
+    Ok(None)
 }
 
 /// The output bag: the inputs used (under the twin's topic names) and every prediction.
