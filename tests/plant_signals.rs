@@ -15,6 +15,8 @@ use rotor_twin::signals::PhaseReference;
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 
+mod common;
+
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("rotor-twin-signals-{name}-{}", std::process::id()));
     std::fs::remove_dir_all(&d).ok();
@@ -31,11 +33,20 @@ fn builtin() -> Rotor {
 /// in V at 7.87 V/mm, DC-coupled with the plant's 1 mm (7.87 V) reference gap; with the
 /// plant's runout vectors given when `runout_m` is Some.
 fn machine_with_raw_probes(runout_m: Option<f64>) -> Rotor {
+    raw_machine(
+        "unit: V, sensitivity_v_per_m: 7870.0, coupling: dc, reference_gap: 7.87",
+        runout_m,
+    )
+}
+
+/// The built-in machine with raw probes `<station>_x` / `_y` at 45° and 135°, each with the
+/// YAML fields `fields`, and the plant's runout when `runout_m` is Some.
+fn raw_machine(fields: &str, runout_m: Option<f64>) -> Rotor {
     let mut yaml = format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n");
     for station in ["probe_pulley_end", "probe_outboard"] {
         for (suffix, angle) in [("x", 45.0f64), ("y", 135.0)] {
             yaml += &format!(
-                "  - {{name: {station}_{suffix}, station: {station}, angle_deg: {angle}, unit: V, sensitivity_v_per_m: 7870.0, coupling: dc, reference_gap: 7.87"
+                "  - {{name: {station}_{suffix}, station: {station}, angle_deg: {angle}, {fields}"
             );
             if let Some(r) = runout_m {
                 let v = plant_runout(r, angle.to_radians());
@@ -287,4 +298,64 @@ fn a_bad_keyphasor_is_refused_and_the_twin_carries_on() {
     let w = only.speed_rad_s().unwrap();
     assert!((w / W8000 - 1.0).abs() < 1e-6, "{w} rad/s");
     assert_eq!(only.phase_reference(rev_ns(4.0)), PhaseReference::Locked);
+}
+
+/// Item 5 of the issue: a bag written by PyPI rosbags in standard types only — the keyphasor as
+/// std_msgs/Header, one std_msgs/Float64 gap (µm, AC) per probe, no speed topic — replays with
+/// remaps: the speed comes from the keyphasor's intervals, and each probe axis's 1X lag is the
+/// one the script wrote (β + α: 95° at 45°, 185° at 135°) within 0.5°, 2 µm within 1 %.
+#[test]
+fn a_rosbags_bag_of_standard_types_gives_the_written_phase_lags() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let python = common::python();
+    let dir = scratch("rosbags-signals");
+    let written = std::process::Command::new(&python)
+        .arg(root.join("tests/interop/write_signal_bag.py"))
+        .arg(&dir)
+        .args(["0.4", "8000"])
+        .output()
+        .unwrap();
+    assert!(
+        written.status.success(),
+        "{}",
+        String::from_utf8_lossy(&written.stderr)
+    );
+    let rotor = raw_machine("unit: um, coupling: ac", None);
+    let mut options = ReplayOptions {
+        coupling: Coupling::Nonlinear,
+        film: FilmEvaluation::Direct,
+        steps_per_rev: 128,
+        remaps: vec![("/plant/keyphasor".into(), "/rotor_twin/keyphasor".into())],
+        ..ReplayOptions::default()
+    };
+    for station in ["probe_pulley_end", "probe_outboard"] {
+        for suffix in ["x", "y"] {
+            let name = format!("{station}_{suffix}");
+            options.probe_signals.push((format!("/plant/{name}"), name));
+        }
+    }
+    let bag = Bag::read(&dir).unwrap();
+    let report = replay(&bag, &rotor, &options, &mut |_| {}).unwrap().0;
+    assert!(report.rejected.is_empty(), "{:?}", report.rejected);
+    assert_eq!(report.stations.len(), 2);
+    for st in &report.stations {
+        let m = st
+            .one_x_probe_axes_measured
+            .unwrap_or_else(|| panic!("{st:?}"));
+        for (j, lag) in [95.0, 185.0].iter().enumerate() {
+            eprintln!(
+                "{} axis {j}: {:.4} µm at {:.3}°",
+                st.station,
+                m[j].amplitude_m * 1e6,
+                m[j].phase_lag_deg
+            );
+            assert!(lag_gap(m[j].phase_lag_deg, *lag).abs() < 0.5, "{st:?}");
+            assert!((m[j].amplitude_m / 2e-6 - 1.0).abs() < 0.01, "{st:?}");
+        }
+        let rpm = st.window_speed_rpm.unwrap();
+        assert!(
+            (rpm - 8000.0).abs() < 0.01,
+            "speed from the keyphasor: {rpm} rpm"
+        );
+    }
 }

@@ -15,8 +15,11 @@ use std::f64::consts::TAU;
 pub const KEYPHASOR_STOP_REVS: f64 = 3.0;
 
 /// Time constant of the running mean removed from AC-coupled probes (revolutions): 8, the
-/// replay's block; the twin's predicted mean over the same constant takes its place, so AC
-/// probes compare the motion about the mean.
+/// replay's block. The mean is an exponential average of whole-revolution means (each the
+/// average of the samples of one revolution of the shaft angle), so it carries none of the 1X
+/// or its harmonics (a running average sample by sample would carry 2 % of the 1X at 16
+/// samples a revolution and shift its phase by 1°); the twin's predicted mean, averaged the
+/// same way, takes its place, so AC probes compare the motion about the mean.
 pub const AC_MEAN_REVS: f64 = 8.0;
 
 /// Largest difference between the stamps of the two readings of a station that are paired into
@@ -25,14 +28,44 @@ pub const AC_MEAN_REVS: f64 = 8.0;
 pub const PAIR_TOLERANCE_REVS: f64 = 0.02;
 
 /// State of one raw-probe station: the last reading of each axis (its time, ns, and its
-/// displacement along the axis, m), the running means (m) of the measured AC part and of the
-/// prediction, and the time of the last mean update.
+/// displacement along the axis, m), and the revolution means of the measured and predicted
+/// orbit points.
 #[derive(Debug, Clone, Copy, Default)]
 struct RawStation {
     last: [Option<(i64, f64)>; 2],
-    mean: [Option<f64>; 2],
-    predicted_mean: Option<[f64; 2]>,
-    mean_time_ns: Option<i64>,
+    measured: RevolutionMean,
+    predicted: RevolutionMean,
+}
+
+/// An exponential average, over [`AC_MEAN_REVS`] revolutions, of whole-revolution means of a
+/// point (m); until a revolution is complete, the mean of the samples so far.
+#[derive(Debug, Clone, Copy, Default)]
+struct RevolutionMean {
+    revolution: Option<i64>,
+    sum: [f64; 2],
+    n: usize,
+    mean: Option<[f64; 2]>,
+}
+
+impl RevolutionMean {
+    /// Adds point `xy` at shaft angle `angle_rad`; returns the mean in force.
+    fn add(&mut self, angle_rad: f64, xy: [f64; 2]) -> [f64; 2] {
+        let rev = (angle_rad / TAU).floor() as i64;
+        if self.revolution.is_some_and(|r| r != rev) && self.n > 0 {
+            let done = [self.sum[0] / self.n as f64, self.sum[1] / self.n as f64];
+            let a = 1.0 / AC_MEAN_REVS;
+            self.mean = Some(self.mean.map_or(done, |m| {
+                [m[0] + a * (done[0] - m[0]), m[1] + a * (done[1] - m[1])]
+            }));
+            self.sum = [0.0; 2];
+            self.n = 0;
+        }
+        self.revolution = Some(rev);
+        self.sum = [self.sum[0] + xy[0], self.sum[1] + xy[1]];
+        self.n += 1;
+        self.mean
+            .unwrap_or([self.sum[0] / self.n as f64, self.sum[1] / self.n as f64])
+    }
 }
 
 /// The keyphasor and raw-probe state the driver keeps.
@@ -351,33 +384,21 @@ impl Driver {
     }
 
     /// An AC-coupled station's point `xy` (m) at `t_ns`: its running mean removed and the
-    /// twin's running mean of the prediction put in its place (time constant
-    /// [`AC_MEAN_REVS`] revolutions), so the comparison is of the motion about the mean.
+    /// twin's running mean of the prediction put in its place ([`AC_MEAN_REVS`]), so the
+    /// comparison is of the motion about the mean. Unchanged while no twin runs (nothing is
+    /// compared then).
     fn remove_ac_mean(&mut self, station: usize, t_ns: i64, xy: [f64; 2]) -> [f64; 2] {
-        let w = self.speed.map_or(0.0, |s| s.0).max(1e-3);
-        let predicted = self.session.as_ref().and_then(|s| {
-            let t = (t_ns - s.epoch_ns()) as f64 * 1e-9;
-            s.predicted_probe(station, t).map(|p| p.0)
-        });
+        let Some(s) = self.session.as_ref() else {
+            return xy;
+        };
+        let angle = s.angle_at(t_ns);
+        let t = (t_ns - s.epoch_ns()) as f64 * 1e-9;
+        let Some((p, _)) = s.predicted_probe(station, t) else {
+            return xy;
+        };
         let st = &mut self.signals.stations[station];
-        let dt = st
-            .mean_time_ns
-            .map_or(0.0, |t0| (t_ns - t0).max(0) as f64 * 1e-9);
-        st.mean_time_ns = Some(t_ns);
-        let alpha = 1.0 - (-dt * w / (TAU * AC_MEAN_REVS)).exp();
-        let mut out = [0.0; 2];
-        for j in 0..2 {
-            let m = st.mean[j].map_or(xy[j], |m| m + alpha * (xy[j] - m));
-            st.mean[j] = Some(m);
-            out[j] = xy[j] - m;
-        }
-        if let Some(p) = predicted {
-            let pm = st.predicted_mean.map_or(p, |m| {
-                [m[0] + alpha * (p[0] - m[0]), m[1] + alpha * (p[1] - m[1])]
-            });
-            st.predicted_mean = Some(pm);
-            out = [out[0] + pm[0], out[1] + pm[1]];
-        }
-        out
+        let m = st.measured.add(angle, xy);
+        let pm = st.predicted.add(angle, p);
+        [xy[0] - m[0] + pm[0], xy[1] - m[1] + pm[1]]
     }
 }

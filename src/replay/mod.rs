@@ -195,14 +195,8 @@ pub fn replay(
     };
     let mut report = ReplayReport::empty(bag, 0.0);
     report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
-    let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
-    driver.set_threshold(crate::session::linear_threshold(rotor));
-    let keyphasor_role = |r: &Role| matches!(r, Role::Keyphasor | Role::KeyphasorHeader);
-    if bag.messages.iter().any(|m| keyphasor_role(&roles[m.topic])) {
-        driver.expect_keyphasor();
-    }
     let mut run = Replaying {
-        driver,
+        driver: driver_for(bag, rotor, options, &roles),
         report,
         comparisons,
         emitted: Vec::new(),
@@ -247,6 +241,18 @@ pub fn replay(
         report.messages_out = out.finish()?;
     }
     Ok((report, comparisons))
+}
+
+/// The driver of a replay of `bag` (topic roles `roles`) on `rotor`: the linear threshold
+/// known, and, when the bag has keyphasor events, waiting for the first to start the twin.
+fn driver_for(bag: &Bag, rotor: &Rotor, options: &ReplayOptions, roles: &[Role]) -> Driver {
+    let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
+    driver.set_threshold(crate::session::linear_threshold(rotor));
+    let keyphasor_role = |r: &Role| matches!(r, Role::Keyphasor | Role::KeyphasorHeader);
+    if bag.messages.iter().any(|m| keyphasor_role(&roles[m.topic])) {
+        driver.expect_keyphasor();
+    }
+    driver
 }
 
 /// A replay under way: the driver, what it emitted for the message at hand, and the report and
@@ -337,14 +343,7 @@ fn map_topics(
     stations: &[String],
     rotor_probes: &[String],
 ) -> Result<Vec<Role>, ReplayError> {
-    for (_, probe) in &options.probe_signals {
-        if !rotor_probes.contains(probe) {
-            return Err(ReplayError::UnknownStation(
-                format!("raw probe {probe}"),
-                rotor_probes.join(", "),
-            ));
-        }
-    }
+    check_probe_signal_names(options, rotor_probes)?;
     let remap = |name: &str| -> String {
         options
             .remaps
@@ -404,12 +403,11 @@ fn map_topics(
         roles.push(role);
     }
     // the keyphasor's intervals give the speed where no speed topic does
-    if !roles.iter().any(|r| {
-        matches!(
-            r,
-            Role::SpeedRotor | Role::SpeedFloat | Role::Keyphasor | Role::KeyphasorHeader
-        )
-    }) {
+    let drives = |r: &Role| {
+        use Role::*;
+        matches!(r, SpeedRotor | SpeedFloat | Keyphasor | KeyphasorHeader)
+    };
+    if !roles.iter().any(drives) {
         let present = bag
             .topics
             .iter()
@@ -427,6 +425,24 @@ fn map_topics(
         });
     }
     Ok(roles)
+}
+
+/// The raw probes `--probe-signal` names exist in the machine.
+fn check_probe_signal_names(
+    options: &ReplayOptions,
+    rotor_probes: &[String],
+) -> Result<(), ReplayError> {
+    match options
+        .probe_signals
+        .iter()
+        .find(|(_, p)| !rotor_probes.contains(p))
+    {
+        Some((_, probe)) => Err(ReplayError::UnknownStation(
+            format!("raw probe {probe}"),
+            rotor_probes.join(", "),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The role of a keyphasor or raw-probe topic (issue 12), None for any other, or why its type

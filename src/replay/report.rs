@@ -246,56 +246,7 @@ impl ReplayReport {
         self.stations = comparisons
             .iter()
             .filter(|c| c.samples > 0)
-            .map(|c| {
-                let w = c.summary();
-                let get = |f: fn(&WindowComparison) -> f64| w.as_ref().map(f);
-                StationReport {
-                    station: c.station.clone(),
-                    samples: c.samples,
-                    window_start_s: get(|w| w.start_s),
-                    window_end_s: get(|w| w.end_s),
-                    window_speed_rpm: get(|w| w.speed_rpm),
-                    one_x_amplitude_measured_m: get(|w| w.measured.one_x_amplitude_m),
-                    one_x_amplitude_predicted_m: get(|w| w.predicted.one_x_amplitude_m),
-                    one_x_amplitude_error_m: get(|w| {
-                        w.predicted.one_x_amplitude_m - w.measured.one_x_amplitude_m
-                    }),
-                    one_x_phase_error_deg: w
-                        .as_ref()
-                        .filter(|w| w.phase_null_reason.is_none())
-                        .map(|w| {
-                            phase_difference_deg(
-                                w.predicted.one_x_forward_phase_deg,
-                                w.measured.one_x_forward_phase_deg,
-                            )
-                        }),
-                    one_x_probe_axes_measured: w.as_ref().and_then(|w| w.measured.one_x_probe_axes),
-                    one_x_probe_axes_predicted: w
-                        .as_ref()
-                        .and_then(|w| w.predicted.one_x_probe_axes),
-                    one_x_phase_lag_error_deg: w.as_ref().and_then(|w| {
-                        let (p, m) = (w.predicted.one_x_probe_axes?, w.measured.one_x_probe_axes?);
-                        Some(
-                            [0, 1].map(|j| {
-                                phase_difference_deg(p[j].phase_lag_deg, m[j].phase_lag_deg)
-                            }),
-                        )
-                    }),
-                    phase_null_reason: match &w {
-                        Some(w) => w.phase_null_reason.map(str::to_string),
-                        None => {
-                            Some("no summary window (fewer than 2 revolutions compared)".into())
-                        }
-                    },
-                    subsync_amplitude_predicted_m: get(|w| w.predicted.subsync_amplitude_m),
-                    subsync_amplitude_measured_m: get(|w| w.measured.subsync_amplitude_m),
-                    subsync_ratio_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ratio),
-                    subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
-                    orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
-                    mean_position_distance_m: get(|w| w.mean_position_distance_m),
-                    blocks: c.blocks.clone(),
-                }
-            })
+            .map(station_report)
             .collect();
     }
 
@@ -376,5 +327,49 @@ impl ReplayReport {
             .collect();
         s += &format!("states: {}\n", states.join(" → "));
         s
+    }
+}
+
+/// The report of one station's comparison, over its summary window.
+fn station_report(c: &StationComparison) -> StationReport {
+    let w = c.summary();
+    let get = |f: fn(&WindowComparison) -> f64| w.as_ref().map(f);
+    StationReport {
+        station: c.station.clone(),
+        samples: c.samples,
+        window_start_s: get(|w| w.start_s),
+        window_end_s: get(|w| w.end_s),
+        window_speed_rpm: get(|w| w.speed_rpm),
+        one_x_amplitude_measured_m: get(|w| w.measured.one_x_amplitude_m),
+        one_x_amplitude_predicted_m: get(|w| w.predicted.one_x_amplitude_m),
+        one_x_amplitude_error_m: get(|w| {
+            w.predicted.one_x_amplitude_m - w.measured.one_x_amplitude_m
+        }),
+        one_x_phase_error_deg: w
+            .as_ref()
+            .filter(|w| w.phase_null_reason.is_none())
+            .map(|w| {
+                phase_difference_deg(
+                    w.predicted.one_x_forward_phase_deg,
+                    w.measured.one_x_forward_phase_deg,
+                )
+            }),
+        one_x_probe_axes_measured: w.as_ref().and_then(|w| w.measured.one_x_probe_axes),
+        one_x_probe_axes_predicted: w.as_ref().and_then(|w| w.predicted.one_x_probe_axes),
+        one_x_phase_lag_error_deg: w.as_ref().and_then(|w| {
+            let (p, m) = (w.predicted.one_x_probe_axes?, w.measured.one_x_probe_axes?);
+            Some([0, 1].map(|j| phase_difference_deg(p[j].phase_lag_deg, m[j].phase_lag_deg)))
+        }),
+        phase_null_reason: match &w {
+            Some(w) => w.phase_null_reason.map(str::to_string),
+            None => Some("no summary window (fewer than 2 revolutions compared)".into()),
+        },
+        subsync_amplitude_predicted_m: get(|w| w.predicted.subsync_amplitude_m),
+        subsync_amplitude_measured_m: get(|w| w.measured.subsync_amplitude_m),
+        subsync_ratio_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ratio),
+        subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
+        orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
+        mean_position_distance_m: get(|w| w.mean_position_distance_m),
+        blocks: c.blocks.clone(),
     }
 }

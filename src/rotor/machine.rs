@@ -66,6 +66,8 @@ pub struct MachineDescription {
 
 // --- plant signals (issue 12) ---
 
+use crate::signals::probes::{check_orthogonal, reading_to_m, ProbeCoupling, ProbeUnit, RawProbe};
+
 /// One raw proximity probe.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -119,124 +121,14 @@ fn default_coupling() -> String {
 impl MachineDescription {
     /// The raw proximity probes of the file as the driver uses them, checked: names unique,
     /// stations known, two orthogonal probes a station, unit, sensitivity, coupling, gap and
-    /// runout valid.
-    pub fn raw_probes(
-        &self,
-        file: &str,
-    ) -> Result<Vec<crate::signals::probes::RawProbe>, ConfigError> {
-        use crate::signals::probes::{
-            check_orthogonal, reading_to_m, ProbeCoupling, ProbeUnit, RawProbe,
-        };
-        let err = |i: usize, field: &str, value: String, rule: String| ConfigError {
-            file: file.to_string(),
-            field: format!("proximity_probes[{i}].{field}"),
-            value,
-            rule,
-        };
+    /// runout valid, the slow-roll speed within (0, rated].
+    pub fn raw_probes(&self, file: &str) -> Result<Vec<RawProbe>, ConfigError> {
         let mut out: Vec<RawProbe> = Vec::with_capacity(self.proximity_probes.len());
         for (i, p) in self.proximity_probes.iter().enumerate() {
-            if let Some(rule) = name_problem(&p.name) {
-                return Err(err(i, "name", shown(&p.name), rule));
-            }
-            if out.iter().any(|q| q.name == p.name) {
-                return Err(err(i, "name", shown(&p.name), "must be unique".into()));
-            }
-            let station = self
-                .probes
-                .iter()
-                .position(|s| s.name == p.station)
-                .ok_or_else(|| {
-                    err(
-                        i,
-                        "station",
-                        shown(&p.station),
-                        "must name one of the probes stations".into(),
-                    )
-                })?;
-            let axis = out.iter().filter(|q| q.station == station).count();
-            if axis >= 2 {
-                return Err(err(
-                    i,
-                    "station",
-                    shown(&p.station),
-                    "has two probes already".into(),
-                ));
-            }
-            let unit: ProbeUnit = p
-                .unit
-                .parse()
-                .map_err(|e| err(i, "unit", shown(&p.unit), e))?;
-            let coupling: ProbeCoupling = p
-                .coupling
-                .parse()
-                .map_err(|e| err(i, "coupling", shown(&p.coupling), e))?;
-            let s = p.sensitivity_v_per_m;
-            if !s.is_finite() || s.abs() < 1.0 {
-                return Err(err(
-                    i,
-                    "sensitivity_v_per_m",
-                    s.to_string(),
-                    "must be finite and at least 1 V/m in size".into(),
-                ));
-            }
-            for (field, v) in [
-                ("angle_deg", p.angle_deg),
-                ("reference_gap", p.reference_gap),
-            ] {
-                if !v.is_finite() {
-                    return Err(err(i, field, v.to_string(), "must be finite".into()));
-                }
-            }
-            if let Some(r) = p.runout {
-                if !(r.amplitude_m.is_finite()
-                    && (0.0..=1e-3).contains(&r.amplitude_m)
-                    && r.phase_lag_deg.is_finite())
-                {
-                    return Err(err(
-                        i,
-                        "runout",
-                        format!("{r:?}"),
-                        "amplitude must be 0 to 1 mm, phase finite".into(),
-                    ));
-                }
-            }
-            out.push(RawProbe {
-                name: p.name.clone(),
-                station,
-                axis,
-                angle_rad: p.angle_deg.to_radians(),
-                unit,
-                sensitivity_v_per_m: s,
-                coupling,
-                reference_gap_m: reading_to_m(p.reference_gap, unit, s),
-                runout: p.runout.map(|r| crate::signals::OneXVector {
-                    amplitude_m: r.amplitude_m,
-                    phase_lag_deg: r.phase_lag_deg.rem_euclid(360.0),
-                }),
-            });
+            let probe = self.raw_probe(i, p, &out, file)?;
+            out.push(probe);
         }
-        for (k, st) in self.probes.iter().enumerate() {
-            let at: Vec<&RawProbe> = out.iter().filter(|q| q.station == k).collect();
-            match at.len() {
-                0 => {}
-                2 => check_orthogonal([at[0].angle_rad, at[1].angle_rad]).map_err(|e| {
-                    ConfigError {
-                        file: file.to_string(),
-                        field: "proximity_probes[*].angle_deg".into(),
-                        value: st.name.clone(),
-                        rule: e,
-                    }
-                })?,
-                _ => {
-                    return Err(ConfigError {
-                        file: file.to_string(),
-                        field: "proximity_probes[*].station".into(),
-                        value: st.name.clone(),
-                        rule: "a station needs two probes (one is not enough for an orbit)".into(),
-                    })
-                }
-            }
-        }
+        self.check_probe_pairs(&out, file)?;
         if let Some(v) = self.slow_roll_speed_rpm {
             if !(v.is_finite() && v > 0.0 && v <= self.rated_speed_rpm) {
                 return Err(ConfigError {
@@ -248,6 +140,115 @@ impl MachineDescription {
             }
         }
         Ok(out)
+    }
+
+    /// Entry `i` of `proximity_probes`, checked against the probes before it (`before`).
+    fn raw_probe(
+        &self,
+        i: usize,
+        p: &ProximityProbeSpec,
+        before: &[RawProbe],
+        file: &str,
+    ) -> Result<RawProbe, ConfigError> {
+        let err = |field: &str, value: String, rule: String| ConfigError {
+            file: file.to_string(),
+            field: format!("proximity_probes[{i}].{field}"),
+            value,
+            rule,
+        };
+        if let Some(rule) = name_problem(&p.name) {
+            return Err(err("name", shown(&p.name), rule));
+        }
+        if before.iter().any(|q| q.name == p.name) {
+            return Err(err("name", shown(&p.name), "must be unique".into()));
+        }
+        let station = self
+            .probes
+            .iter()
+            .position(|s| s.name == p.station)
+            .ok_or_else(|| {
+                err(
+                    "station",
+                    shown(&p.station),
+                    "must name one of the probes stations".into(),
+                )
+            })?;
+        let axis = before.iter().filter(|q| q.station == station).count();
+        if axis >= 2 {
+            return Err(err(
+                "station",
+                shown(&p.station),
+                "has two probes already".into(),
+            ));
+        }
+        let unit: ProbeUnit = p.unit.parse().map_err(|e| err("unit", shown(&p.unit), e))?;
+        let coupling: ProbeCoupling = p
+            .coupling
+            .parse()
+            .map_err(|e| err("coupling", shown(&p.coupling), e))?;
+        let s = p.sensitivity_v_per_m;
+        if !s.is_finite() || s.abs() < 1.0 {
+            return Err(err(
+                "sensitivity_v_per_m",
+                s.to_string(),
+                "must be finite and at least 1 V/m in size".into(),
+            ));
+        }
+        for (field, v) in [
+            ("angle_deg", p.angle_deg),
+            ("reference_gap", p.reference_gap),
+        ] {
+            if !v.is_finite() {
+                return Err(err(field, v.to_string(), "must be finite".into()));
+            }
+        }
+        if let Some(r) = p.runout {
+            if !(r.amplitude_m.is_finite()
+                && (0.0..=1e-3).contains(&r.amplitude_m)
+                && r.phase_lag_deg.is_finite())
+            {
+                return Err(err(
+                    "runout",
+                    format!("{r:?}"),
+                    "amplitude must be 0 to 1 mm, phase finite".into(),
+                ));
+            }
+        }
+        Ok(RawProbe {
+            name: p.name.clone(),
+            station,
+            axis,
+            angle_rad: p.angle_deg.to_radians(),
+            unit,
+            sensitivity_v_per_m: s,
+            coupling,
+            reference_gap_m: reading_to_m(p.reference_gap, unit, s),
+            runout: p.runout.map(|r| crate::signals::OneXVector {
+                amplitude_m: r.amplitude_m,
+                phase_lag_deg: r.phase_lag_deg.rem_euclid(360.0),
+            }),
+        })
+    }
+
+    /// Each station with raw probes has two, orthogonal.
+    fn check_probe_pairs(&self, probes: &[RawProbe], file: &str) -> Result<(), ConfigError> {
+        for (k, st) in self.probes.iter().enumerate() {
+            let at: Vec<&RawProbe> = probes.iter().filter(|q| q.station == k).collect();
+            let problem = match at.len() {
+                0 => None,
+                2 => check_orthogonal([at[0].angle_rad, at[1].angle_rad]).err(),
+                _ => Some("a station needs two probes (one is not enough for an orbit)".into()),
+            };
+            if let Some(rule) = problem {
+                return Err(ConfigError {
+                    file: file.to_string(),
+                    field: "proximity_probes[*]".into(),
+                    value: st.name.clone(),
+                    rule,
+                });
+            }
+        }
+        Ok(())
     }
 }
 // --- end plant signals ---
