@@ -197,6 +197,9 @@ pub fn plant_of(rotor: &Rotor, spec: &PlantSpec) -> Rotor {
     plant
 }
 
+/// What [`write_bag`] wrote: the bag directory, the messages per topic, the plant's truth.
+pub type WrittenBag = (PathBuf, Vec<(String, u64)>, PlantTruth);
+
 /// Runs the plant of `rotor` through `spec` and writes the bag to `out`; `progress` gets the
 /// plant time (s) now and then. Returns the bag directory, the messages per topic and the
 /// plant's true 1X vectors (issue 12).
@@ -205,7 +208,7 @@ pub fn write_bag(
     spec: &PlantSpec,
     out: &Path,
     progress: &mut dyn FnMut(f64),
-) -> Result<(PathBuf, Vec<(String, u64)>, PlantTruth), PlantError> {
+) -> Result<WrittenBag, PlantError> {
     let plant = plant_of(rotor, spec);
     let config = TwinConfig {
         film: spec.film,

@@ -13,7 +13,7 @@ use rotor_twin::rotor::{MachineDescription, Rotor, DEFAULT_MACHINE_YAML};
 use rotor_twin::session::Outgoing;
 use rotor_twin::signals::PhaseReference;
 use std::f64::consts::TAU;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 mod common;
 
@@ -89,7 +89,7 @@ fn plant_bag(
     (dir, truth)
 }
 
-fn replay_of(dir: &PathBuf, rotor: &Rotor) -> ReplayReport {
+fn replay_of(dir: &Path, rotor: &Rotor) -> ReplayReport {
     let bag = Bag::read(dir).unwrap();
     let options = ReplayOptions {
         coupling: Coupling::Nonlinear,
