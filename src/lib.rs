@@ -19,6 +19,7 @@ pub mod replay;
 pub mod ros;
 pub mod rotor;
 pub mod session;
+pub mod signals;
 pub mod topics;
 pub mod transient;
 pub mod units;

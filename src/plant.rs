@@ -9,7 +9,7 @@ use crate::messages::{self, Header, Time};
 use crate::record::{RecordError, Recorder, TopicQos};
 use crate::rotor::{BearingModel, Rotor};
 use crate::session::{Session, SessionSettings};
-use crate::topics::{PROBE, SPEED, UNBALANCE};
+use crate::topics::{KEYPHASOR, PROBE, PROBE_SIGNAL, SPEED, UNBALANCE};
 use crate::units::rpm_to_rad_s;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -89,7 +89,81 @@ pub struct PlantSpec {
     pub film: FilmEvaluation,
     /// Seed of the noise.
     pub seed: u64,
+    /// Plant signals (issue 12): keyphasor, raw probes and their runout.
+    pub signals: PlantSignals,
 }
+
+// --- plant signals (issue 12) ---
+
+/// What the plant delivers besides the speed: a keyphasor at an arbitrary shaft angle, and raw
+/// proximity-probe readings with runout instead of machine-frame probe pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlantSignals {
+    /// The plant's shaft angle (deg) at which its reference mark passes the keyphasor probe;
+    /// None: no keyphasor topic. The unbalance is then published with its heavy-spot angle
+    /// measured from the mark (what a balancer reads), φ + θ_k.
+    pub keyphasor_angle_deg: Option<f64>,
+    /// Raw probe readings (ProbeSignal, in V at [`RAW_SENSITIVITY_V_PER_M`], DC-coupled, gap
+    /// [`RAW_REFERENCE_GAP_M`] at the centre) along each station's two probe axes, named
+    /// `<station>_x` (first angle) and `<station>_y` (second), instead of ProbeDisplacement pairs.
+    pub raw_probes: bool,
+    /// Slow-roll runout of each raw probe (m, zero to peak): a 1X pattern of the shaft surface
+    /// whose high spot is [`RUNOUT_HIGH_SPOT_DEG`] from the mark, so the probe at angle α reads
+    /// it with the lag α − 30°.
+    pub runout_m: f64,
+}
+
+/// Sensitivity of the plant's raw probes (V/m): 7.87 V/mm.
+pub const RAW_SENSITIVITY_V_PER_M: f64 = 7870.0;
+/// Gap of the plant's raw probes with the shaft centred (m): 1.0 mm (7.87 V, mid-range).
+pub const RAW_REFERENCE_GAP_M: f64 = 1.0e-3;
+/// Angle of the runout's high spot from the keyphasor mark (deg).
+pub const RUNOUT_HIGH_SPOT_DEG: f64 = 30.0;
+
+/// The plant's runout vector seen by a probe at `angle_rad`: `runout_m` at lag α − 30°.
+pub fn plant_runout(runout_m: f64, angle_rad: f64) -> crate::signals::OneXVector {
+    crate::signals::OneXVector {
+        amplitude_m: runout_m,
+        phase_lag_deg: (angle_rad.to_degrees() - RUNOUT_HIGH_SPOT_DEG).rem_euclid(360.0),
+    }
+}
+
+/// The plant's true 1X vectors over the last [`TRUTH_REVS`] revolutions: at each probe station,
+/// along its two probe axes, from its own (noise- and runout-free) orbit against its own shaft
+/// angle counted from the keyphasor mark.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PlantTruth {
+    /// Per station (machine order): the two axes' 1X vectors; None without a keyphasor.
+    pub one_x_probe_axes: Vec<Option<[crate::signals::OneXVector; 2]>>,
+}
+
+/// Revolutions at the end of the run over which the truth is computed: 32 (the replay's
+/// summary window).
+pub const TRUTH_REVS: usize = 32;
+
+/// Samples of the plant's own orbit for the truth: per station, (ψ from the mark, d along axis
+/// 0, d along axis 1).
+#[derive(Debug, Default)]
+struct TruthSamples {
+    stations: Vec<Vec<(f64, [f64; 2])>>,
+}
+
+impl TruthSamples {
+    fn truth(&self, keyphasor: bool) -> PlantTruth {
+        let vector = |v: &Vec<(f64, [f64; 2])>, j: usize| {
+            crate::signals::one_x_vector(v.iter().map(|(psi, d)| (*psi, d[j])), v.len())
+                .unwrap_or_default()
+        };
+        PlantTruth {
+            one_x_probe_axes: self
+                .stations
+                .iter()
+                .map(|v| keyphasor.then(|| [vector(v, 0), vector(v, 1)]))
+                .collect(),
+        }
+    }
+}
+// --- end plant signals ---
 
 /// Why a synthetic bag could not be written.
 #[derive(Debug, Error)]
@@ -123,14 +197,18 @@ pub fn plant_of(rotor: &Rotor, spec: &PlantSpec) -> Rotor {
     plant
 }
 
+/// What [`write_bag`] wrote: the bag directory, the messages per topic, the plant's truth.
+pub type WrittenBag = (PathBuf, Vec<(String, u64)>, PlantTruth);
+
 /// Runs the plant of `rotor` through `spec` and writes the bag to `out`; `progress` gets the
-/// plant time (s) now and then. Returns the bag directory and the messages per topic.
+/// plant time (s) now and then. Returns the bag directory, the messages per topic and the
+/// plant's true 1X vectors (issue 12).
 pub fn write_bag(
     rotor: &Rotor,
     spec: &PlantSpec,
     out: &Path,
     progress: &mut dyn FnMut(f64),
-) -> Result<(PathBuf, Vec<(String, u64)>), PlantError> {
+) -> Result<WrittenBag, PlantError> {
     let plant = plant_of(rotor, spec);
     let config = TwinConfig {
         film: spec.film,
@@ -147,29 +225,24 @@ pub fn write_bag(
             source,
         })?;
     let mut bag = PlantBag::create(out, rotor, spec)?;
-    bag.write_unbalance(&plant)?;
+    bag.write_unbalance(&plant, spec)?;
     let noise = Normal::new(0.0, spec.noise_m).map_err(|_| PlantError::Noise(spec.noise_m))?;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(spec.seed);
-    let (mut next_speed, mut next_probe) = (0.0, 0.0);
+    let mut sampler = Sampler {
+        noise,
+        rng: rand_chacha::ChaCha8Rng::seed_from_u64(spec.seed),
+        next_speed: 0.0,
+        next_probe: 0.0,
+        truth_from_s: spec.profile.duration_s()
+            - TRUTH_REVS as f64 * TAU / spec.profile.speed_rad_s(spec.profile.duration_s()),
+        truth: TruthSamples {
+            stations: vec![Vec::new(); plant.probes.len()],
+        },
+    };
     let mut last_progress = std::time::Instant::now();
     let profile = spec.profile;
     while session.twin().time_s() < profile.duration_s() {
-        // speed messages at 100 Hz and probe samples every 1/samples_per_rev revolution, each at
-        // its own time, from the plant's state interpolated within the step just taken
-        let now = session.twin().time_s();
-        while next_speed <= now {
-            bag.write_speed(next_speed, &profile)?;
-            next_speed += 1.0 / SPEED_RATE_HZ;
-        }
-        while next_probe <= now {
-            for (k, station) in plant.probes.iter().enumerate() {
-                if let Some(([x, y], _)) = session.predicted_probe(k, next_probe) {
-                    let noisy = [x + noise.sample(&mut rng), y + noise.sample(&mut rng)];
-                    bag.write_probe(next_probe, &station.name, noisy)?;
-                }
-            }
-            next_probe += TAU / profile.speed_rad_s(next_probe) / spec.samples_per_rev as f64;
-        }
+        sampler.write_due(&mut bag, &session, &plant, spec)?;
+        let (now, a0) = (session.twin().time_s(), session.twin().output().angle_rad);
         let t_mid = now + 0.5 * config.time_step_s;
         let input = StepInput {
             speed_rad_s: profile.speed_rad_s(t_mid),
@@ -181,21 +254,109 @@ pub fn write_bag(
                 time_s: now,
                 source,
             })?;
+        let o = session.twin().output();
+        bag.write_keyphasor_crossing(spec, (now, a0), (o.time_s, o.angle_rad))?;
         if last_progress.elapsed().as_secs() >= 5 {
             last_progress = std::time::Instant::now();
             progress(session.twin().time_s());
         }
     }
     let counts = bag.rec.counts();
-    Ok((bag.rec.finish()?, counts))
+    let truth = sampler
+        .truth
+        .truth(spec.signals.keyphasor_angle_deg.is_some());
+    Ok((bag.rec.finish()?, counts, truth))
 }
 
-/// The bag being written: the recorder and its three topics.
+/// When the next speed message and probe sample are due, the noise, and the truth gathered.
+struct Sampler {
+    noise: Normal<f64>,
+    rng: rand_chacha::ChaCha8Rng,
+    next_speed: f64,
+    next_probe: f64,
+    truth_from_s: f64,
+    truth: TruthSamples,
+}
+
+impl Sampler {
+    /// Speed messages at 100 Hz and probe samples every 1/samples_per_rev revolution up to the
+    /// plant's present time, each at its own time, from the plant's state interpolated within
+    /// the step just taken.
+    fn write_due(
+        &mut self,
+        bag: &mut PlantBag,
+        session: &Session,
+        plant: &Rotor,
+        spec: &PlantSpec,
+    ) -> Result<(), RecordError> {
+        let now = session.twin().time_s();
+        while self.next_speed <= now {
+            bag.write_speed(self.next_speed, &spec.profile)?;
+            self.next_speed += 1.0 / SPEED_RATE_HZ;
+        }
+        while self.next_probe <= now {
+            let t = self.next_probe;
+            for (k, station) in plant.probes.iter().enumerate() {
+                if let Some(([x, y], angle)) = session.predicted_probe(k, t) {
+                    self.sample_station(bag, spec, station, k, t, [x, y], angle)?;
+                }
+            }
+            self.next_probe += TAU / spec.profile.speed_rad_s(t) / spec.samples_per_rev as f64;
+        }
+        Ok(())
+    }
+
+    /// One sample of station `k` at plant time `t` (s): the pair, or the two raw readings
+    /// with runout and noise; the clean axis displacements go to the truth.
+    #[allow(clippy::too_many_arguments)]
+    fn sample_station(
+        &mut self,
+        bag: &mut PlantBag,
+        spec: &PlantSpec,
+        station: &crate::rotor::ProbeStation,
+        k: usize,
+        t: f64,
+        xy: [f64; 2],
+        angle_rad: f64,
+    ) -> Result<(), RecordError> {
+        let sig = spec.signals;
+        let psi = angle_rad - sig.keyphasor_angle_deg.unwrap_or(0.0).to_radians();
+        let clean = station
+            .angles_rad
+            .map(|a| xy[0] * a.cos() + xy[1] * a.sin());
+        if t >= self.truth_from_s {
+            self.truth.stations[k].push((psi, clean));
+        }
+        if !sig.raw_probes {
+            let noisy = [
+                xy[0] + self.noise.sample(&mut self.rng),
+                xy[1] + self.noise.sample(&mut self.rng),
+            ];
+            return bag.write_probe(t, &station.name, noisy);
+        }
+        for (j, suffix) in ["x", "y"].iter().enumerate() {
+            let runout = crate::signals::probes::runout_at(
+                &plant_runout(sig.runout_m, station.angles_rad[j]),
+                psi,
+            );
+            let d = clean[j] + runout + self.noise.sample(&mut self.rng);
+            let volts = RAW_SENSITIVITY_V_PER_M * (RAW_REFERENCE_GAP_M - d);
+            bag.write_probe_signal(t, &format!("{}_{suffix}", station.name), volts)?;
+        }
+        Ok(())
+    }
+}
+
+/// The bag being written: the recorder and its topics.
 struct PlantBag {
     rec: Recorder,
     speed: usize,
     unbalance: usize,
-    probe: usize,
+    /// probe pairs (absent with raw probes)
+    probe: Option<usize>,
+    /// keyphasor and raw probe signals (issue 12)
+    keyphasor: Option<usize>,
+    probe_signal: Option<usize>,
 }
 
 fn header(ns: i64, frame: &str) -> Header {
@@ -235,23 +396,92 @@ impl PlantBag {
                 p.from_rpm, p.hold_start_s, p.to_rpm, p.ramp_s, p.hold_end_s
             ),
         );
-        // as a rig publishes: the speed and the unbalance reliable, the probes best effort
+        let sig = spec.signals;
+        rec.set_custom_data(
+            "plant_signals",
+            &format!(
+                "keyphasor {}; probes {}",
+                sig.keyphasor_angle_deg
+                    .map_or("none".into(), |a| format!("at plant shaft angle {a}° (unbalance phases published from the mark)")),
+                if sig.raw_probes {
+                    format!("raw (ProbeSignal in V, {RAW_SENSITIVITY_V_PER_M} V/m, DC, gap {} mm at the centre; runout {:.2} µm, high spot {RUNOUT_HIGH_SPOT_DEG}° from the mark)", RAW_REFERENCE_GAP_M * 1e3, sig.runout_m * 1e6)
+                } else {
+                    "pairs (ProbeDisplacement, m)".into()
+                }
+            ),
+        );
+        // as a rig publishes: the speed and the unbalance reliable, the probes and keyphasor
+        // best effort
+        let sensor = TopicQos::sensor(1000);
         Ok(Self {
             speed: rec.add_topic::<messages::RotorSpeed>(SPEED, TopicQos::reliable(100))?,
             unbalance: rec.add_topic::<messages::Unbalance>(UNBALANCE, TopicQos::reliable(10))?,
-            probe: rec.add_topic::<messages::ProbeDisplacement>(PROBE, TopicQos::sensor(1000))?,
+            probe: match sig.raw_probes {
+                false => Some(rec.add_topic::<messages::ProbeDisplacement>(PROBE, sensor)?),
+                true => None,
+            },
+            keyphasor: match sig.keyphasor_angle_deg {
+                Some(_) => Some(rec.add_topic::<messages::Keyphasor>(KEYPHASOR, sensor)?),
+                None => None,
+            },
+            probe_signal: match sig.raw_probes {
+                true => Some(rec.add_topic::<messages::ProbeSignal>(PROBE_SIGNAL, sensor)?),
+                false => None,
+            },
             rec,
         })
     }
 
-    /// The unbalance as the machine description gives it, once at the start.
-    fn write_unbalance(&mut self, plant: &Rotor) -> Result<(), RecordError> {
+    /// A keyphasor event if the plant's angle passed the mark θ_k (mod 2π) within the step
+    /// from (t0, a0) to (t1, a1) (s, rad), at the instant interpolated within the step.
+    fn write_keyphasor_crossing(
+        &mut self,
+        spec: &PlantSpec,
+        (t0, a0): (f64, f64),
+        (t1, a1): (f64, f64),
+    ) -> Result<(), RecordError> {
+        let (Some(h), Some(mark_deg)) = (self.keyphasor, spec.signals.keyphasor_angle_deg) else {
+            return Ok(());
+        };
+        let mark = mark_deg.to_radians();
+        let target = mark + TAU * ((a1 - mark) / TAU).floor();
+        // the first step also takes an event exactly at its start (a mark at angle 0)
+        let at_start = t0 == 0.0 && (target - a0).abs() < 1e-12;
+        if (target <= a0 && !at_start) || a1 <= a0 {
+            return Ok(());
+        }
+        let t = t0 + (target - a0) / (a1 - a0) * (t1 - t0);
+        let ns = stamp(t);
+        let m = messages::Keyphasor {
+            header: header(ns, "keyphasor"),
+            revolution: (target / TAU).floor().max(0.0) as u32,
+        };
+        self.rec.write(h, &m, ns as u64, ns as u64)
+    }
+
+    fn write_probe_signal(&mut self, t: f64, probe: &str, value: f64) -> Result<(), RecordError> {
+        let Some(h) = self.probe_signal else {
+            return Ok(());
+        };
+        let ns = stamp(t);
+        let m = messages::ProbeSignal {
+            header: header(ns, probe),
+            probe: probe.into(),
+            value,
+        };
+        self.rec.write(h, &m, ns as u64, ns as u64)
+    }
+
+    /// The unbalance as the machine description gives it, once at the start; with a
+    /// keyphasor, its heavy-spot angle from the mark (φ + θ_k).
+    fn write_unbalance(&mut self, plant: &Rotor, spec: &PlantSpec) -> Result<(), RecordError> {
+        let mark = spec.signals.keyphasor_angle_deg.unwrap_or(0.0).to_radians();
         for (plane, u) in plant.unbalance.iter().enumerate() {
             let m = messages::Unbalance {
                 header: header(EPOCH_NS, "rotor"),
                 plane: plane as u32,
                 magnitude: u.magnitude_kg_m,
-                phase: u.phase_rad,
+                phase: crate::signals::keyphasor::wrap_pi(u.phase_rad + mark),
             };
             self.rec
                 .write(self.unbalance, &m, EPOCH_NS as u64, EPOCH_NS as u64)?;
@@ -270,6 +500,9 @@ impl PlantBag {
     }
 
     fn write_probe(&mut self, t: f64, station: &str, xy: [f64; 2]) -> Result<(), RecordError> {
+        let Some(h) = self.probe else {
+            return Ok(());
+        };
         let ns = stamp(t);
         let m = messages::ProbeDisplacement {
             header: header(ns, station),
@@ -277,6 +510,6 @@ impl PlantBag {
             x: xy[0],
             y: xy[1],
         };
-        self.rec.write(self.probe, &m, ns as u64, ns as u64)
+        self.rec.write(h, &m, ns as u64, ns as u64)
     }
 }

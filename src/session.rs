@@ -239,6 +239,23 @@ impl Session {
         self.epoch_ns + (self.twin.time_s() * 1e9).round() as i64
     }
 
+    /// Turns the twin's shaft angle by `delta_rad` (rad), also the angle its probe predictions
+    /// are interpolated from (the keyphasor lock).
+    pub fn shift_angle(&mut self, delta_rad: f64) {
+        if delta_rad.is_finite() {
+            self.twin.shift_angle(delta_rad);
+            self.previous_angle_rad += delta_rad;
+        }
+    }
+
+    /// The twin's shaft angle (rad) at `stamp_ns` (ns since the epoch), extrapolated from its
+    /// present time at its present speed.
+    pub fn angle_at(&self, stamp_ns: i64) -> f64 {
+        let o = self.twin.output();
+        let t = (stamp_ns - self.epoch_ns) as f64 * 1e-9;
+        o.angle_rad + o.speed_rad_s * (t - o.time_s)
+    }
+
     /// Advances one step and hands its messages to `emit`. On an error the twin state is
     /// unchanged and nothing is emitted.
     pub fn step(

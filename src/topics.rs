@@ -11,6 +11,14 @@ pub const UNBALANCE: &str = "/rotor_twin/unbalance";
 pub const OIL_TEMPERATURE: &str = "/rotor_twin/oil_temperature";
 /// Measured probe displacements in (rotor_twin_msgs/ProbeDisplacement).
 pub const PROBE: &str = "/rotor_twin/probe";
+// --- plant signals (issue 12) ---
+/// Keyphasor events in (rotor_twin_msgs/Keyphasor, or std_msgs/Header by remap): best effort,
+/// [`SENSOR_READER`].
+pub const KEYPHASOR: &str = "/rotor_twin/keyphasor";
+/// Raw proximity-probe readings in (rotor_twin_msgs/ProbeSignal; std_msgs/Float64 topics per
+/// probe by the `probe_signal_topics` mapping): best effort, [`SENSOR_READER`].
+pub const PROBE_SIGNAL: &str = "/rotor_twin/probe_signal";
+// --- end plant signals ---
 /// Predicted minus measured at a probe station, out.
 pub const RESIDUAL: &str = "/rotor_twin/residual";
 /// Distance from the linear stability threshold, out.

@@ -43,6 +43,8 @@ fn rust_types_mirror_the_msg_files() {
     check::<InstabilityWarning>();
     check::<StabilityMargin>();
     check::<OrbitResidual>();
+    check::<Keyphasor>();
+    check::<ProbeSignal>();
     check::<Float64>();
     check::<PointStamped>();
     check::<Clock>();
@@ -65,6 +67,8 @@ fn every_msg_file_is_mirrored_listed_and_documented() {
         InstabilityWarning::TYPE_NAME,
         StabilityMargin::TYPE_NAME,
         OrbitResidual::TYPE_NAME,
+        Keyphasor::TYPE_NAME,
+        ProbeSignal::TYPE_NAME,
     ];
     for entry in std::fs::read_dir(dir.join("msg")).unwrap() {
         let path = entry.unwrap().path();

@@ -42,6 +42,10 @@ pub struct ReplayArgs {
     /// A geometry_msgs/PointStamped probe pair (x, y in m): STATION=TOPIC (repeatable).
     #[arg(long, value_parser = parse_probe_point)]
     pub probe_point: Vec<(String, String)>,
+    /// A std_msgs/Float64 raw proximity-probe topic, in the probe's unit (machine file's
+    /// `proximity_probes`): PROBE=TOPIC (repeatable; issue 12).
+    #[arg(long, value_parser = parse_probe_signal)]
+    pub probe_signal: Vec<(String, String)>,
     /// Bearing coupling: nonlinear (reference), linear or prehistory.
     #[arg(long, default_value = "nonlinear", value_parser = ModelKind::from_str)]
     pub model: ModelKind,
@@ -116,6 +120,17 @@ fn parse_probe_point(s: &str) -> Result<(String, String), String> {
     }
     // stored as (topic, station)
     Ok((topic.into(), station.into()))
+}
+
+/// `PROBE=TOPIC` of `--probe-signal`, stored as (topic, probe).
+fn parse_probe_signal(s: &str) -> Result<(String, String), String> {
+    let (probe, topic) = s
+        .split_once('=')
+        .ok_or_else(|| format!("--probe-signal '{s}': expected PROBE=TOPIC"))?;
+    if !topic.starts_with('/') {
+        return Err(format!("--probe-signal '{s}': topic must be absolute (/…)"));
+    }
+    Ok((topic.into(), probe.into()))
 }
 
 /// The main job: the shipped sample bag through the built-in machine, the summary printed, the
@@ -195,6 +210,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         remaps: args.remap.clone(),
         speed_unit: args.speed_unit,
         probe_points: args.probe_point.clone(),
+        probe_signals: args.probe_signal.clone(),
         rate: if args.fast { None } else { args.rate },
         duration_s: args.duration,
         out_bag: (!args.no_bag).then(|| out_dir.join("bag")),

@@ -50,6 +50,21 @@ pub struct SynthArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The plant's shaft angle (deg) at which its keyphasor fires, once a revolution (issue 12):
+    /// the keyphasor topic is written, best effort, and the unbalance phase is published from
+    /// the mark. Default 0.
+    #[arg(long, default_value_t = 0.0)]
+    pub keyphasor_deg: f64,
+    /// Write no keyphasor topic (phases are then null in a replay).
+    #[arg(long)]
+    pub no_keyphasor: bool,
+    /// Write raw proximity-probe readings (ProbeSignal, V at 7.87 V/mm, DC, 1 mm gap, named
+    /// <station>_x and <station>_y along the station's two angles) instead of probe pairs.
+    #[arg(long)]
+    pub raw_probes: bool,
+    /// Runout of each raw probe (µm, zero to peak; high spot 30° from the keyphasor mark).
+    #[arg(long, default_value_t = 0.0)]
+    pub runout_um: f64,
 }
 
 /// Runs `rotor-twin synth-bag`: checks the arguments, writes the bag, prints what it holds.
@@ -67,6 +82,7 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         ("--ramp", args.ramp),
         ("--hold-end", args.hold_end),
         ("--noise-um", args.noise_um),
+        ("--runout-um", args.runout_um),
     ] {
         anyhow::ensure!(v.is_finite() && v >= 0.0, "{name} {v}: must be ≥ 0");
     }
@@ -90,9 +106,19 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         grid_factor: args.grid_factor,
         film: args.film.into(),
         seed: args.seed,
+        signals: crate::plant::PlantSignals {
+            keyphasor_angle_deg: (!args.no_keyphasor).then_some(args.keyphasor_deg),
+            raw_probes: args.raw_probes,
+            runout_m: args.runout_um * 1e-6,
+        },
     };
+    anyhow::ensure!(
+        args.keyphasor_deg.is_finite(),
+        "--keyphasor-deg {}: must be finite",
+        args.keyphasor_deg
+    );
     let total = spec.profile.duration_s();
-    let (dir, counts) = write_bag(&rotor, &spec, &args.out, &mut |t| {
+    let (dir, counts, _truth) = write_bag(&rotor, &spec, &args.out, &mut |t| {
         eprintln!("synth-bag: {t:.2} of {total:.2} s")
     })?;
     println!("wrote SYNTHETIC bag {}", dir.display());

@@ -117,6 +117,22 @@ pub enum Input {
         stamp_ns: i64,
     },
     // --- end oil supply temperature ---
+    // --- plant signals (issue 12) ---
+    /// A once-per-revolution keyphasor event: the plant's shaft angle 0 at the stamp.
+    Keyphasor {
+        /// Header stamp of the event (ns since the epoch; 0: unstamped, the receive time).
+        stamp_ns: i64,
+    },
+    /// One raw proximity-probe reading along the probe's own axis.
+    ProbeSignal {
+        /// The probe.
+        probe: ProbeRef,
+        /// The reading in the probe's unit (machine file's `proximity_probes`).
+        value: f64,
+        /// Header stamp (ns since the epoch; 0: unstamped).
+        stamp_ns: i64,
+    },
+    // --- end plant signals ---
 }
 
 // --- oil supply temperature (issue 12) ---
@@ -124,6 +140,27 @@ impl From<&messages::Temperature> for Input {
     fn from(m: &messages::Temperature) -> Self {
         Input::OilTemperature {
             temperature_k: m.temperature + crate::film::ZERO_CELSIUS_K,
+            stamp_ns: m.header.stamp.as_nanos(),
+        }
+    }
+}
+// --- end oil supply temperature ---
+
+// --- plant signals (issue 12) ---
+
+/// A raw proximity probe, as a message names it (ProbeSignal) or as a topic mapping fixes it
+/// (one std_msgs/Float64 topic per probe).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProbeRef {
+    /// By name, checked against the machine's `proximity_probes`.
+    Name(String),
+    /// By index into the machine's `proximity_probes` (already checked).
+    Index(usize),
+}
+
+impl From<&messages::Keyphasor> for Input {
+    fn from(m: &messages::Keyphasor) -> Self {
+        Input::Keyphasor {
             stamp_ns: m.header.stamp.as_nanos(),
         }
     }
@@ -147,6 +184,36 @@ pub fn oil_viscosity_scale(rotor: &Rotor, t_k: f64) -> Result<f64, String> {
     crate::film::check_viscosity_scale(scale).map_err(|e| format!("oil temperature: {e}"))
 }
 // --- end oil supply temperature ---
+impl From<&messages::Header> for Input {
+    /// A std_msgs/Header on the keyphasor topic: its stamp is the event.
+    fn from(m: &messages::Header) -> Self {
+        Input::Keyphasor {
+            stamp_ns: m.stamp.as_nanos(),
+        }
+    }
+}
+
+impl From<&messages::ProbeSignal> for Input {
+    fn from(m: &messages::ProbeSignal) -> Self {
+        Input::ProbeSignal {
+            probe: ProbeRef::Name(m.probe.clone()),
+            value: m.value,
+            stamp_ns: m.header.stamp.as_nanos(),
+        }
+    }
+}
+
+impl Input {
+    /// A bare probe reading (std_msgs/Float64) of raw probe `probe`: unstamped.
+    pub fn probe_value(value: f64, probe: usize) -> Self {
+        Input::ProbeSignal {
+            probe: ProbeRef::Index(probe),
+            value,
+            stamp_ns: 0,
+        }
+    }
+}
+// --- end plant signals ---
 
 impl From<&messages::RotorSpeed> for Input {
     fn from(m: &messages::RotorSpeed) -> Self {

@@ -7,12 +7,14 @@
 //! or clock: the same inputs at the same times give the same outputs, whoever feeds them.
 
 pub mod inputs;
+mod plant_signals;
 pub mod settings;
 
 pub use inputs::{
-    check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, SpeedGate, SpeedUnit,
-    StationRef,
+    check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
+    SpeedUnit, StationRef,
 };
+pub use plant_signals::SignalState;
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 
 use crate::dynamics::StepInput;
@@ -60,6 +62,8 @@ pub struct ProbeComparison {
     pub measured_m: [f64; 2],
     /// Predicted displacement (m).
     pub predicted_m: [f64; 2],
+    /// Whether the twin's angle (`angle_rad`) is locked to the plant's keyphasor here.
+    pub phase_reference: crate::signals::PhaseReference,
 }
 
 /// What the driver counted since it was made.
@@ -98,6 +102,8 @@ pub struct Driver {
     counts: DriverCounts,
     /// the last accepted oil supply temperature (K)
     oil_temperature_k: Option<f64>,
+    /// keyphasor lock and raw-probe state (issue 12)
+    signals: SignalState,
 }
 
 impl Driver {
@@ -122,6 +128,7 @@ impl Driver {
             last_refusal: String::new(),
             counts: DriverCounts::default(),
             oil_temperature_k: None,
+            signals: SignalState::default(),
         }
     }
 
@@ -198,7 +205,7 @@ impl Driver {
                 speed_rad_s,
                 accel_rad_s2,
                 stamp_ns,
-            } => self.take_speed(now_ns, speed_rad_s, accel_rad_s2, stamp_ns, emit),
+            } => self.take_speed(now_ns, speed_rad_s, accel_rad_s2, stamp_ns, false, emit),
             Input::Unbalance {
                 plane,
                 magnitude_kg_m,
@@ -211,6 +218,12 @@ impl Driver {
                 stamp_ns,
             } => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
             Input::OilTemperature { temperature_k, .. } => self.take_oil_temperature(temperature_k),
+            Input::Keyphasor { stamp_ns } => self.take_keyphasor(now_ns, stamp_ns, emit),
+            Input::ProbeSignal {
+                probe,
+                value,
+                stamp_ns,
+            } => self.take_probe_signal(now_ns, &probe, value, stamp_ns, emit),
         };
         if let Fed::Refused(why) = &fed {
             self.note_refused(now_ns, why, emit);
@@ -237,6 +250,7 @@ impl Driver {
     ) -> usize {
         self.check_gap(now_ns, emit);
         self.check_stale(now_ns, emit);
+        self.check_keyphasor_stop(now_ns, emit);
         self.warn_refusals(now_ns, emit);
         let mut taken = 0;
         if let (Some(s), Some((w, a, _))) = (self.session.as_mut(), self.speed) {
@@ -271,6 +285,7 @@ impl Driver {
         w: f64,
         a: f64,
         stamp_ns: i64,
+        from_keyphasor: bool,
         emit: &mut impl FnMut(Outgoing),
     ) -> Fed {
         let stamp_ns = if self.settings.check_speed_stamps {
@@ -284,12 +299,13 @@ impl Driver {
         };
         self.speed = Some((w, a, now_ns));
         self.last_stale_warning_ns = None;
+        self.signals.speed_from_keyphasor = from_keyphasor;
         if w < self.settings.min_speed_rad_s {
             // below the model's range: pause, and start afresh when the speed is back
             self.session = None;
             return Fed::Taken;
         }
-        if self.session.is_some() {
+        if self.session.is_some() || self.keyphasor_defers_start(now_ns) {
             return Fed::Taken;
         }
         self.start(now_ns, w, emit)
@@ -325,6 +341,7 @@ impl Driver {
             }
         }
         self.session = Some(s);
+        self.signals.keyphasor.unlock();
         self.counts.starts += 1;
         Fed::Started { speed_rad_s: w }
     }
@@ -412,6 +429,7 @@ impl Driver {
             speed_rad_s: s.twin().output().speed_rad_s,
             measured_m: measured,
             predicted_m: [r.predicted_x, r.predicted_y],
+            phase_reference: self.phase_reference(time_ns),
         };
         emit(Outgoing::Residual(r));
         Fed::Compared(comparison)

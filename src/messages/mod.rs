@@ -326,6 +326,31 @@ ros_message!(
     }
 );
 
+// --- plant signals (issue 12): keyphasor and raw proximity probes ---
+
+ros_message!(
+    /// A once-per-revolution keyphasor event: shaft angle 0 of the plant at the stamp.
+    Keyphasor, "Keyphasor.msg" {
+        /// Time of the event; frame: the keyphasor's name.
+        header: Header = "std_msgs/Header",
+        /// Revolution count kept by the sensor (0: none); not used.
+        revolution: u32 = "uint32",
+    }
+);
+
+ros_message!(
+    /// One raw proximity-probe reading along the probe's own axis, in the probe's unit.
+    ProbeSignal, "ProbeSignal.msg" {
+        /// Time of the reading; frame: the probe.
+        header: Header = "std_msgs/Header",
+        /// Probe name (machine file's `proximity_probes`).
+        probe: String = "string",
+        /// Reading in the probe's unit (m, um, mil or V).
+        value: f64 = "float64",
+    }
+);
+// --- end plant signals ---
+
 /// CDR (XCDR1, little endian) payload with its 4-byte encapsulation header `00 01 00 00`: what
 /// DDS puts on the wire and rosbag2 stores.
 pub fn to_cdr<T: Serialize>(message: &T) -> Result<Vec<u8>, String> {

@@ -156,3 +156,18 @@ impl RosMessage for Temperature {
         ("variance", "float64"),
     ];
 }
+
+// --- end oil supply temperature ---
+
+// --- plant signals (issue 12) ---
+
+/// std_msgs/Header as a message of its own: a keyphasor event from a plant bus that has no
+/// keyphasor type (the stamp is the event; accepted by remap onto the keyphasor topic).
+impl RosMessage for Header {
+    const TYPE_NAME: &'static str = "std_msgs/msg/Header";
+    const DEFINITION: &'static str = HEADER_DEFINITION;
+    const DEPENDENCIES: &'static [(&'static str, &'static str)] =
+        &[("builtin_interfaces/Time", TIME_DEFINITION)];
+    const FIELDS: &'static [(&'static str, &'static str)] =
+        &[("stamp", "builtin_interfaces/Time"), ("frame_id", "string")];
+}

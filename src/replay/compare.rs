@@ -8,6 +8,7 @@ use crate::monitor::spectrum::{
     one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
 };
 use crate::monitor::ClassifierSettings;
+use crate::signals::{one_x_vector, OneXVector, PhaseReference};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
@@ -52,6 +53,8 @@ pub struct Sample {
     pub measured_m: [f64; 2],
     /// Predicted displacement `[x, y]` (m).
     pub predicted_m: [f64; 2],
+    /// Whether `angle_rad` was locked to the plant's keyphasor (issue 12).
+    pub phase_reference: PhaseReference,
 }
 
 /// The features of one orbit over a window.
@@ -59,8 +62,13 @@ pub struct Sample {
 pub struct OrbitFeatures {
     /// 1X semi-major axis (m).
     pub one_x_amplitude_m: f64,
-    /// Phase of the forward 1X component against the shaft angle (degrees).
-    pub one_x_phase_deg: f64,
+    /// Phase of the forward 1X component at the window's start (degrees): only for comparing
+    /// two orbits of one window, and only with a keyphasor (not serialized).
+    #[serde(skip)]
+    pub one_x_forward_phase_deg: f64,
+    /// The 1X vector along each probe axis of the station (the machine file's angles), its
+    /// phase lag from the keyphasor (API 670); null without a keyphasor lock over the window.
+    pub one_x_probe_axes: Option<[OneXVector; 2]>,
     /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−3)/R, corrected between
     /// bins ([`subsynchronous_peak`], the monitor's detector).
     pub subsync_amplitude_m: f64,
@@ -90,6 +98,8 @@ pub struct WindowComparison {
     pub orbit_rms_distance_m: f64,
     /// Distance between the two mean positions (m).
     pub mean_position_distance_m: f64,
+    /// Why the window's phases are null (None: keyphasor-referenced).
+    pub phase_null_reason: Option<&'static str>,
 }
 
 /// The order spectra of one block of [`BLOCK_REVS`] revolutions.
@@ -111,6 +121,8 @@ pub struct StationComparison {
     /// Station name.
     pub station: String,
     clearance_m: f64,
+    /// the station's two probe axes (rad from +x towards +y)
+    axes_rad: [f64; 2],
     settings: ClassifierSettings,
     block: Vec<Sample>,
     recent: VecDeque<Sample>,
@@ -129,6 +141,7 @@ impl StationComparison {
         Self {
             station: station.into(),
             clearance_m,
+            axes_rad: [0.0, std::f64::consts::FRAC_PI_2],
             settings: ClassifierSettings::default(),
             block: Vec::new(),
             recent: VecDeque::new(),
@@ -136,6 +149,13 @@ impl StationComparison {
             block_spectra: Vec::new(),
             samples: 0,
         }
+    }
+
+    /// The station's probe axes (rad from +x towards +y), along which 1X phase lags are read
+    /// (default: x and y).
+    pub fn with_axes(mut self, axes_rad: [f64; 2]) -> Self {
+        self.axes_rad = axes_rad;
+        self
     }
 
     /// The clearance sub-synchronous motion is judged against (m).
@@ -314,8 +334,13 @@ impl StationComparison {
         if samples.len() < 8 * revs.max(1) {
             return None;
         }
-        let measured = self.features(samples, revs, |s| s.measured_m);
-        let predicted = self.features(samples, revs, |s| s.predicted_m);
+        let reason = samples.iter().find_map(|s| s.phase_reference.null_reason());
+        let mut measured = self.features(samples, revs, |s| s.measured_m);
+        let mut predicted = self.features(samples, revs, |s| s.predicted_m);
+        if reason.is_some() {
+            measured.one_x_probe_axes = None;
+            predicted.one_x_probe_axes = None;
+        }
         let (mm, pm) = (measured.mean_m, predicted.mean_m);
         let n = samples.len() as f64;
         let shape = samples
@@ -337,6 +362,7 @@ impl StationComparison {
             predicted,
             orbit_rms_distance_m: shape.sqrt(),
             mean_position_distance_m: (pm[0] - mm[0]).hypot(pm[1] - mm[1]),
+            phase_null_reason: reason,
         })
     }
 
@@ -360,9 +386,18 @@ impl StationComparison {
             .settings
             .subsync_counts(abest, one_x.semi_major_m(), self.clearance_m);
         let ratio = counts.then_some(peak.order);
+        let axis = |a: f64| {
+            let (sn, cs) = a.sin_cos();
+            let values = samples.iter().map(|s| {
+                let p = pick(s);
+                (s.angle_rad, p[0] * cs + p[1] * sn)
+            });
+            one_x_vector(values, samples.len()).unwrap_or_default()
+        };
         OrbitFeatures {
             one_x_amplitude_m: one_x.semi_major_m(),
-            one_x_phase_deg: one_x.forward_phase_rad.to_degrees(),
+            one_x_forward_phase_deg: one_x.forward_phase_rad.to_degrees(),
+            one_x_probe_axes: Some([axis(self.axes_rad[0]), axis(self.axes_rad[1])]),
             subsync_amplitude_m: abest,
             subsync_ratio: ratio,
             mean_m: mean,
@@ -434,6 +469,7 @@ mod tests {
                 speed_rad_s: TAU * f,
                 measured_m: m,
                 predicted_m: p,
+                phase_reference: PhaseReference::Locked,
             });
         }
         let w = c.summary().unwrap();
@@ -448,7 +484,10 @@ mod tests {
             (w.predicted.one_x_amplitude_m - 2.5e-6).abs() < 0.025e-6,
             "{w:?}"
         );
-        let dphi = phase_difference_deg(w.predicted.one_x_phase_deg, w.measured.one_x_phase_deg);
+        let dphi = phase_difference_deg(
+            w.predicted.one_x_forward_phase_deg,
+            w.measured.one_x_forward_phase_deg,
+        );
         assert!((dphi - 20.0).abs() < 1.0, "phase error {dphi}°");
         let r = w.measured.subsync_ratio.expect("0.45X found");
         assert!((r - 0.45).abs() < 0.01, "ratio {r}");
@@ -492,6 +531,7 @@ mod tests {
                 speed_rad_s: TAU * 150.0,
                 measured_m: m,
                 predicted_m: [1e-6 * psi.cos(), 1e-6 * psi.sin()],
+                phase_reference: PhaseReference::Locked,
             });
         }
         c

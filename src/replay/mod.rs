@@ -22,6 +22,8 @@ use compare::{Sample, StationComparison};
 use std::path::PathBuf;
 use thiserror::Error;
 
+/// The keyphasor and raw-probe input topics (issue 12).
+pub use crate::topics::{KEYPHASOR as KEYPHASOR_TOPIC, PROBE_SIGNAL as PROBE_SIGNAL_TOPIC};
 /// The twin's input topics (before remapping, the names the node uses).
 pub use crate::topics::{PROBE as PROBE_TOPIC, SPEED as SPEED_TOPIC, UNBALANCE as UNBALANCE_TOPIC};
 
@@ -44,6 +46,8 @@ pub struct ReplayOptions {
     pub speed_unit: SpeedUnit,
     /// geometry_msgs/PointStamped probe topics (after remapping) → probe station name.
     pub probe_points: Vec<(String, String)>,
+    /// std_msgs/Float64 raw-probe topics (after remapping) → raw probe name (issue 12).
+    pub probe_signals: Vec<(String, String)>,
     /// Bag time per wall time (None: as fast as the model runs).
     pub rate: Option<f64>,
     /// Replay only the first this many seconds of the bag.
@@ -66,6 +70,7 @@ impl Default for ReplayOptions {
             remaps: Vec::new(),
             speed_unit: SpeedUnit::Rpm,
             probe_points: Vec::new(),
+            probe_signals: Vec::new(),
             rate: None,
             duration_s: None,
             out_bag: None,
@@ -139,6 +144,11 @@ enum Role {
     ProbePoint(usize),
     /// sensor_msgs/Temperature on the oil temperature topic (issue 12).
     OilTemperature,
+    // plant signals (issue 12)
+    Keyphasor,
+    KeyphasorHeader,
+    ProbeSignal,
+    ProbeValue(usize),
     Other,
 }
 
@@ -153,7 +163,12 @@ pub fn replay(
 ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
     let wall = std::time::Instant::now();
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
-    let roles = map_topics(bag, options, &stations)?;
+    let raw: Vec<String> = rotor
+        .proximity_probes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let roles = map_topics(bag, options, &stations, &raw)?;
     let clearance = rotor
         .bearings
         .iter()
@@ -164,7 +179,8 @@ pub fn replay(
         .fold(f64::INFINITY, f64::min);
     let comparisons: Vec<StationComparison> = stations
         .iter()
-        .map(|s| StationComparison::new(s, clearance))
+        .zip(&rotor.probes)
+        .map(|(s, p)| StationComparison::new(s, clearance).with_axes(p.angles_rad))
         .collect();
     let mut out = match &options.out_bag {
         Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
@@ -182,10 +198,8 @@ pub fn replay(
     };
     let mut report = ReplayReport::empty(bag, 0.0);
     report.bag_duration_s = (t_end - t0) as f64 * 1e-9;
-    let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
-    driver.set_threshold(crate::session::linear_threshold(rotor));
     let mut run = Replaying {
-        driver,
+        driver: driver_for(bag, rotor, options, &roles),
         report,
         comparisons,
         emitted: Vec::new(),
@@ -232,6 +246,18 @@ pub fn replay(
     Ok((report, comparisons))
 }
 
+/// The driver of a replay of `bag` (topic roles `roles`) on `rotor`: the linear threshold
+/// known, and, when the bag has keyphasor events, waiting for the first to start the twin.
+fn driver_for(bag: &Bag, rotor: &Rotor, options: &ReplayOptions, roles: &[Role]) -> Driver {
+    let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
+    driver.set_threshold(crate::session::linear_threshold(rotor));
+    let keyphasor_role = |r: &Role| matches!(r, Role::Keyphasor | Role::KeyphasorHeader);
+    if bag.messages.iter().any(|m| keyphasor_role(&roles[m.topic])) {
+        driver.expect_keyphasor();
+    }
+    driver
+}
+
 /// A replay under way: the driver, what it emitted for the message at hand, and the report and
 /// comparisons being filled.
 struct Replaying {
@@ -275,6 +301,7 @@ impl Replaying {
                 speed_rad_s: c.speed_rad_s,
                 measured_m: c.measured_m,
                 predicted_m: c.predicted_m,
+                phase_reference: c.phase_reference,
             }),
             Fed::Refused(why) => self.report.note_rejection(topic, &why),
             Fed::Taken | Fed::Unused => {}
@@ -292,6 +319,10 @@ fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, 
         Role::Probe => Input::from(&from_cdr::<messages::ProbeDisplacement>(payload)?),
         Role::ProbePoint(k) => Input::probe_point(&from_cdr::<messages::PointStamped>(payload)?, k),
         Role::OilTemperature => Input::from(&from_cdr::<messages::Temperature>(payload)?),
+        Role::Keyphasor => Input::from(&from_cdr::<messages::Keyphasor>(payload)?),
+        Role::KeyphasorHeader => Input::from(&from_cdr::<messages::Header>(payload)?),
+        Role::ProbeSignal => Input::from(&from_cdr::<messages::ProbeSignal>(payload)?),
+        Role::ProbeValue(k) => Input::probe_value(from_cdr::<messages::Float64>(payload)?.data, k),
         Role::Other => return Ok(None),
     }))
 }
@@ -301,7 +332,12 @@ fn decode(role: Role, payload: &[u8], unit: SpeedUnit) -> Result<Option<Input>, 
 /// stations exist.
 pub fn check_mapping(bag: &Bag, rotor: &Rotor, options: &ReplayOptions) -> Result<(), ReplayError> {
     let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
-    map_topics(bag, options, &stations).map(|_| ())
+    let raw: Vec<String> = rotor
+        .proximity_probes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    map_topics(bag, options, &stations, &raw).map(|_| ())
 }
 
 /// The role of each bag topic, checking that the speed topic is there and the types fit.
@@ -309,7 +345,9 @@ fn map_topics(
     bag: &Bag,
     options: &ReplayOptions,
     stations: &[String],
+    rotor_probes: &[String],
 ) -> Result<Vec<Role>, ReplayError> {
+    check_probe_signal_names(options, rotor_probes)?;
     let remap = |name: &str| -> String {
         options
             .remaps
@@ -358,6 +396,8 @@ fn map_topics(
                 return Err(wrong(messages::Temperature::TYPE_NAME));
             }
             Role::OilTemperature
+        } else if let Some(role) = plant_signal_role(&name, t, options, rotor_probes)? {
+            role
         } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| *tp == name) {
             if t.type_name != messages::PointStamped::TYPE_NAME {
                 return Err(wrong(messages::PointStamped::TYPE_NAME));
@@ -371,10 +411,12 @@ fn map_topics(
         }
         roles.push(role);
     }
-    if !roles
-        .iter()
-        .any(|r| matches!(r, Role::SpeedRotor | Role::SpeedFloat))
-    {
+    // the keyphasor's intervals give the speed where no speed topic does
+    let drives = |r: &Role| {
+        use Role::*;
+        matches!(r, SpeedRotor | SpeedFloat | Keyphasor | KeyphasorHeader)
+    };
+    if !roles.iter().any(drives) {
         let present = bag
             .topics
             .iter()
@@ -383,7 +425,7 @@ fn map_topics(
             .join(", ");
         return Err(ReplayError::MissingTopic {
             topic: SPEED_TOPIC.into(),
-            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed".into(),
+            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed (or a keyphasor to /rotor_twin/keyphasor)".into(),
             present: if present.is_empty() {
                 "none".into()
             } else {
@@ -392,6 +434,62 @@ fn map_topics(
         });
     }
     Ok(roles)
+}
+
+/// The raw probes `--probe-signal` names exist in the machine.
+fn check_probe_signal_names(
+    options: &ReplayOptions,
+    rotor_probes: &[String],
+) -> Result<(), ReplayError> {
+    match options
+        .probe_signals
+        .iter()
+        .find(|(_, p)| !rotor_probes.contains(p))
+    {
+        Some((_, probe)) => Err(ReplayError::UnknownStation(
+            format!("raw probe {probe}"),
+            rotor_probes.join(", "),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The role of a keyphasor or raw-probe topic (issue 12), None for any other, or why its type
+/// does not fit.
+fn plant_signal_role(
+    name: &str,
+    t: &crate::bag::BagTopic,
+    options: &ReplayOptions,
+    rotor_probes: &[String],
+) -> Result<Option<Role>, ReplayError> {
+    let wrong = |expected: &str| ReplayError::WrongType {
+        topic: t.name.clone(),
+        found: t.type_name.clone(),
+        expected: expected.into(),
+    };
+    if name == KEYPHASOR_TOPIC {
+        return match t.type_name.as_str() {
+            messages::Keyphasor::TYPE_NAME => Ok(Some(Role::Keyphasor)),
+            messages::Header::TYPE_NAME => Ok(Some(Role::KeyphasorHeader)),
+            _ => Err(wrong(
+                "rotor_twin_msgs/msg/Keyphasor or std_msgs/msg/Header",
+            )),
+        };
+    }
+    if name == PROBE_SIGNAL_TOPIC {
+        if t.type_name != messages::ProbeSignal::TYPE_NAME {
+            return Err(wrong(messages::ProbeSignal::TYPE_NAME));
+        }
+        return Ok(Some(Role::ProbeSignal));
+    }
+    if let Some((_, probe)) = options.probe_signals.iter().find(|(tp, _)| tp == name) {
+        if t.type_name != messages::Float64::TYPE_NAME {
+            return Err(wrong(messages::Float64::TYPE_NAME));
+        }
+        let k = rotor_probes.iter().position(|p| p == probe).unwrap_or(0);
+        return Ok(Some(Role::ProbeValue(k)));
+    }
+    Ok(None)
 }
 
 /// The output bag: the inputs used (under the twin's topic names) and every prediction.

@@ -6,6 +6,7 @@ use super::compare::{
 };
 use crate::bag::Bag;
 use crate::session::{Outgoing, Session};
+use crate::signals::OneXVector;
 use serde::Serialize;
 
 /// Predicted against measured at one probe station, over the summary window (the last 32
@@ -28,8 +29,21 @@ pub struct StationReport {
     pub one_x_amplitude_predicted_m: Option<f64>,
     /// Predicted minus measured 1X semi-major axis (m).
     pub one_x_amplitude_error_m: Option<f64>,
-    /// Predicted minus measured phase of the forward 1X component, in (−180, 180] (degrees).
+    /// Predicted minus measured phase of the forward 1X component, in (−180, 180] (degrees);
+    /// null without a keyphasor lock over the window (see `phase_null_reason`).
     pub one_x_phase_error_deg: Option<f64>,
+    // --- plant signals (issue 12) ---
+    /// Measured 1X vector along each of the station's two probe axes: amplitude (m) and phase
+    /// lag from the keyphasor event to the next positive peak (deg, 0–360, API 670 / Bently);
+    /// null without a keyphasor lock over the window.
+    pub one_x_probe_axes_measured: Option<[OneXVector; 2]>,
+    /// Predicted 1X vector along each probe axis (same convention).
+    pub one_x_probe_axes_predicted: Option<[OneXVector; 2]>,
+    /// Predicted minus measured phase lag per probe axis, in (−180, 180] (deg).
+    pub one_x_phase_lag_error_deg: Option<[f64; 2]>,
+    /// Why the phases are null (null when they are keyphasor-referenced).
+    pub phase_null_reason: Option<String>,
+    // --- end plant signals ---
     /// Largest predicted sub-synchronous semi-major axis (m).
     pub subsync_amplitude_predicted_m: Option<f64>,
     /// Largest measured sub-synchronous semi-major axis (m).
@@ -232,35 +246,7 @@ impl ReplayReport {
         self.stations = comparisons
             .iter()
             .filter(|c| c.samples > 0)
-            .map(|c| {
-                let w = c.summary();
-                let get = |f: fn(&WindowComparison) -> f64| w.as_ref().map(f);
-                StationReport {
-                    station: c.station.clone(),
-                    samples: c.samples,
-                    window_start_s: get(|w| w.start_s),
-                    window_end_s: get(|w| w.end_s),
-                    window_speed_rpm: get(|w| w.speed_rpm),
-                    one_x_amplitude_measured_m: get(|w| w.measured.one_x_amplitude_m),
-                    one_x_amplitude_predicted_m: get(|w| w.predicted.one_x_amplitude_m),
-                    one_x_amplitude_error_m: get(|w| {
-                        w.predicted.one_x_amplitude_m - w.measured.one_x_amplitude_m
-                    }),
-                    one_x_phase_error_deg: get(|w| {
-                        phase_difference_deg(
-                            w.predicted.one_x_phase_deg,
-                            w.measured.one_x_phase_deg,
-                        )
-                    }),
-                    subsync_amplitude_predicted_m: get(|w| w.predicted.subsync_amplitude_m),
-                    subsync_amplitude_measured_m: get(|w| w.measured.subsync_amplitude_m),
-                    subsync_ratio_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ratio),
-                    subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
-                    orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
-                    mean_position_distance_m: get(|w| w.mean_position_distance_m),
-                    blocks: c.blocks.clone(),
-                }
-            })
+            .map(station_report)
             .collect();
     }
 
@@ -287,11 +273,20 @@ impl ReplayReport {
         let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
         for st in &self.stations {
             s += &format!(
-                "{}: 1X {} predicted vs {} measured (phase error {}), sub-synchronous {} at {} vs {} at {}, orbit shape RMS distance {}\n",
+                "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit shape RMS distance {}\n",
                 st.station,
                 um(st.one_x_amplitude_predicted_m),
                 um(st.one_x_amplitude_measured_m),
-                st.one_x_phase_error_deg.map_or("—".into(), |v| format!("{v:.1}°")),
+                match (&st.one_x_probe_axes_measured, &st.one_x_probe_axes_predicted) {
+                    (Some(m), Some(p)) => format!(
+                        "phase lag {:.1}°/{:.1}° predicted vs {:.1}°/{:.1}° measured",
+                        p[0].phase_lag_deg, p[1].phase_lag_deg, m[0].phase_lag_deg, m[1].phase_lag_deg
+                    ),
+                    _ => format!(
+                        "phase null: {}",
+                        st.phase_null_reason.as_deref().unwrap_or("—")
+                    ),
+                },
                 um(st.subsync_amplitude_predicted_m),
                 ratio(st.subsync_ratio_predicted),
                 um(st.subsync_amplitude_measured_m),
@@ -332,5 +327,49 @@ impl ReplayReport {
             .collect();
         s += &format!("states: {}\n", states.join(" → "));
         s
+    }
+}
+
+/// The report of one station's comparison, over its summary window.
+fn station_report(c: &StationComparison) -> StationReport {
+    let w = c.summary();
+    let get = |f: fn(&WindowComparison) -> f64| w.as_ref().map(f);
+    StationReport {
+        station: c.station.clone(),
+        samples: c.samples,
+        window_start_s: get(|w| w.start_s),
+        window_end_s: get(|w| w.end_s),
+        window_speed_rpm: get(|w| w.speed_rpm),
+        one_x_amplitude_measured_m: get(|w| w.measured.one_x_amplitude_m),
+        one_x_amplitude_predicted_m: get(|w| w.predicted.one_x_amplitude_m),
+        one_x_amplitude_error_m: get(|w| {
+            w.predicted.one_x_amplitude_m - w.measured.one_x_amplitude_m
+        }),
+        one_x_phase_error_deg: w
+            .as_ref()
+            .filter(|w| w.phase_null_reason.is_none())
+            .map(|w| {
+                phase_difference_deg(
+                    w.predicted.one_x_forward_phase_deg,
+                    w.measured.one_x_forward_phase_deg,
+                )
+            }),
+        one_x_probe_axes_measured: w.as_ref().and_then(|w| w.measured.one_x_probe_axes),
+        one_x_probe_axes_predicted: w.as_ref().and_then(|w| w.predicted.one_x_probe_axes),
+        one_x_phase_lag_error_deg: w.as_ref().and_then(|w| {
+            let (p, m) = (w.predicted.one_x_probe_axes?, w.measured.one_x_probe_axes?);
+            Some([0, 1].map(|j| phase_difference_deg(p[j].phase_lag_deg, m[j].phase_lag_deg)))
+        }),
+        phase_null_reason: match &w {
+            Some(w) => w.phase_null_reason.map(str::to_string),
+            None => Some("no summary window (fewer than 2 revolutions compared)".into()),
+        },
+        subsync_amplitude_predicted_m: get(|w| w.predicted.subsync_amplitude_m),
+        subsync_amplitude_measured_m: get(|w| w.measured.subsync_amplitude_m),
+        subsync_ratio_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ratio),
+        subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
+        orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
+        mean_position_distance_m: get(|w| w.mean_position_distance_m),
+        blocks: c.blocks.clone(),
     }
 }

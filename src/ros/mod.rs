@@ -619,6 +619,22 @@ fn subscribe_inputs(
             move |m, t| ToRecord::Point(i, m, t),
         )?;
     }
+    // --- plant signals (issue 12): keyphasor events and raw probe readings, best effort ---
+    route.subscribe::<messages::Keyphasor>(
+        node,
+        &topic_name(ros, crate::topics::KEYPHASOR)?,
+        qos::SENSOR_READER,
+        |m| Ok(Input::from(m)),
+        ToRecord::Keyphasor,
+    )?;
+    route.subscribe::<messages::ProbeSignal>(
+        node,
+        &topic_name(ros, crate::topics::PROBE_SIGNAL)?,
+        qos::SENSOR_READER,
+        |m| Ok(Input::from(m)),
+        ToRecord::ProbeSignal,
+    )?;
+    // --- end plant signals ---
     if params.use_sim_time {
         // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
         subscribe_clock(node, &topic_name(ros, CLOCK)?, route.clock.clone())?;

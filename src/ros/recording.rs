@@ -25,6 +25,10 @@ pub(super) enum ToRecord {
     Point(usize, messages::PointStamped, i64),
     /// The oil supply temperature (issue 12).
     Temperature(messages::Temperature, i64),
+    /// A keyphasor event (issue 12).
+    Keyphasor(messages::Keyphasor, i64),
+    /// A raw probe reading (issue 12).
+    ProbeSignal(messages::ProbeSignal, i64),
 }
 
 /// Starts recording to bag directory `dir` what arrives on `rx` (the speed as std_msgs/Float64
@@ -54,6 +58,8 @@ pub(super) fn spawn(
     let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos::STATE)?;
     let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, qos::MARGIN_QOS)?;
     let h_oil = rec.add_topic::<messages::Temperature>(crate::topics::OIL_TEMPERATURE, input)?;
+    let h_keyphasor = rec.add_topic::<messages::Keyphasor>(crate::topics::KEYPHASOR, input)?;
+    let h_signal = rec.add_topic::<messages::ProbeSignal>(crate::topics::PROBE_SIGNAL, input)?;
     let h_points = points
         .iter()
         .map(|(_, topic)| rec.add_topic::<messages::PointStamped>(topic, input))
@@ -70,6 +76,8 @@ pub(super) fn spawn(
                         ToRecord::Probe(m, ns) => rec.write(h_probe, m, t(ns), t(ns))?,
                         ToRecord::Point(i, m, ns) => rec.write(h_points[*i], m, t(ns), t(ns))?,
                         ToRecord::Temperature(m, ns) => rec.write(h_oil, m, t(ns), t(ns))?,
+                        ToRecord::Keyphasor(m, ns) => rec.write(h_keyphasor, m, t(ns), t(ns))?,
+                        ToRecord::ProbeSignal(m, ns) => rec.write(h_signal, m, t(ns), t(ns))?,
                         ToRecord::Out(o, ns) => match o {
                             Outgoing::Journal(m) => rec.write(h_journal, m, t(ns), t(ns))?,
                             Outgoing::Film(m) => rec.write(h_film, m, t(ns), t(ns))?,

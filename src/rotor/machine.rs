@@ -52,7 +52,206 @@ pub struct MachineDescription {
     /// boundaries, each capped by the clearance (`monitor::AlarmLevels`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alarm_levels: Option<AlarmLevelsSpec>,
+    // --- plant signals (issue 12) ---
+    /// Optional raw proximity probes: one scalar signal each along its own axis, two per probe
+    /// station (see [`ProximityProbeSpec`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub proximity_probes: Vec<ProximityProbeSpec>,
+    /// Optional slow-roll speed (rpm): below it (and above zero) the 1X vector of each raw probe
+    /// is measured as its runout, and subtracted from then on (a runout given per probe wins).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slow_roll_speed_rpm: Option<f64>,
+    // --- end plant signals ---
 }
+
+// --- plant signals (issue 12) ---
+
+use crate::signals::probes::{check_orthogonal, reading_to_m, ProbeCoupling, ProbeUnit, RawProbe};
+
+/// One raw proximity probe.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProximityProbeSpec {
+    /// Probe name (the ProbeSignal message's `probe`; unique).
+    pub name: String,
+    /// The probe station (a `probes` entry's name) it belongs to; two probes a station.
+    pub station: String,
+    /// Mounting angle, from `+x` towards `+y` (the direction of rotation) (deg). API 670's X–Y
+    /// pair, 45° either side of vertical, is at 45° and 135° with `+y` up.
+    pub angle_deg: f64,
+    /// Unit of the readings: `m`, `um`, `mil` or `V` (default `um`).
+    #[serde(default = "default_probe_unit")]
+    pub unit: String,
+    /// Sensitivity for readings in volts (V/m); default 7870 (7.87 V/mm = 200 mV/mil).
+    #[serde(default = "default_sensitivity")]
+    pub sensitivity_v_per_m: f64,
+    /// `ac` (mean removed; the default) or `dc` (gap kept as the journal's mean position).
+    #[serde(default = "default_coupling")]
+    pub coupling: String,
+    /// Gap at the reference position (the shaft centred), in the probe's unit; DC coupling.
+    #[serde(default)]
+    pub reference_gap: f64,
+    /// Slow-roll runout 1X vector, if known: amplitude (m) and phase lag (deg) from the keyphasor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub runout: Option<RunoutSpec>,
+}
+
+/// A slow-roll runout vector.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunoutSpec {
+    /// Amplitude, zero to peak, along the probe's axis (m).
+    pub amplitude_m: f64,
+    /// Phase lag from the keyphasor event to the positive peak (deg).
+    pub phase_lag_deg: f64,
+}
+
+fn default_probe_unit() -> String {
+    "um".into()
+}
+
+fn default_sensitivity() -> f64 {
+    crate::signals::probes::DEFAULT_SENSITIVITY_V_PER_M
+}
+
+fn default_coupling() -> String {
+    "ac".into()
+}
+
+impl MachineDescription {
+    /// The raw proximity probes of the file as the driver uses them, checked: names unique,
+    /// stations known, two orthogonal probes a station, unit, sensitivity, coupling, gap and
+    /// runout valid, the slow-roll speed within (0, rated].
+    pub fn raw_probes(&self, file: &str) -> Result<Vec<RawProbe>, ConfigError> {
+        let mut out: Vec<RawProbe> = Vec::with_capacity(self.proximity_probes.len());
+        for (i, p) in self.proximity_probes.iter().enumerate() {
+            let probe = self.raw_probe(i, p, &out, file)?;
+            out.push(probe);
+        }
+        self.check_probe_pairs(&out, file)?;
+        if let Some(v) = self.slow_roll_speed_rpm {
+            if !(v.is_finite() && v > 0.0 && v <= self.rated_speed_rpm) {
+                return Err(ConfigError {
+                    file: file.to_string(),
+                    field: "slow_roll_speed_rpm".into(),
+                    value: v.to_string(),
+                    rule: "must be above 0 and at most the rated speed".into(),
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// Entry `i` of `proximity_probes`, checked against the probes before it (`before`).
+    fn raw_probe(
+        &self,
+        i: usize,
+        p: &ProximityProbeSpec,
+        before: &[RawProbe],
+        file: &str,
+    ) -> Result<RawProbe, ConfigError> {
+        let err = |field: &str, value: String, rule: String| ConfigError {
+            file: file.to_string(),
+            field: format!("proximity_probes[{i}].{field}"),
+            value,
+            rule,
+        };
+        if let Some(rule) = name_problem(&p.name) {
+            return Err(err("name", shown(&p.name), rule));
+        }
+        if before.iter().any(|q| q.name == p.name) {
+            return Err(err("name", shown(&p.name), "must be unique".into()));
+        }
+        let station = self
+            .probes
+            .iter()
+            .position(|s| s.name == p.station)
+            .ok_or_else(|| {
+                err(
+                    "station",
+                    shown(&p.station),
+                    "must name one of the probes stations".into(),
+                )
+            })?;
+        let axis = before.iter().filter(|q| q.station == station).count();
+        if axis >= 2 {
+            return Err(err(
+                "station",
+                shown(&p.station),
+                "has two probes already".into(),
+            ));
+        }
+        let unit: ProbeUnit = p.unit.parse().map_err(|e| err("unit", shown(&p.unit), e))?;
+        let coupling: ProbeCoupling = p
+            .coupling
+            .parse()
+            .map_err(|e| err("coupling", shown(&p.coupling), e))?;
+        let s = p.sensitivity_v_per_m;
+        if !s.is_finite() || s.abs() < 1.0 {
+            return Err(err(
+                "sensitivity_v_per_m",
+                s.to_string(),
+                "must be finite and at least 1 V/m in size".into(),
+            ));
+        }
+        for (field, v) in [
+            ("angle_deg", p.angle_deg),
+            ("reference_gap", p.reference_gap),
+        ] {
+            if !v.is_finite() {
+                return Err(err(field, v.to_string(), "must be finite".into()));
+            }
+        }
+        if let Some(r) = p.runout {
+            if !(r.amplitude_m.is_finite()
+                && (0.0..=1e-3).contains(&r.amplitude_m)
+                && r.phase_lag_deg.is_finite())
+            {
+                return Err(err(
+                    "runout",
+                    format!("{r:?}"),
+                    "amplitude must be 0 to 1 mm, phase finite".into(),
+                ));
+            }
+        }
+        Ok(RawProbe {
+            name: p.name.clone(),
+            station,
+            axis,
+            angle_rad: p.angle_deg.to_radians(),
+            unit,
+            sensitivity_v_per_m: s,
+            coupling,
+            reference_gap_m: reading_to_m(p.reference_gap, unit, s),
+            runout: p.runout.map(|r| crate::signals::OneXVector {
+                amplitude_m: r.amplitude_m,
+                phase_lag_deg: r.phase_lag_deg.rem_euclid(360.0),
+            }),
+        })
+    }
+
+    /// Each station with raw probes has two, orthogonal.
+    fn check_probe_pairs(&self, probes: &[RawProbe], file: &str) -> Result<(), ConfigError> {
+        for (k, st) in self.probes.iter().enumerate() {
+            let at: Vec<&RawProbe> = probes.iter().filter(|q| q.station == k).collect();
+            let problem = match at.len() {
+                0 => None,
+                2 => check_orthogonal([at[0].angle_rad, at[1].angle_rad]).err(),
+                _ => Some("a station needs two probes (one is not enough for an orbit)".into()),
+            };
+            if let Some(rule) = problem {
+                return Err(ConfigError {
+                    file: file.to_string(),
+                    field: "proximity_probes[*]".into(),
+                    value: st.name.clone(),
+                    rule,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+// --- end plant signals ---
 
 /// Alarm levels set by the machine's owner: orbit amplitudes (half the peak-to-peak
 /// displacement), each capped by the bearing's clearance when applied.
@@ -415,6 +614,7 @@ impl MachineDescription {
     // with the bearing entry as a tagged enum is open in issue 10.
     pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
         self.validate_limits(file)?;
+        self.raw_probes(file)?;
         let err = |field: String, value: String, rule: &str| ConfigError {
             file: file.to_string(),
             field,

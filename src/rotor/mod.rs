@@ -215,6 +215,10 @@ pub struct Rotor {
     /// Vibration alarm levels from the machine file (None: the monitor's API 617 / ISO 20816
     /// defaults).
     pub alarm_levels: Option<machine::AlarmLevelsSpec>,
+    /// Raw proximity probes (issue 12; empty: none).
+    pub proximity_probes: Vec<crate::signals::probes::RawProbe>,
+    /// Slow-roll speed below which raw probes' runout is measured (rad/s).
+    pub slow_roll_speed_rad_s: Option<f64>,
     /// Global mass matrix (kg, kg·m²).
     pub mass: Mat<f64>,
     /// Global stiffness: shaft plus support springs (N/m, N·m/rad).
@@ -340,6 +344,9 @@ impl Rotor {
             gravity_m_s2: desc.gravity_m_s2,
             rated_speed_rad_s: rpm_to_rad_s(desc.rated_speed_rpm),
             alarm_levels: desc.alarm_levels,
+            // checked by MachineDescription::validate: a description that did not pass it gives none
+            proximity_probes: desc.raw_probes("").unwrap_or_default(),
+            slow_roll_speed_rad_s: desc.slow_roll_speed_rpm.map(rpm_to_rad_s),
             node_z_m,
             elements,
             discs,

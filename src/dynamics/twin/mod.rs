@@ -130,6 +130,15 @@ impl Twin {
         Ok(())
     }
 
+    /// Turns the rotor's angle (the phase reference of the unbalance) by `delta_rad` (rad),
+    /// e.g. to lock it to the plant's keyphasor; the motion stays. A non-finite value is ignored.
+    pub fn shift_angle(&mut self, delta_rad: f64) {
+        if delta_rad.is_finite() {
+            self.state.angle_rad += delta_rad;
+            self.output.angle_rad = self.state.angle_rad;
+        }
+    }
+
     /// The last step's output (the initial state before the first step).
     pub fn output(&self) -> &StepOutput {
         &self.output

@@ -1,0 +1,404 @@
+//! The driver's part of the plant's own signals (issue 12): the keyphasor lock of the twin's
+//! shaft angle (and the speed from the keyphasor where no speed topic speaks), and raw
+//! proximity-probe readings turned into machine-frame displacements, AC mean removed, slow-roll
+//! runout subtracted, before they are compared like any probe pair.
+
+use super::{seconds_to_ns, Driver, Fed, ProbeRef, StationRef};
+use crate::messages::InstabilityWarning;
+use crate::session::{warning, Outgoing, WarningKind};
+use crate::signals::probes::{check_reading, machine_from_probes, runout_at, SlowRoll};
+use crate::signals::{KeyphasorLock, KeyphasorSettings, OneXVector, PhaseReference};
+use std::f64::consts::TAU;
+
+/// Revolutions without a keyphasor event, at the speed in force, after which the keyphasor
+/// counts as stopped (and phases are null): 3.
+pub const KEYPHASOR_STOP_REVS: f64 = 3.0;
+
+/// Time constant of the running mean removed from AC-coupled probes (revolutions): 8, the
+/// replay's block. The mean is an exponential average of whole-revolution means (each the
+/// average of the samples of one revolution of the shaft angle), so it carries none of the 1X
+/// or its harmonics (a running average sample by sample would carry 2 % of the 1X at 16
+/// samples a revolution and shift its phase by 1°); the twin's predicted mean, averaged the
+/// same way, takes its place, so AC probes compare the motion about the mean.
+pub const AC_MEAN_REVS: f64 = 8.0;
+
+/// Largest difference between the stamps of the two readings of a station that are paired into
+/// one orbit point (share of a revolution): 1/50 (7.2° of rotation). A DAQ stamps the channels of
+/// one scan alike.
+pub const PAIR_TOLERANCE_REVS: f64 = 0.02;
+
+/// State of one raw-probe station: the last reading of each axis (its time, ns, and its
+/// displacement along the axis, m), and the revolution means of the measured and predicted
+/// orbit points.
+#[derive(Debug, Clone, Copy, Default)]
+struct RawStation {
+    last: [Option<(i64, f64)>; 2],
+    measured: RevolutionMean,
+    predicted: RevolutionMean,
+}
+
+/// An exponential average, over [`AC_MEAN_REVS`] revolutions, of whole-revolution means of a
+/// point (m); until a revolution is complete, the mean of the samples so far.
+#[derive(Debug, Clone, Copy, Default)]
+struct RevolutionMean {
+    revolution: Option<i64>,
+    sum: [f64; 2],
+    n: usize,
+    mean: Option<[f64; 2]>,
+}
+
+impl RevolutionMean {
+    /// Adds point `xy` at shaft angle `angle_rad`; returns the mean in force.
+    fn add(&mut self, angle_rad: f64, xy: [f64; 2]) -> [f64; 2] {
+        let rev = (angle_rad / TAU).floor() as i64;
+        if self.revolution.is_some_and(|r| r != rev) && self.n > 0 {
+            let done = [self.sum[0] / self.n as f64, self.sum[1] / self.n as f64];
+            let a = 1.0 / AC_MEAN_REVS;
+            self.mean = Some(self.mean.map_or(done, |m| {
+                [m[0] + a * (done[0] - m[0]), m[1] + a * (done[1] - m[1])]
+            }));
+            self.sum = [0.0; 2];
+            self.n = 0;
+        }
+        self.revolution = Some(rev);
+        self.sum = [self.sum[0] + xy[0], self.sum[1] + xy[1]];
+        self.n += 1;
+        self.mean
+            .unwrap_or([self.sum[0] / self.n as f64, self.sum[1] / self.n as f64])
+    }
+}
+
+/// The keyphasor and raw-probe state the driver keeps.
+#[derive(Debug, Clone, Default)]
+pub struct SignalState {
+    /// The lock.
+    pub(super) keyphasor: KeyphasorLock,
+    /// Any event was received.
+    seen: bool,
+    /// Keyphasor events are known to come (a replayed bag has them): the twin waits for the
+    /// first to start.
+    expected: bool,
+    /// The stop was warned about (reset by the next event).
+    stop_warned: bool,
+    /// The speed in force came from keyphasor intervals (no speed topic speaks).
+    pub(super) speed_from_keyphasor: bool,
+    /// The last keyphasor speed (rad/s) and when (ns), for its acceleration.
+    last_kp_speed: Option<(f64, i64)>,
+    stations: Vec<RawStation>,
+    /// Runout per raw probe: measured below the slow-roll speed (or the file's).
+    slow_roll: Vec<SlowRoll>,
+    measured_runout: Vec<Option<OneXVector>>,
+}
+
+impl SignalState {
+    /// Fresh state for a keyphasor lock with `settings`.
+    pub fn new(settings: KeyphasorSettings) -> Self {
+        Self {
+            keyphasor: KeyphasorLock::new(settings),
+            ..Self::default()
+        }
+    }
+
+    /// The slow-roll runout measured for raw probe `probe`, if any.
+    pub fn measured_runout(&self, probe: usize) -> Option<OneXVector> {
+        self.measured_runout.get(probe).copied().flatten()
+    }
+}
+
+impl Driver {
+    /// Whether 1X phases at `t_ns` are referenced to the keyphasor, and if not why.
+    pub fn phase_reference(&self, t_ns: i64) -> PhaseReference {
+        let s = &self.signals;
+        if !s.seen {
+            return PhaseReference::NoKeyphasor;
+        }
+        if self.keyphasor_stopped(t_ns) {
+            return PhaseReference::Stopped;
+        }
+        if s.keyphasor.is_locked() && self.session.is_some() {
+            PhaseReference::Locked
+        } else {
+            PhaseReference::NotLocked
+        }
+    }
+
+    /// The slow-roll runout vector of each raw probe: the machine file's, else measured.
+    pub fn runouts(&self) -> Vec<Option<OneXVector>> {
+        (0..self.rotor.proximity_probes.len())
+            .map(|k| self.runout(k))
+            .collect()
+    }
+
+    fn runout(&self, k: usize) -> Option<OneXVector> {
+        self.rotor
+            .proximity_probes
+            .get(k)
+            .and_then(|p| p.runout)
+            .or_else(|| self.signals.measured_runout(k))
+    }
+
+    fn keyphasor_stopped(&self, t_ns: i64) -> bool {
+        let (Some(last), Some((w, _, _))) = (self.signals.keyphasor.last_event_ns(), self.speed)
+        else {
+            return false;
+        };
+        let limit_s = KEYPHASOR_STOP_REVS * TAU / w.max(1e-3);
+        (t_ns - last) as f64 * 1e-9 > limit_s
+    }
+
+    /// A keyphasor event stamped `stamp_ns`, received at `now_ns`: checked against the speed,
+    /// then the twin's angle is corrected; without a speed topic, its interval is the speed.
+    pub(super) fn take_keyphasor(
+        &mut self,
+        now_ns: i64,
+        stamp_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let tolerance = seconds_to_ns(self.settings.input_timeout_s);
+        let t = if stamp_ns != 0 && (stamp_ns - now_ns).abs() <= tolerance {
+            stamp_ns
+        } else {
+            now_ns
+        };
+        self.signals.seen = true;
+        self.signals.stop_warned = false;
+        let topic_speed = self
+            .speed
+            .filter(|_| !self.signals.speed_from_keyphasor)
+            .filter(|s| (now_ns - s.2) <= tolerance)
+            .map(|s| s.0);
+        let angle = self.session.as_ref().map(|s| s.angle_at(t));
+        let ev = match self.signals.keyphasor.event(t, angle, topic_speed) {
+            Ok(ev) => ev,
+            Err(why) => return Fed::Refused(why),
+        };
+        if let (Some(c), Some(s)) = (ev.correction_rad, self.session.as_mut()) {
+            s.shift_angle(c);
+        }
+        if ev.relocked {
+            emit(warning(
+                now_ns,
+                InstabilityWarning::WARN,
+                WarningKind::BadInput,
+                "",
+                "keyphasor: the reference moved and held; the twin's angle is locked to the new one"
+                    .into(),
+            ));
+        }
+        let fed = match (ev.interval_speed_rad_s, topic_speed) {
+            (Some(w), None) => self.speed_from_interval(now_ns, w, emit),
+            _ => Fed::Taken,
+        };
+        self.start_at_event(t, fed, emit)
+    }
+
+    /// With a keyphasor the twin starts at an event, its angle 0 there: locked from its first
+    /// step (a lock that turned a running twin by a large angle would set off a transient).
+    pub(super) fn keyphasor_defers_start(&self, now_ns: i64) -> bool {
+        (self.signals.seen || self.signals.expected) && !self.keyphasor_stopped(now_ns)
+    }
+
+    /// Keyphasor events will come (a bag with keyphasor messages): the twin waits for the
+    /// first event to start, so that it is locked from its first step.
+    pub fn expect_keyphasor(&mut self) {
+        self.signals.expected = true;
+    }
+
+    /// Starts the twin at the event at `t_ns` if the speed in force allows and none runs.
+    fn start_at_event(&mut self, t_ns: i64, fed: Fed, emit: &mut impl FnMut(Outgoing)) -> Fed {
+        let Some((w, _, _)) = self.speed else {
+            return fed;
+        };
+        if self.session.is_some() || w < self.settings.min_speed_rad_s {
+            return fed;
+        }
+        let started = self.start(t_ns, w, emit);
+        if matches!(started, Fed::Started { .. }) {
+            self.signals.keyphasor.lock_at_event();
+        }
+        started
+    }
+
+    /// The speed from a keyphasor interval (rad/s), with the acceleration from the last one.
+    fn speed_from_interval(&mut self, now_ns: i64, w: f64, emit: &mut impl FnMut(Outgoing)) -> Fed {
+        let a = self.signals.last_kp_speed.map_or(0.0, |(w0, t0)| {
+            let dt = (now_ns - t0) as f64 * 1e-9;
+            if dt > 0.0 {
+                ((w - w0) / dt).clamp(
+                    -super::inputs::MAX_ACCEL_RAD_S2,
+                    super::inputs::MAX_ACCEL_RAD_S2,
+                )
+            } else {
+                0.0
+            }
+        });
+        self.signals.last_kp_speed = Some((w, now_ns));
+        self.take_speed(now_ns, w, a, 0, true, emit)
+    }
+
+    /// Warns once when the keyphasor stops while the shaft turns; phases are null meanwhile.
+    pub(super) fn check_keyphasor_stop(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        if self.signals.stop_warned || self.session.is_none() || !self.keyphasor_stopped(now_ns) {
+            return;
+        }
+        self.signals.stop_warned = true;
+        emit(warning(
+            now_ns,
+            InstabilityWarning::WARN,
+            WarningKind::StaleInput,
+            "",
+            format!(
+                "keyphasor stopped: no event for {KEYPHASOR_STOP_REVS} revolutions; 1X phases are null until it is back, the twin carries on with the speed"
+            ),
+        ));
+    }
+
+    /// One raw probe reading: checked, turned into the displacement along the probe's axis,
+    /// runout subtracted; paired with the other probe of its station into an orbit point.
+    pub(super) fn take_probe_signal(
+        &mut self,
+        now_ns: i64,
+        probe: &ProbeRef,
+        value: f64,
+        stamp_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let probes = &self.rotor.proximity_probes;
+        let k = match probe {
+            ProbeRef::Index(k) if *k < probes.len() => *k,
+            ProbeRef::Name(n) => match probes.iter().position(|p| &p.name == n) {
+                Some(k) => k,
+                None => {
+                    return Fed::Refused(format!(
+                        "probe '{}' is not in the machine's proximity_probes",
+                        n.chars().take(64).collect::<String>()
+                    ))
+                }
+            },
+            ProbeRef::Index(k) => return Fed::Refused(format!("raw probe {k} does not exist")),
+        };
+        let p = &probes[k];
+        let (station, axis) = (p.station, p.axis);
+        let d = match check_reading(p, value) {
+            Ok(d) => d,
+            Err(why) => return Fed::Refused(why),
+        };
+        let tolerance = seconds_to_ns(self.settings.input_timeout_s);
+        let t = if stamp_ns != 0 && (stamp_ns - now_ns).abs() <= tolerance {
+            stamp_ns
+        } else {
+            now_ns
+        };
+        let d = self.compensate_runout(k, t, d);
+        if self.signals.stations.len() < self.rotor.probes.len() {
+            self.signals.stations = vec![RawStation::default(); self.rotor.probes.len()];
+        }
+        self.signals.stations[station].last[axis] = Some((t, d));
+        self.pair_station(now_ns, station, axis, emit)
+    }
+
+    /// The displacement `d` (m) of raw probe `k` at `t_ns` with its runout subtracted (when
+    /// the phase is referenced); below the slow-roll speed, the runout is measured instead.
+    fn compensate_runout(&mut self, k: usize, t_ns: i64, d: f64) -> f64 {
+        let n = self.rotor.proximity_probes.len();
+        if self.signals.slow_roll.len() < n {
+            self.signals.slow_roll = vec![SlowRoll::default(); n];
+            self.signals.measured_runout = vec![None; n];
+        }
+        let slow = self.rotor.slow_roll_speed_rad_s;
+        let w = self.speed.map(|s| s.0);
+        if let (Some(limit), Some(w), Some(psi)) = (slow, w, self.keyphasor_angle(t_ns)) {
+            if w > 0.0 && w < limit {
+                self.signals.slow_roll[k].add(psi, d);
+                if let Some(v) = self.signals.slow_roll[k].vector() {
+                    self.signals.measured_runout[k] = Some(v);
+                }
+                return d;
+            }
+        }
+        match (self.runout(k), self.phase_reference(t_ns)) {
+            (Some(r), PhaseReference::Locked) => {
+                let psi = self.session.as_ref().map_or(0.0, |s| s.angle_at(t_ns));
+                d - runout_at(&r, psi)
+            }
+            _ => d,
+        }
+    }
+
+    /// The plant's shaft angle at `t_ns` from the keyphasor alone (rad, 0 at the last event,
+    /// growing at the speed in force), for slow roll where no twin runs.
+    fn keyphasor_angle(&self, t_ns: i64) -> Option<f64> {
+        let last = self.signals.keyphasor.last_event_ns()?;
+        let (w, _, _) = self.speed?;
+        let dt = (t_ns - last) as f64 * 1e-9;
+        (dt >= 0.0 && self.signals.seen && !self.keyphasor_stopped(t_ns)).then_some(w * dt)
+    }
+
+    /// Pairs the reading just stored on `axis` of `station` with the other axis' if their
+    /// stamps agree within [`PAIR_TOLERANCE_REVS`]; the pair becomes an orbit point.
+    fn pair_station(
+        &mut self,
+        now_ns: i64,
+        station: usize,
+        axis: usize,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let st = self.signals.stations[station];
+        let (Some((t0, d0)), Some((t1, d1))) = (st.last[axis], st.last[1 - axis]) else {
+            return Fed::Taken;
+        };
+        let w = self.speed.map_or(0.0, |s| s.0).max(1e-3);
+        if ((t0 - t1).abs() as f64 * 1e-9) > PAIR_TOLERANCE_REVS * TAU / w {
+            return Fed::Taken;
+        }
+        self.signals.stations[station].last = [None, None];
+        let mut d = [0.0; 2];
+        d[axis] = d0;
+        d[1 - axis] = d1;
+        let angles = self.station_axes(station);
+        let mut xy = machine_from_probes(d, angles);
+        if self.station_is_ac(station) {
+            xy = self.remove_ac_mean(station, t0, xy);
+        }
+        self.compare_probe(now_ns, &StationRef::Index(station), xy, t0, emit)
+    }
+
+    /// The two axis angles (rad) of a raw-probe station, in axis order.
+    fn station_axes(&self, station: usize) -> [f64; 2] {
+        let mut a = [0.0, std::f64::consts::FRAC_PI_2];
+        for p in self
+            .rotor
+            .proximity_probes
+            .iter()
+            .filter(|p| p.station == station)
+        {
+            a[p.axis] = p.angle_rad;
+        }
+        a
+    }
+
+    fn station_is_ac(&self, station: usize) -> bool {
+        self.rotor.proximity_probes.iter().any(|p| {
+            p.station == station && p.coupling == crate::signals::probes::ProbeCoupling::Ac
+        })
+    }
+
+    /// An AC-coupled station's point `xy` (m) at `t_ns`: its running mean removed and the
+    /// twin's running mean of the prediction put in its place ([`AC_MEAN_REVS`]), so the
+    /// comparison is of the motion about the mean. Unchanged while no twin runs (nothing is
+    /// compared then).
+    fn remove_ac_mean(&mut self, station: usize, t_ns: i64, xy: [f64; 2]) -> [f64; 2] {
+        let Some(s) = self.session.as_ref() else {
+            return xy;
+        };
+        let angle = s.angle_at(t_ns);
+        let t = (t_ns - s.epoch_ns()) as f64 * 1e-9;
+        let Some((p, _)) = s.predicted_probe(station, t) else {
+            return xy;
+        };
+        let st = &mut self.signals.stations[station];
+        let m = st.measured.add(angle, xy);
+        let pm = st.predicted.add(angle, p);
+        [xy[0] - m[0] + pm[0], xy[1] - m[1] + pm[1]]
+    }
+}

@@ -1,0 +1,361 @@
+//! The plant's own signals (issue 12): a synthetic plant that differs from the twin in what it
+//! delivers — a keyphasor at an arbitrary shaft angle, raw proximity probes at ±45° of vertical
+//! in volts with 5 µm of runout and 0.3 µm of noise, best effort — replays to the plant's true
+//! 1X phase lag and amplitude; without a keyphasor the phases are null with the reason; a
+//! keyphasor that misses, jumps or stops is refused and reported while the twin carries on.
+
+use rotor_twin::bag::Bag;
+use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind};
+use rotor_twin::dynamics::{Coupling, FilmEvaluation};
+use rotor_twin::plant::{plant_runout, write_bag, PlantSignals, PlantSpec, SpeedProfile};
+use rotor_twin::replay::{replay, ReplayOptions, ReplayReport};
+use rotor_twin::rotor::{MachineDescription, Rotor, DEFAULT_MACHINE_YAML};
+use rotor_twin::session::Outgoing;
+use rotor_twin::signals::PhaseReference;
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+mod common;
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rotor-twin-signals-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&d).ok();
+    d
+}
+
+fn builtin() -> Rotor {
+    Rotor::from_description(
+        &MachineDescription::from_yaml(DEFAULT_MACHINE_YAML, "built-in").unwrap(),
+    )
+}
+
+/// The built-in machine with raw probes `<station>_x` / `_y` at the stations' 45° and 135°,
+/// in V at 7.87 V/mm, DC-coupled with the plant's 1 mm (7.87 V) reference gap; with the
+/// plant's runout vectors given when `runout_m` is Some.
+fn machine_with_raw_probes(runout_m: Option<f64>) -> Rotor {
+    raw_machine(
+        "unit: V, sensitivity_v_per_m: 7870.0, coupling: dc, reference_gap: 7.87",
+        runout_m,
+    )
+}
+
+/// The built-in machine with raw probes `<station>_x` / `_y` at 45° and 135°, each with the
+/// YAML fields `fields`, and the plant's runout when `runout_m` is Some.
+fn raw_machine(fields: &str, runout_m: Option<f64>) -> Rotor {
+    let mut yaml = format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n");
+    for station in ["probe_pulley_end", "probe_outboard"] {
+        for (suffix, angle) in [("x", 45.0f64), ("y", 135.0)] {
+            yaml += &format!(
+                "  - {{name: {station}_{suffix}, station: {station}, angle_deg: {angle}, {fields}"
+            );
+            if let Some(r) = runout_m {
+                let v = plant_runout(r, angle.to_radians());
+                yaml += &format!(
+                    ", runout: {{amplitude_m: {}, phase_lag_deg: {}}}",
+                    v.amplitude_m, v.phase_lag_deg
+                );
+            }
+            yaml += "}\n";
+        }
+    }
+    Rotor::from_description(&MachineDescription::from_yaml(&yaml, "raw.yaml").unwrap())
+}
+
+/// A plant of the built-in machine held at 8,000 rpm (stable) for `seconds`, the twin's own
+/// film model (direct solver), 16 samples a revolution, 0.3 µm of noise, with `signals`.
+fn plant_bag(
+    name: &str,
+    seconds: f64,
+    signals: PlantSignals,
+) -> (PathBuf, rotor_twin::plant::PlantTruth) {
+    let spec = PlantSpec {
+        profile: SpeedProfile {
+            from_rpm: 8000.0,
+            to_rpm: 8000.0,
+            hold_start_s: seconds,
+            ramp_s: 0.0,
+            hold_end_s: 0.0,
+        },
+        samples_per_rev: 16,
+        noise_m: 0.3e-6,
+        viscosity_factor: 1.0,
+        grid_factor: 1.0,
+        film: FilmEvaluation::Direct,
+        seed: 7,
+        signals,
+    };
+    let dir = scratch(name);
+    let (dir, _, truth) = write_bag(&builtin(), &spec, &dir, &mut |_| {}).unwrap();
+    (dir, truth)
+}
+
+fn replay_of(dir: &Path, rotor: &Rotor) -> ReplayReport {
+    let bag = Bag::read(dir).unwrap();
+    let options = ReplayOptions {
+        coupling: Coupling::Nonlinear,
+        film: FilmEvaluation::Direct,
+        steps_per_rev: 128,
+        ..ReplayOptions::default()
+    };
+    replay(&bag, rotor, &options, &mut |_| {}).unwrap().0
+}
+
+fn lag_gap(a: f64, b: f64) -> f64 {
+    (a - b + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// The issue's check: keyphasor at 123° of the plant's shaft angle, raw probes in volts at 45°
+/// and 135° with 5 µm of runout and 0.3 µm of noise. The replay's measured 1X phase lag is
+/// within 5° of the plant's true lag (computed by the plant from its own shaft angle, counted
+/// from the mark, and its own noise- and runout-free orbit, over the same last 32 revolutions),
+/// the amplitude within 5 %. The twin, given the unbalance phase from the mark, predicts the lag
+/// within 5° too. Without the runout in the machine file the same bag misses by more (the
+/// runout is larger than the 1X motion): the compensation is what makes the figure.
+#[test]
+fn a_plant_keyphasor_anywhere_and_raw_probes_with_runout_give_the_true_phase_lag() {
+    let signals = PlantSignals {
+        keyphasor_angle_deg: Some(123.0),
+        raw_probes: true,
+        runout_m: 5e-6,
+    };
+    let (dir, truth) = plant_bag("raw", 0.35, signals);
+    let report = replay_of(&dir, &machine_with_raw_probes(Some(5e-6)));
+    assert!(report.rejected.is_empty(), "{:?}", report.rejected);
+    let mut worst = (0.0f64, 0.0f64);
+    for (k, st) in report.stations.iter().enumerate() {
+        let t = truth.one_x_probe_axes[k].expect("truth with a keyphasor");
+        let m = st
+            .one_x_probe_axes_measured
+            .unwrap_or_else(|| panic!("{st:?}"));
+        let p = st.one_x_probe_axes_predicted.unwrap();
+        for j in 0..2 {
+            let dl = lag_gap(m[j].phase_lag_deg, t[j].phase_lag_deg);
+            let da = m[j].amplitude_m / t[j].amplitude_m - 1.0;
+            eprintln!(
+                "{} axis {j}: truth {:.3} µm at {:.2}°, measured {:.3} µm at {:.2}°, predicted {:.3} µm at {:.2}°",
+                st.station,
+                t[j].amplitude_m * 1e6,
+                t[j].phase_lag_deg,
+                m[j].amplitude_m * 1e6,
+                m[j].phase_lag_deg,
+                p[j].amplitude_m * 1e6,
+                p[j].phase_lag_deg
+            );
+            assert!(t[j].amplitude_m > 1e-6, "a 1X response to measure: {t:?}");
+            assert!(dl.abs() < 5.0, "{}: lag {dl}° off the truth", st.station);
+            assert!(
+                da.abs() < 0.05,
+                "{}: amplitude {da} off the truth",
+                st.station
+            );
+            assert!(lag_gap(p[j].phase_lag_deg, m[j].phase_lag_deg).abs() < 5.0);
+            worst = (worst.0.max(dl.abs()), worst.1.max(da.abs()));
+        }
+        assert!(st.phase_null_reason.is_none());
+    }
+    eprintln!(
+        "worst: lag {:.2}°, amplitude {:.2} %",
+        worst.0,
+        worst.1 * 100.0
+    );
+    // the same bag without the runout compensation
+    let raw = replay_of(&dir, &machine_with_raw_probes(None));
+    let miss = raw
+        .stations
+        .iter()
+        .enumerate()
+        .flat_map(|(k, st)| {
+            let t = truth.one_x_probe_axes[k].unwrap();
+            let m = st.one_x_probe_axes_measured.unwrap();
+            (0..2).map(move |j| lag_gap(m[j].phase_lag_deg, t[j].phase_lag_deg).abs())
+        })
+        .fold(0.0, f64::max);
+    eprintln!("without runout compensation: worst lag {miss:.1}°");
+    assert!(miss > 10.0, "runout uncompensated should show: {miss}°");
+}
+
+/// Without a keyphasor topic the phase outputs are null with the reason; amplitudes stay.
+#[test]
+fn without_a_keyphasor_phases_are_null_with_the_reason() {
+    let (dir, truth) = plant_bag("nokp", 0.2, PlantSignals::default());
+    assert!(truth.one_x_probe_axes.iter().all(Option::is_none));
+    let report = replay_of(&dir, &builtin());
+    for st in &report.stations {
+        assert!(st.one_x_probe_axes_measured.is_none() && st.one_x_phase_error_deg.is_none());
+        assert!(st.one_x_amplitude_measured_m.unwrap() > 1e-6);
+        let why = st.phase_null_reason.as_deref().unwrap();
+        assert!(why.contains("no keyphasor"), "{why}");
+    }
+}
+
+const W8000: f64 = 8000.0 * std::f64::consts::PI / 30.0;
+
+fn rev_ns(k: f64) -> i64 {
+    1_000_000_000 + (k * TAU / W8000 * 1e9).round() as i64
+}
+
+/// A keyphasor that misses a pulse, comes 30° late for two events (within the interval check's
+/// 10 % = 36°, beyond the lock's 20°), then stops: each bad event is
+/// refused with its reason and warned about, the stop is warned about and the phase reference
+/// reads Stopped, while the twin keeps stepping on the speed topic. A driver fed only keyphasor
+/// events takes its speed from their intervals (8,000 rpm to 1e-6).
+#[test]
+fn a_bad_keyphasor_is_refused_and_the_twin_carries_on() {
+    let rotor = builtin();
+    let settings = DriverSettings::new(
+        ModelKind::Nonlinear,
+        FilmEvaluation::Direct,
+        rotor.rated_speed_rad_s,
+    );
+    let mut driver = Driver::new(rotor.clone(), settings);
+    let mut warnings = Vec::new();
+    let mut emit = |o: Outgoing| {
+        if let Outgoing::Warning(w) = o {
+            warnings.push(w.evidence);
+        }
+    };
+    let speed = |t: i64| Input::Speed {
+        speed_rad_s: W8000,
+        accel_rad_s2: 0.0,
+        stamp_ns: t,
+    };
+    let mut refused = Vec::new();
+    let mut k_speed = 0i64;
+    let mut feed_speeds_to = |d: &mut Driver, t: i64, emit: &mut dyn FnMut(Outgoing)| {
+        while 1_000_000_000 + k_speed * 10_000_000 <= t {
+            d.feed(
+                1_000_000_000 + k_speed * 10_000_000,
+                speed(1_000_000_000 + k_speed * 10_000_000),
+                &mut |o| emit(o),
+            );
+            k_speed += 1;
+        }
+    };
+    for k in 0..30 {
+        let shift = if k == 14 || k == 15 {
+            30.0 / 360.0
+        } else {
+            0.0
+        };
+        if k == 11 {
+            continue; // a missed pulse
+        }
+        let t = rev_ns(k as f64 + shift);
+        feed_speeds_to(&mut driver, t, &mut emit);
+        if let Fed::Refused(why) = driver.feed(t, Input::Keyphasor { stamp_ns: t }, &mut emit) {
+            refused.push(why);
+        }
+        if k == 10 {
+            assert_eq!(driver.phase_reference(t), PhaseReference::Locked);
+        }
+    }
+    assert_eq!(refused.len(), 3, "{refused:?}");
+    assert!(
+        refused[0].contains("contradicts the speed"),
+        "{}",
+        refused[0]
+    );
+    assert!(
+        refused[1].contains("jumped by -30.0°") && refused[2].contains("jumped"),
+        "{refused:?}"
+    );
+    // the keyphasor stops; the speed goes on for 0.2 s (27 revolutions, 1,920 steps of 104 µs)
+    let steps_before = driver.counts().steps;
+    let end = rev_ns(29.0) + 200_000_000;
+    feed_speeds_to(&mut driver, end, &mut emit);
+    assert!(driver.session().is_some() && driver.counts().steps > steps_before + 1800);
+    assert_eq!(driver.phase_reference(end), PhaseReference::Stopped);
+    assert!(
+        warnings.iter().any(|w| w.contains("keyphasor stopped")),
+        "{warnings:?}"
+    );
+    // every refusal counted; the bad_input warning goes out at once, then at most once a second
+    assert_eq!(driver.counts().refused, 3);
+    assert!(
+        warnings.iter().any(|w| w.contains("contradicts the speed")),
+        "{warnings:?}"
+    );
+    assert!(driver
+        .session()
+        .unwrap()
+        .twin()
+        .output()
+        .probes
+        .iter()
+        .all(|p| p.displacement_m.iter().all(|v| v.is_finite())));
+
+    // keyphasor only: the speed from its intervals
+    let mut only = Driver::new(rotor, settings);
+    let mut started = false;
+    for k in 0..5 {
+        let t = rev_ns(k as f64);
+        started |= matches!(
+            only.feed(t, Input::Keyphasor { stamp_ns: t }, &mut |_| {}),
+            Fed::Started { .. }
+        );
+    }
+    assert!(started);
+    let w = only.speed_rad_s().unwrap();
+    assert!((w / W8000 - 1.0).abs() < 1e-6, "{w} rad/s");
+    assert_eq!(only.phase_reference(rev_ns(4.0)), PhaseReference::Locked);
+}
+
+/// Item 5 of the issue: a bag written by PyPI rosbags in standard types only — the keyphasor as
+/// std_msgs/Header, one std_msgs/Float64 gap (µm, AC) per probe, no speed topic — replays with
+/// remaps: the speed comes from the keyphasor's intervals, and each probe axis's 1X lag is the
+/// one the script wrote (β + α: 95° at 45°, 185° at 135°) within 0.5°, 2 µm within 1 %.
+#[test]
+fn a_rosbags_bag_of_standard_types_gives_the_written_phase_lags() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let python = common::python();
+    let dir = scratch("rosbags-signals");
+    let written = std::process::Command::new(&python)
+        .arg(root.join("tests/interop/write_signal_bag.py"))
+        .arg(&dir)
+        .args(["0.4", "8000"])
+        .output()
+        .unwrap();
+    assert!(
+        written.status.success(),
+        "{}",
+        String::from_utf8_lossy(&written.stderr)
+    );
+    let rotor = raw_machine("unit: um, coupling: ac", None);
+    let mut options = ReplayOptions {
+        coupling: Coupling::Nonlinear,
+        film: FilmEvaluation::Direct,
+        steps_per_rev: 128,
+        remaps: vec![("/plant/keyphasor".into(), "/rotor_twin/keyphasor".into())],
+        ..ReplayOptions::default()
+    };
+    for station in ["probe_pulley_end", "probe_outboard"] {
+        for suffix in ["x", "y"] {
+            let name = format!("{station}_{suffix}");
+            options.probe_signals.push((format!("/plant/{name}"), name));
+        }
+    }
+    let bag = Bag::read(&dir).unwrap();
+    let report = replay(&bag, &rotor, &options, &mut |_| {}).unwrap().0;
+    assert!(report.rejected.is_empty(), "{:?}", report.rejected);
+    assert_eq!(report.stations.len(), 2);
+    for st in &report.stations {
+        let m = st
+            .one_x_probe_axes_measured
+            .unwrap_or_else(|| panic!("{st:?}"));
+        for (j, lag) in [95.0, 185.0].iter().enumerate() {
+            eprintln!(
+                "{} axis {j}: {:.4} µm at {:.3}°",
+                st.station,
+                m[j].amplitude_m * 1e6,
+                m[j].phase_lag_deg
+            );
+            assert!(lag_gap(m[j].phase_lag_deg, *lag).abs() < 0.5, "{st:?}");
+            assert!((m[j].amplitude_m / 2e-6 - 1.0).abs() < 0.01, "{st:?}");
+        }
+        let rpm = st.window_speed_rpm.unwrap();
+        assert!(
+            (rpm - 8000.0).abs() < 0.01,
+            "speed from the keyphasor: {rpm} rpm"
+        );
+    }
+}
