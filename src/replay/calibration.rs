@@ -3,9 +3,12 @@
 //! fitted values.
 //!
 //! The shaft angle is integrated from the speed messages (rotor_twin_msgs/RotorSpeed, with their
-//! acceleration: exact on a linear ramp) from zero at the bag's first speed message; so the 1X
-//! phase is relative to that start (the synthetic plant's own angle, which starts there), until
-//! a keyphasor gives the shaft's reference mark.
+//! acceleration: exact on a linear ramp) from zero at the bag's first speed message. At each
+//! keyphasor event (rotor_twin_msgs/Keyphasor, or std_msgs/Header, on the keyphasor topic) it is
+//! set to the nearest whole revolution, so that angle 0 is the shaft's reference mark and the 1X
+//! vectors are phase lags in the API 670 sense, like the replay's; the fitted unbalance phase is
+//! then measured from the mark, as the twin reads `Unbalance.phase` with a keyphasor. Without a
+//! keyphasor the phase is relative to the start (the synthetic plant's own angle starts there).
 
 use crate::bag::Bag;
 use crate::calibrate::{
@@ -15,6 +18,7 @@ use crate::calibrate::{
 use crate::messages::{self, from_cdr, RosMessage};
 use crate::rotor::Rotor;
 use serde::Serialize;
+use std::f64::consts::TAU;
 
 /// Revolutions a fit window spans.
 pub const CALIBRATION_WINDOW_REVS: f64 = 16.0;
@@ -76,6 +80,11 @@ pub fn angle_samples(
             }
             let angle = angle_at(t).map_or(0.0, |(a, _)| a);
             last = Some((t, angle, s.speed, s.acceleration));
+        } else if topic == crate::topics::KEYPHASOR && is_keyphasor_type(type_name) {
+            // the reference mark passes: the angle is a whole number of revolutions
+            if let (Some((.., acc)), Some((a, w))) = (last, angle_at(t)) {
+                last = Some((t, (a / TAU).round() * TAU, w, acc));
+            }
         } else if topic == crate::topics::PROBE
             && type_name == messages::ProbeDisplacement::TYPE_NAME
             && (window_s[0]..=window_s[1]).contains(&t)
@@ -99,6 +108,11 @@ pub fn angle_samples(
         }
     }
     out
+}
+
+/// A keyphasor event's type: ours, or a bare std_msgs/Header (the replay accepts both).
+fn is_keyphasor_type(type_name: &str) -> bool {
+    type_name == messages::Keyphasor::TYPE_NAME || type_name == messages::Header::TYPE_NAME
 }
 
 /// Fits the viscosity, then the unbalance at that viscosity, to the bag's samples in
