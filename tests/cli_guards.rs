@@ -211,3 +211,55 @@ fn a_missing_bag_is_reported_once() {
     assert_eq!(err.matches("No such file").count(), 1, "{err}");
     assert_eq!(err.matches("/nonexistent/bag").count(), 1, "{err}");
 }
+
+/// The files in a replay's output directory.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn replay_and_calibrate_reuse_their_output_directory() {
+    let out = scratch("reuse");
+    let out_s = out.to_str().unwrap();
+    let plain = ["replay", "--out", out_s, "--duration", "0.05"];
+    let calibrate = [
+        "replay",
+        "--out",
+        out_s,
+        "--duration",
+        "0.6",
+        "--calibrate",
+        "--calibrate-window",
+        "0:0.6",
+    ];
+    let (ok, _, err) = run_cli(&plain);
+    assert!(ok, "{err}");
+    assert!(listing(&out).contains(&"orbit_probe_outboard.svg".into()));
+    std::fs::write(out.join("notes.txt"), "the user's").unwrap();
+    // --calibrate over a replay's output, then again over its own (it writes no report.json)
+    for run in 0..2 {
+        let (ok, _, err) = run_cli(&calibrate);
+        assert!(ok, "calibrate run {run}: {err}");
+        // nothing of the earlier plain replay is left beside the calibration
+        assert_eq!(
+            listing(&out),
+            ["bag", "calibration.json", "notes.txt"],
+            "run {run}"
+        );
+    }
+    // and a plain replay over a calibration leaves no stale calibration.json
+    let (ok, _, err) = run_cli(&plain);
+    assert!(ok, "{err}");
+    let names = listing(&out);
+    assert!(
+        names.contains(&"report.json".into()) && !names.contains(&"calibration.json".into()),
+        "{names:?}"
+    );
+    assert!(names.contains(&"notes.txt".into()), "{names:?}");
+    std::fs::remove_dir_all(&out).ok();
+}

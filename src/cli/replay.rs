@@ -24,7 +24,8 @@ pub struct ReplayArgs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Output directory: the output bag (bag/), report.json and the plots. Default:
-    /// replay_<bag name> in the current directory. A previous replay's output there is replaced.
+    /// replay_<bag name> in the current directory. A previous replay's output there (bag/,
+    /// report.json, calibration.json, the plots) is replaced; other files are left alone.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Replay at this many times the bag's pace (1 = as recorded).
@@ -302,22 +303,41 @@ fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Creates `dir`, or clears a previous replay's output in it (a directory holding anything
-/// else is refused, so nothing of the user's is overwritten).
+/// The files a replay writes beside `bag/`: its report, `--calibrate`'s calibration and the
+/// plots of each probe station.
+const OUTPUT_FILES: [&str; 2] = ["report.json", "calibration.json"];
+const PLOT_PREFIXES: [&str; 4] = ["orbit_", "spectrum_", "waterfall_", "amplitude_speed_"];
+
+/// Creates `dir`, or clears a previous replay's output in it (its bag, report or calibration and
+/// plots, so that no file of an earlier run is left beside the new ones; a directory holding
+/// neither `report.json` nor `calibration.json` is refused, so nothing of the user's is
+/// overwritten).
 fn prepare_out_dir(dir: &Path) -> anyhow::Result<()> {
-    if dir.exists() {
-        anyhow::ensure!(
-            dir.join("report.json").exists(),
-            "--out {}: exists and is not a previous replay's output (no report.json); choose another",
-            dir.display()
-        );
-        let bag = dir.join("bag");
-        if bag.exists() {
-            std::fs::remove_dir_all(&bag)
-                .with_context(|| format!("removing the previous output bag {}", bag.display()))?;
+    if !dir.exists() {
+        return std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()));
+    }
+    anyhow::ensure!(
+        OUTPUT_FILES.iter().any(|f| dir.join(f).exists()),
+        "--out {}: exists and is not a previous replay's output (no report.json or calibration.json); choose another",
+        dir.display()
+    );
+    let bag = dir.join("bag");
+    if bag.exists() {
+        std::fs::remove_dir_all(&bag)
+            .with_context(|| format!("removing the previous output bag {}", bag.display()))?;
+    }
+    let listing = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
+    for entry in listing {
+        let path = entry?.path();
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+        let previous = name.is_some_and(|n| {
+            OUTPUT_FILES.contains(&n.as_str())
+                || (n.ends_with(".svg") && PLOT_PREFIXES.iter().any(|p| n.starts_with(p)))
+        });
+        if previous && path.is_file() {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing the previous output {}", path.display()))?;
         }
-    } else {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     Ok(())
 }
