@@ -385,6 +385,30 @@ fn run_calibrated(
     ))
 }
 
+/// The mean relative 1X amplitude error, |predicted − measured| / measured, over the blocks of
+/// station report `r` that lie within `window_s` (bag time, s), and how many there are.
+fn window_one_x_error(
+    r: &crate::replay::StationReport,
+    window_s: [f64; 2],
+) -> Option<(f64, usize)> {
+    let errors: Vec<f64> = r
+        .blocks
+        .iter()
+        .filter(|b| b.start_s >= window_s[0] && b.end_s <= window_s[1])
+        .filter(|b| b.measured.one_x_amplitude_m > 0.0)
+        .map(|b| {
+            (b.predicted.one_x_amplitude_m - b.measured.one_x_amplitude_m).abs()
+                / b.measured.one_x_amplitude_m
+        })
+        .collect();
+    (!errors.is_empty()).then(|| {
+        (
+            errors.iter().sum::<f64>() / errors.len() as f64,
+            errors.len(),
+        )
+    })
+}
+
 /// The estimates and the before/after comparison, as text.
 fn calibration_summary(
     cal: &crate::replay::calibration::BagCalibration,
@@ -428,9 +452,16 @@ fn calibration_summary(
                 .zip(r.one_x_amplitude_measured_m)
                 .map_or("-".into(), |(e, m)| format!("{:+.1} %", 100.0 * e / m))
         };
+        let in_window = |r: &crate::replay::StationReport| {
+            window_one_x_error(r, cal.window_s).map_or("-".into(), |(e, n)| {
+                format!("{:.1} % ({n} blocks)", 100.0 * e)
+            })
+        };
         s += &format!(
-            "  {}: 1X amplitude error before {}, after {}\n",
+            "  {}: 1X amplitude error over the fitted window (mean |predicted - measured| / measured, blocks of 8 revolutions) before {}, after {}; over the bag's last 32 revolutions before {}, after {}\n",
             b.station,
+            in_window(b),
+            in_window(a),
             pct(b),
             pct(a)
         );
