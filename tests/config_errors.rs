@@ -102,6 +102,16 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
         "range",
         "finite",
     );
+    // one oil supply: a second bearing with another law is refused, not silently ignored
+    says(
+        &error_of(&with(
+            "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.60]",
+            "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.50]",
+        )),
+        "bearings[1].lubricant",
+        "0.5",
+        "one oil supply",
+    );
     says(
         &error_of(&with(
             "angles_deg: [45.0, 135.0]",

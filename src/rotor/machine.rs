@@ -452,7 +452,37 @@ impl MachineDescription {
                 ));
             }
         }
-        Ok(())
+        self.validate_one_oil_supply(file)
+    }
+
+    /// One oil supply: when a bearing has a viscosity–temperature law, every bearing with a
+    /// lubricant has the same lubricant (an oil temperature sets one viscosity scale for every
+    /// film, `driver::oil_viscosity_scale`).
+    fn validate_one_oil_supply(&self, file: &str) -> Result<(), ConfigError> {
+        let lubricated: Vec<(usize, LubricantSpec)> = self
+            .bearings
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| b.lubricant.map(|l| (i, l)))
+            .collect();
+        if lubricated
+            .iter()
+            .all(|(_, l)| l.viscosity_temperature.is_none())
+        {
+            return Ok(());
+        }
+        let (first, reference) = lubricated[0];
+        match lubricated.iter().find(|(_, l)| *l != reference) {
+            None => Ok(()),
+            Some((i, l)) => Err(ConfigError {
+                file: file.to_string(),
+                field: format!("bearings[{i}].lubricant"),
+                value: format!("{l:?}"),
+                rule: format!(
+                    "with a viscosity_temperature law the bearings share one oil supply: every lubricant must equal bearings[{first}].lubricant ({reference:?}), since an oil temperature sets one viscosity scale for every film"
+                ),
+            }),
+        }
     }
 }
 
