@@ -307,7 +307,7 @@ fn the_shipped_sample_bag_replays() {
 }
 
 /// The amplitude plot has a speed panel and a bag-time panel, its legend beside the data; the
-/// waterfall has an amplitude scale bar labelled in µm.
+/// orbit is 1:1 with its legend beside it; the waterfall has an amplitude scale bar in µm.
 fn check_amplitude_plots(out: &Path) {
     let a = svg_check::read(&out.join("amplitude_speed_probe_outboard.svg"));
     a.assert_texts(&[
@@ -317,6 +317,13 @@ fn check_amplitude_plots(out: &Path) {
         "legend",
     ]);
     a.assert_legend_right_of_data();
+    let o = svg_check::read(&out.join("orbit_probe_outboard.svg"));
+    o.assert_legend_right_of_data();
+    let (px_x, px_y) = o.px_per_unit();
+    assert!(
+        (px_x / px_y - 1.0).abs() < 0.005,
+        "orbit aspect {px_x} vs {px_y} px/µm"
+    );
     let w = svg_check::read(&out.join("waterfall_probe_outboard.svg"));
     let bar = w.texts.iter().filter(|t| t.text.ends_with(" µm")).count();
     assert_eq!(bar, 2, "one scale bar in each half");

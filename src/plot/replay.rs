@@ -10,7 +10,8 @@ use std::path::Path;
 const MEASURED: RGBColor = RGBColor(200, 30, 30);
 const PREDICTED: RGBColor = RGBColor(30, 60, 200);
 
-/// Predicted over measured orbit (µm), 1:1, inside the clearance circle.
+/// Predicted over measured orbit (µm), 1:1, inside the clearance circle; the legend in a panel
+/// of its own (a whip orbit fills the circle).
 pub fn orbit_comparison_svg(
     path: &Path,
     title: &str,
@@ -23,10 +24,11 @@ pub fn orbit_comparison_svg(
         .map(|p| p[0].hypot(p[1]))
         .fold(clearance_m, f64::max);
     let lim = 1.1 * extent * 1e6;
-    let root = SVGBackend::new(path, (640, 660)).into_drawing_area();
+    let root = SVGBackend::new(path, (860, 660)).into_drawing_area();
     root.fill(&WHITE)?;
     let titled = root.titled(title, ("sans-serif", 18))?;
-    let area = super::square_chart_area(titled, 15, 40, 50);
+    let (chart_area, legend_area) = titled.split_horizontally(640);
+    let area = super::square_chart_area(chart_area, 15, 40, 50);
     let mut chart = ChartBuilder::on(&area)
         .margin(15)
         .x_label_area_size(40)
@@ -38,36 +40,30 @@ pub fn orbit_comparison_svg(
         .y_desc("y (µm)")
         .draw()?;
     let c = clearance_m * 1e6;
-    chart
-        .draw_series(LineSeries::new(
-            (0..=360).map(|k| {
-                let a = (k as f64).to_radians();
-                (c * a.cos(), c * a.sin())
-            }),
-            BLACK,
-        ))?
-        .label("bearing clearance circle")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+    chart.draw_series(LineSeries::new(
+        (0..=360).map(|k| {
+            let a = (k as f64).to_radians();
+            (c * a.cos(), c * a.sin())
+        }),
+        BLACK,
+    ))?;
     type Pick = fn(&Sample) -> [f64; 2];
     let series: [(&str, Pick, RGBColor); 2] = [
         ("measured", |s| s.measured_m, MEASURED),
         ("predicted", |s| s.predicted_m, PREDICTED),
     ];
+    let mut entries = vec![Entry::new(
+        Swatch::Line(BLACK, 1),
+        format!("bearing clearance ({c:.0} µm)"),
+    )];
     for (label, pick, color) in series {
-        chart
-            .draw_series(LineSeries::new(
-                samples.iter().map(|s| (pick(s)[0] * 1e6, pick(s)[1] * 1e6)),
-                color,
-            ))?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+        chart.draw_series(LineSeries::new(
+            samples.iter().map(|s| (pick(s)[0] * 1e6, pick(s)[1] * 1e6)),
+            color,
+        ))?;
+        entries.push(Entry::new(Swatch::Line(color, 1), label));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())
 }
