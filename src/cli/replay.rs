@@ -156,6 +156,25 @@ pub fn run_sample() -> anyhow::Result<()> {
 /// Runs `rotor-twin replay`.
 // Long (≈125 lines): argument checks, the replay, the report and the plots in sequence; the
 // checks belong in the options' own constructor (issue 10).
+/// With the tabulated film, prepares the tables before the replay and says on stderr where
+/// they came from (the disk cache or built), as the node does.
+fn say_film_tables(rotor: &Rotor, film: super::simulate::FilmArg) -> anyhow::Result<()> {
+    if film != super::simulate::FilmArg::Table {
+        return Ok(());
+    }
+    let start = std::time::Instant::now();
+    let origins = crate::dynamics::prepare_film_tables(rotor)?;
+    if !origins.is_empty() {
+        let said: Vec<String> = origins.iter().map(ToString::to_string).collect();
+        eprintln!(
+            "film tables ready in {:.2} s ({})",
+            start.elapsed().as_secs_f64(),
+            said.join("; ")
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.delta > 0.0 && args.delta <= 1.0,
@@ -184,6 +203,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     );
     let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
+    say_film_tables(&rotor, args.film)?;
     let out_dir = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .bag

@@ -189,17 +189,7 @@ fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::
     let start = std::time::Instant::now();
     let origins = crate::dynamics::prepare_film_tables(rotor)?;
     if info {
-        let said: Vec<String> = origins
-            .iter()
-            .map(|o| match o {
-                crate::film::TableOrigin::InProcess => "shared".to_string(),
-                crate::film::TableOrigin::Loaded(p) => format!("loaded from {}", p.display()),
-                crate::film::TableOrigin::Built(Some(p)) => {
-                    format!("built, stored in {}", p.display())
-                }
-                crate::film::TableOrigin::Built(None) => "built, not cached".to_string(),
-            })
-            .collect();
+        let said: Vec<String> = origins.iter().map(ToString::to_string).collect();
         eprintln!(
             "rotor_twin: film tables ready in {:.2} s ({})",
             start.elapsed().as_secs_f64(),

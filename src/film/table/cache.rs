@@ -63,6 +63,17 @@ pub enum TableOrigin {
     Built(Option<PathBuf>),
 }
 
+impl std::fmt::Display for TableOrigin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TableOrigin::InProcess => f.write_str("shared"),
+            TableOrigin::Loaded(p) => write!(f, "loaded from {}", p.display()),
+            TableOrigin::Built(Some(p)) => write!(f, "built, stored in {}", p.display()),
+            TableOrigin::Built(None) => f.write_str("built, not cached"),
+        }
+    }
+}
+
 /// The result of looking a table up on disk.
 pub enum Lookup {
     /// The file verified: the table.
