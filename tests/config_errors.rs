@@ -154,3 +154,53 @@ fn a_missing_file_is_named() {
         "{text}"
     );
 }
+
+/// The bearing entry is parsed into one variant per model: each model's data must be there and
+/// nothing another model needs is accepted; a machine the model cannot represent is refused.
+#[test]
+fn bearing_entries_are_parsed_by_their_model() {
+    // a second bearing on the first one's node: one support point cannot hold the tilt
+    let e = error_of(&with(
+        "    node: 27\n    model: finite",
+        "    node: 3\n    model: finite",
+    ));
+    says(&e, "bearings", "node(s) [3]", "two or more shaft nodes");
+    // a short bearing has no grooves
+    let e = error_of(&with(
+        "    node: 3\n    model: finite",
+        "    node: 3\n    model: short\n    grooves: two-axial",
+    ));
+    says(&e, "bearings[0].grooves", "two-axial", "no grooves");
+    // a linear bearing with a negative direct stiffness carries no rotor
+    let linear = "    node: 3\n    model: linear\n    stiffness_n_per_m: [[-1.0e8, 0.0], [0.0, 1.0e8]]\n  - name: other\n    node: 4\n    model: rigid\n  - name: unused\n    node: 5\n    model: finite";
+    let e = error_of(&with("    node: 3\n    model: finite", linear));
+    says(
+        &e,
+        "bearings[0].stiffness_n_per_m[0][0]",
+        "-100000000",
+        "greater than zero",
+    );
+    // a rigid bearing has no flexible support
+    let rigid = "    node: 3\n    model: rigid\n    support: {mass_kg: 10.0, stiffness_n_per_m: [[1.0e8, 0.0], [0.0, 1.0e8]]}\n  - name: unused\n    node: 5\n    model: finite";
+    let e = error_of(&with("    node: 3\n    model: finite", rigid));
+    says(&e, "bearings[0].support", "(given)", "no flexible support");
+    // an unknown model is named by serde with the choices
+    let e = error_of(&with(
+        "    node: 3\n    model: finite",
+        "    node: 3\n    model: tilting_pad",
+    ));
+    says(&e, "bearings[0].model", "", "unknown variant `tilting_pad`");
+    // a probe's unit and coupling are names of their own, refused with the choices
+    let probe = |unit: &str, coupling: &str| {
+        format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n  - {{name: px, station: probe_outboard, angle_deg: 45.0, unit: {unit}, coupling: {coupling}}}\n")
+    };
+    let e = error_of(&probe("mm", "ac"));
+    says(&e, "proximity_probes[0].unit", "", "unknown variant `mm`");
+    let e = error_of(&probe("µm", "AC"));
+    says(
+        &e,
+        "proximity_probes[0].coupling",
+        "",
+        "unknown variant `AC`",
+    );
+}

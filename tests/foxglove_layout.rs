@@ -55,7 +55,7 @@ fn layout_refers_to_what_the_node_publishes() {
             }
         }
         if id.starts_with("Plot!orbit") {
-            let c = desc.bearings[0].radial_clearance_m.unwrap();
+            let c = desc.bearings[0].film().unwrap().geometry.radial_clearance_m;
             for key in ["minXValue", "minYValue"] {
                 assert_eq!(cfg[key].as_f64().unwrap(), -c, "{id} {key}");
             }

@@ -18,9 +18,10 @@ pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
 pub use machine::{
-    AlarmLevelsSpec, BearingModelKind, BearingSpec, DiscSpec, GroovesSpec, LubricantSpec,
-    MachineDescription, MaterialSpec, ProbeSpec, ShaftSection, SupportSpec, UnbalanceSpec,
-    ViscosityTemperatureSpec, DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
+    AlarmLevelsSpec, BearingModelSpec, BearingSpec, DiscSpec, FilmSpec, GroovesSpec, LubricantSpec,
+    MachineDescription, MachineDescriptionOf, MaterialSpec, ProbeSpec, ProximityProbeSpec,
+    RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec, UnbalanceSpec, ViscosityTemperatureSpec,
+    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
 pub use modal::{
     campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
@@ -232,96 +233,10 @@ pub struct Rotor {
 impl Rotor {
     /// Assembles the rotor of a (checked) machine description.
     pub fn from_description(desc: &MachineDescription) -> Self {
-        let materials = |name: &str| {
-            let m = &desc.materials[name];
-            Material::from_poisson(m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3)
-        };
-        let mut elements = Vec::new();
-        let mut node_z_m = vec![0.0];
-        for s in &desc.shaft {
-            let l = s.length_m / s.elements as f64;
-            for _ in 0..s.elements {
-                elements.push(ShaftElement {
-                    length_m: l,
-                    outer_diameter_m: s.outer_diameter_m,
-                    inner_diameter_m: s.inner_diameter_m,
-                    material: materials(&s.material),
-                });
-                node_z_m.push(node_z_m.last().copied().unwrap_or(0.0) + l);
-            }
-        }
-        let nodes = node_z_m.len();
-        let pedestals = desc.bearings.iter().filter(|b| b.support.is_some()).count();
-        let n_dof = 4 * nodes + 2 * pedestals;
-        let mut next_pedestal = 4 * nodes;
-        let bearings: Vec<BearingSite> = desc
-            .bearings
-            .iter()
-            .map(|b| {
-                let pedestal_dofs = b.support.as_ref().map(|_| {
-                    let d = [next_pedestal, next_pedestal + 1];
-                    next_pedestal += 2;
-                    d
-                });
-                BearingSite {
-                    name: b.name.clone(),
-                    node: b.node,
-                    journal_dofs: [4 * b.node, 4 * b.node + 1],
-                    pedestal_dofs,
-                    model: bearing_model(b),
-                }
-            })
-            .collect();
-        let discs: Vec<Disc> = desc
-            .discs
-            .iter()
-            .enumerate()
-            .map(|(i, d)| Disc {
-                name: if d.name.is_empty() {
-                    format!("disc {i}")
-                } else {
-                    d.name.clone()
-                },
-                node: d.node,
-                mass_kg: d.mass_kg,
-                polar_inertia_kg_m2: d.polar_inertia_kg_m2,
-                diametral_inertia_kg_m2: d.diametral_inertia_kg_m2,
-            })
-            .collect();
-
-        let mut mass = Mat::<f64>::zeros(n_dof, n_dof);
-        let mut stiffness = Mat::<f64>::zeros(n_dof, n_dof);
-        let mut gyroscopic = Mat::<f64>::zeros(n_dof, n_dof);
-        let mut damping = Mat::<f64>::zeros(n_dof, n_dof);
-        for (e, el) in elements.iter().enumerate() {
-            let at = 4 * e;
-            add_block(&mut stiffness, at, &el.stiffness());
-            add_block(&mut mass, at, &el.mass());
-            add_block(&mut gyroscopic, at, &el.gyroscopic());
-        }
-        if desc.shaft_damping_beta_s > 0.0 {
-            for e in 0..elements.len() {
-                let k = elements[e].stiffness();
-                let c = k.map(|row| row.map(|v| desc.shaft_damping_beta_s * v));
-                add_block(&mut damping, 4 * e, &c);
-            }
-        }
-        for d in &discs {
-            add_block(&mut mass, 4 * d.node, &d.mass());
-            add_block(&mut gyroscopic, 4 * d.node, &d.gyroscopic());
-        }
-        for (b, spec) in bearings.iter().zip(&desc.bearings) {
-            if let (Some(p), Some(s)) = (b.pedestal_dofs, &spec.support) {
-                for i in 0..2 {
-                    mass[(p[i], p[i])] += s.mass_kg;
-                    for j in 0..2 {
-                        stiffness[(p[i], p[j])] += s.stiffness_n_per_m[i][j];
-                        damping[(p[i], p[j])] += s.damping_n_s_per_m[i][j];
-                    }
-                }
-            }
-        }
-        Rotor {
+        let (elements, node_z_m) = shaft_elements(desc);
+        let bearings = bearing_sites(desc, node_z_m.len());
+        let discs = discs(desc);
+        let mut rotor = Rotor {
             name: desc.name.clone(),
             unbalance: desc
                 .unbalance
@@ -351,11 +266,55 @@ impl Rotor {
             elements,
             discs,
             bearings,
-            mass,
-            stiffness,
-            gyroscopic,
-            damping,
+            mass: Mat::zeros(0, 0),
+            stiffness: Mat::zeros(0, 0),
+            gyroscopic: Mat::zeros(0, 0),
+            damping: Mat::zeros(0, 0),
+        };
+        rotor.assemble(desc);
+        rotor
+    }
+
+    /// The global M, K, G and C of the elements, discs and pedestals (seed eq. 5's matrices).
+    fn assemble(&mut self, desc: &MachineDescription) {
+        let n_dof = 4 * self.node_z_m.len()
+            + 2 * self
+                .bearings
+                .iter()
+                .filter(|b| b.pedestal_dofs.is_some())
+                .count();
+        let mut mass = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut stiffness = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut gyroscopic = Mat::<f64>::zeros(n_dof, n_dof);
+        let mut damping = Mat::<f64>::zeros(n_dof, n_dof);
+        for (e, el) in self.elements.iter().enumerate() {
+            let at = 4 * e;
+            let k = el.stiffness();
+            add_block(&mut stiffness, at, &k);
+            add_block(&mut mass, at, &el.mass());
+            add_block(&mut gyroscopic, at, &el.gyroscopic());
+            if desc.shaft_damping_beta_s > 0.0 {
+                let c = k.map(|row| row.map(|v| desc.shaft_damping_beta_s * v));
+                add_block(&mut damping, at, &c);
+            }
         }
+        for d in &self.discs {
+            add_block(&mut mass, 4 * d.node, &d.mass());
+            add_block(&mut gyroscopic, 4 * d.node, &d.gyroscopic());
+        }
+        for (b, spec) in self.bearings.iter().zip(&desc.bearings) {
+            if let (Some(p), Some(s)) = (b.pedestal_dofs, &spec.support) {
+                for i in 0..2 {
+                    mass[(p[i], p[i])] += s.mass_kg;
+                    for j in 0..2 {
+                        stiffness[(p[i], p[j])] += s.stiffness_n_per_m[i][j];
+                        damping[(p[i], p[j])] += s.damping_n_s_per_m[i][j];
+                    }
+                }
+            }
+        }
+        (self.mass, self.stiffness) = (mass, stiffness);
+        (self.gyroscopic, self.damping) = (gyroscopic, damping);
     }
 
     /// Number of global DOFs.
@@ -391,45 +350,85 @@ impl Rotor {
     }
 }
 
-fn bearing_model(b: &BearingSpec) -> BearingModel {
-    match b.model {
-        BearingModelKind::Finite | BearingModelKind::Short => {
-            let (d, l, c) = (
-                b.diameter_m.unwrap_or_default(),
-                b.length_m.unwrap_or_default(),
-                b.radial_clearance_m.unwrap_or_default(),
-            );
-            let geometry = match b.grooves {
-                GroovesSpec::None => BearingGeometry::plain(d, l, c),
-                GroovesSpec::TwoAxial => {
-                    BearingGeometry::two_axial_grooves(d, l, c, 20f64.to_radians(), 0.0)
-                }
+/// The shaft's Timoshenko elements, each section split into its equal elements, and the axial
+/// position of every node (m).
+fn shaft_elements(desc: &MachineDescription) -> (Vec<ShaftElement>, Vec<f64>) {
+    let mut elements = Vec::new();
+    let mut node_z_m = vec![0.0];
+    for s in &desc.shaft {
+        let m = &desc.materials[&s.material];
+        let material =
+            Material::from_poisson(m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3);
+        let l = s.length_m / s.elements as f64;
+        for _ in 0..s.elements {
+            elements.push(ShaftElement {
+                length_m: l,
+                outer_diameter_m: s.outer_diameter_m,
+                inner_diameter_m: s.inner_diameter_m,
+                material,
+            });
+            node_z_m.push(node_z_m.last().copied().unwrap_or(0.0) + l);
+        }
+    }
+    (elements, node_z_m)
+}
+
+/// The bearings at their journals; each flexible pedestal gets two DOFs after the shaft's
+/// `4 · nodes`.
+fn bearing_sites(desc: &MachineDescription, nodes: usize) -> Vec<BearingSite> {
+    let mut next_pedestal = 4 * nodes;
+    desc.bearings
+        .iter()
+        .map(|b| {
+            let pedestal_dofs = b.support.as_ref().map(|_| {
+                let d = [next_pedestal, next_pedestal + 1];
+                next_pedestal += 2;
+                d
+            });
+            BearingSite {
+                name: b.name.clone(),
+                node: b.node,
+                journal_dofs: [4 * b.node, 4 * b.node + 1],
+                pedestal_dofs,
+                model: bearing_model(b),
             }
-            .expect("checked by MachineDescription::validate");
-            let lub = b
-                .lubricant
-                .expect("checked by MachineDescription::validate");
+        })
+        .collect()
+}
+
+/// The rigid discs, named `disc N` where the file gives no name.
+fn discs(desc: &MachineDescription) -> Vec<Disc> {
+    desc.discs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| Disc {
+            name: if d.name.is_empty() {
+                format!("disc {i}")
+            } else {
+                d.name.clone()
+            },
+            node: d.node,
+            mass_kg: d.mass_kg,
+            polar_inertia_kg_m2: d.polar_inertia_kg_m2,
+            diametral_inertia_kg_m2: d.diametral_inertia_kg_m2,
+        })
+        .collect()
+}
+
+fn bearing_model(b: &BearingSpec) -> BearingModel {
+    match &b.model {
+        BearingModelSpec::Finite(f) | BearingModelSpec::Short(f) => {
             BearingModel::Film(FilmBearing {
-                geometry,
-                lubricant: Lubricant::new(lub.density_kg_m3, lub.viscosity_pa_s)
-                    .expect("checked by MachineDescription::validate"),
-                grid: b
-                    .grid
-                    .as_deref()
-                    .map(|g| FilmGrid::parse(g).expect("checked by MachineDescription::validate"))
-                    .unwrap_or_default(),
-                short: b.model == BearingModelKind::Short,
-                viscosity_law: lub
-                    .viscosity_temperature
-                    .map(|v| v.law(lub.density_kg_m3).expect("checked by validate")),
+                geometry: f.geometry.clone(),
+                lubricant: f.lubricant,
+                grid: f.grid,
+                short: matches!(b.model, BearingModelSpec::Short(_)),
+                viscosity_law: f.viscosity_law,
                 viscosity_scale: 1.0,
             })
         }
-        BearingModelKind::Linear => BearingModel::Linear(FilmCoefficients {
-            stiffness_n_per_m: b.stiffness_n_per_m.unwrap_or_default(),
-            damping_n_s_per_m: b.damping_n_s_per_m.unwrap_or_default(),
-        }),
-        BearingModelKind::Rigid => BearingModel::Rigid,
+        BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),
+        BearingModelSpec::Rigid => BearingModel::Rigid,
     }
 }
 

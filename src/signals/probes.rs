@@ -12,16 +12,20 @@
 //! Two probes at one station give the machine-frame displacement (x, y) from
 //! d_j = x cos α_j + y sin α_j.
 
-/// The unit a raw probe reading comes in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The unit a raw probe reading comes in (machine file: `m`, `um` or `µm`, `mil`, `V`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum ProbeUnit {
     /// Metres.
+    #[serde(rename = "m")]
     M,
     /// Micrometres.
+    #[serde(rename = "um", alias = "µm")]
     Um,
     /// Mils (thousandths of an inch, 25.4 µm).
+    #[serde(rename = "mil")]
     Mil,
     /// Volts, with a sensitivity (V/m).
+    #[serde(rename = "V", alias = "v")]
     V,
 }
 
@@ -82,8 +86,9 @@ pub fn machine_from_probes(d_m: [f64; 2], angles_rad: [f64; 2]) -> [f64; 2] {
     ]
 }
 
-/// How a probe's signal is coupled.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How a probe's signal is coupled (machine file: `ac` or `dc`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum ProbeCoupling {
     /// AC: the mean (the gap) is removed; only the dynamic part is compared.
     Ac,

@@ -1,0 +1,300 @@
+//! A bearing entry of the machine file: read as written ([`RawBearingSpec`], every field optional
+//! so that serde's errors name the exact field), then parsed once into [`BearingSpec`], one
+//! variant per model, whose contents are already checked (parse, don't validate): what the rotor
+//! assembly reads cannot be missing or out of range.
+
+use super::rules::Rules;
+use super::LubricantSpec;
+use crate::film::{BearingGeometry, FilmCoefficients, FilmGrid, Lubricant, WaltherLaw};
+use crate::rotor::ConfigError;
+use serde::{Deserialize, Serialize};
+
+/// A film bearing at most this many diameters long (the film model's own bound).
+const MAX_BEARING_LENGTH_DIAMETERS: f64 = 10.0;
+/// Largest radial clearance, as a fraction of the journal diameter (5 % of the radius).
+const MAX_CLEARANCE_PER_DIAMETER: f64 = 0.025;
+/// Angular width of each supply groove of a `two-axial` bearing (deg).
+const AXIAL_GROOVE_WIDTH_DEG: f64 = 20.0;
+
+/// How a bearing is modelled, as the machine file's `model` names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(crate) enum BearingModelName {
+    Finite,
+    Short,
+    Linear,
+    Rigid,
+}
+
+/// Supply grooves of a film bearing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum GroovesSpec {
+    /// Plain 360° bearing.
+    #[default]
+    None,
+    /// Two axial grooves, 90° either side of the static load.
+    TwoAxial,
+}
+
+/// A bearing entry as written in the file; [`RawBearingSpec::parse`] turns it into a
+/// [`BearingSpec`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBearingSpec {
+    /// Name (also the ROS frame suffix).
+    pub name: String,
+    /// Shaft node at the journal centre.
+    pub node: usize,
+    /// How it is modelled: `finite`, `short`, `linear` or `rigid`.
+    model: BearingModelName,
+    /// Film bearings: journal diameter D (m).
+    #[serde(default)]
+    diameter_m: Option<f64>,
+    /// Film bearings: length L (m).
+    #[serde(default)]
+    length_m: Option<f64>,
+    /// Film bearings: radial clearance c (m).
+    #[serde(default)]
+    radial_clearance_m: Option<f64>,
+    /// Film bearings: lubricant.
+    #[serde(default)]
+    lubricant: Option<LubricantSpec>,
+    /// Film bearings: grid over the half bearing, `NTHxNZ` (default 60x10).
+    #[serde(default)]
+    grid: Option<String>,
+    /// Finite film bearings: supply grooves.
+    #[serde(default)]
+    grooves: GroovesSpec,
+    /// Linear bearings: `[[kxx, kxy], [kyx, kyy]]` (N/m).
+    #[serde(default)]
+    stiffness_n_per_m: Option<[[f64; 2]; 2]>,
+    /// Linear bearings: `[[cxx, cxy], [cyx, cyy]]` (N·s/m); zero if absent.
+    #[serde(default)]
+    damping_n_s_per_m: Option<[[f64; 2]; 2]>,
+    /// Flexible support under the bearing (the seed's C_mn, D_mn); rigid if absent.
+    #[serde(default)]
+    support: Option<SupportSpec>,
+}
+
+/// A bearing at a shaft node, checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BearingSpec {
+    /// Name (also the ROS frame suffix).
+    pub name: String,
+    /// Shaft node at the journal centre.
+    pub node: usize,
+    /// The model and its data.
+    pub model: BearingModelSpec,
+    /// Flexible support under the bearing; rigid to the ground if absent (never under a
+    /// rigid bearing).
+    pub support: Option<SupportSpec>,
+}
+
+/// One variant per bearing model, each with exactly the data it needs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BearingModelSpec {
+    /// Fluid film, finite-length Reynolds equation (seed eq. 2), plain or grooved.
+    Finite(FilmSpec),
+    /// Fluid film, short-bearing (Ocvirk) closed form; plain only.
+    Short(FilmSpec),
+    /// Constant stiffness and damping.
+    Linear(FilmCoefficients),
+    /// Rigid: the journal cannot move (a pinned support).
+    Rigid,
+}
+
+/// A fluid-film bearing's checked data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilmSpec {
+    /// Diameter, length, clearance and grooves (each checked by `BearingGeometry`).
+    pub geometry: BearingGeometry,
+    /// The lubricant at its design supply temperature.
+    pub lubricant: Lubricant,
+    /// The oil's viscosity–temperature law, when the file gives one (checked against
+    /// `lubricant` at the design supply temperature).
+    pub viscosity_law: Option<WaltherLaw>,
+    /// Finite-volume grid over the half bearing.
+    pub grid: FilmGrid,
+}
+
+/// A pedestal: a mass on a spring–damper to the ground, carrying the bearing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// Pedestal mass (kg), greater than zero.
+    pub mass_kg: f64,
+    /// `[[kxx, kxy], [kyx, kyy]]` to the ground (N/m).
+    pub stiffness_n_per_m: [[f64; 2]; 2],
+    /// `[[cxx, cxy], [cyx, cyy]]` to the ground (N·s/m).
+    #[serde(default)]
+    pub damping_n_s_per_m: [[f64; 2]; 2],
+}
+
+impl BearingSpec {
+    /// The film data of a film bearing (finite or short).
+    pub fn film(&self) -> Option<&FilmSpec> {
+        match &self.model {
+            BearingModelSpec::Finite(f) | BearingModelSpec::Short(f) => Some(f),
+            BearingModelSpec::Linear(_) | BearingModelSpec::Rigid => None,
+        }
+    }
+}
+
+impl RawBearingSpec {
+    /// The lubricant as written, of a film bearing.
+    pub(super) fn film_lubricant(&self) -> Option<LubricantSpec> {
+        match self.model {
+            BearingModelName::Finite | BearingModelName::Short => self.lubricant,
+            BearingModelName::Linear | BearingModelName::Rigid => None,
+        }
+    }
+
+    /// Entry `i` of `bearings`, parsed: every field its model needs present and valid, none it
+    /// cannot use.
+    pub(super) fn parse(self, i: usize, rules: &Rules) -> Result<BearingSpec, ConfigError> {
+        let field = |name: &str| format!("bearings[{i}].{name}");
+        let model = match self.model {
+            BearingModelName::Finite => BearingModelSpec::Finite(self.film(i, rules)?),
+            BearingModelName::Short => {
+                if self.grooves != GroovesSpec::None {
+                    return Err(rules.error(
+                        field("grooves"),
+                        "two-axial",
+                        "the short-bearing model has no grooves",
+                    ));
+                }
+                BearingModelSpec::Short(self.film(i, rules)?)
+            }
+            BearingModelName::Linear => BearingModelSpec::Linear(self.linear(i, rules)?),
+            BearingModelName::Rigid => {
+                if self.support.is_some() {
+                    return Err(rules.error(
+                        field("support"),
+                        "(given)",
+                        "a rigid bearing has no flexible support",
+                    ));
+                }
+                BearingModelSpec::Rigid
+            }
+        };
+        if let Some(s) = &self.support {
+            rules.positive(field("support.mass_kg"), s.mass_kg)?;
+            rules.finite_matrix(field("support.stiffness_n_per_m"), &s.stiffness_n_per_m)?;
+            rules.finite_matrix(field("support.damping_n_s_per_m"), &s.damping_n_s_per_m)?;
+        }
+        Ok(BearingSpec {
+            name: self.name,
+            node: self.node,
+            model,
+            support: self.support,
+        })
+    }
+
+    /// The film data of entry `i`.
+    fn film(&self, i: usize, rules: &Rules) -> Result<FilmSpec, ConfigError> {
+        let field = |name: &str| format!("bearings[{i}].{name}");
+        let required = |name: &str, v: Option<f64>| {
+            let v = v.ok_or_else(|| {
+                rules.error(field(name), "(missing)", "is required for a film bearing")
+            })?;
+            rules.positive(field(name), v).map(|_| v)
+        };
+        let d = required("diameter_m", self.diameter_m)?;
+        let l = required("length_m", self.length_m)?;
+        let c = required("radial_clearance_m", self.radial_clearance_m)?;
+        if l > MAX_BEARING_LENGTH_DIAMETERS * d {
+            return Err(rules.error(
+                field("length_m"),
+                l,
+                format!("must not exceed {MAX_BEARING_LENGTH_DIAMETERS} diameters (diameter_m = {d}): beyond it the film model does not hold"),
+            ));
+        }
+        if c > MAX_CLEARANCE_PER_DIAMETER * d {
+            return Err(rules.error(
+                field("radial_clearance_m"),
+                c,
+                "must be below 5 % of the journal radius",
+            ));
+        }
+        let geometry = match self.grooves {
+            GroovesSpec::None => BearingGeometry::plain(d, l, c),
+            GroovesSpec::TwoAxial => BearingGeometry::two_axial_grooves(
+                d,
+                l,
+                c,
+                AXIAL_GROOVE_WIDTH_DEG.to_radians(),
+                0.0,
+            ),
+        }
+        .map_err(|e| rules.error(field("(geometry)"), format!("D {d}, L {l}, c {c}"), e))?;
+        let grid = match &self.grid {
+            Some(g) => FilmGrid::parse(g).map_err(|e| rules.error(field("grid"), g, e))?,
+            None => FilmGrid::default(),
+        };
+        let (lubricant, viscosity_law) = self.oil(i, rules)?;
+        Ok(FilmSpec {
+            geometry,
+            lubricant,
+            viscosity_law,
+            grid,
+        })
+    }
+
+    /// The lubricant of entry `i`, and its viscosity–temperature law if given.
+    fn oil(&self, i: usize, rules: &Rules) -> Result<(Lubricant, Option<WaltherLaw>), ConfigError> {
+        let field = |name: &str| format!("bearings[{i}].{name}");
+        let Some(lub) = self.lubricant else {
+            return Err(rules.error(
+                field("lubricant"),
+                "(missing)",
+                "is required for a film bearing",
+            ));
+        };
+        rules.positive(field("lubricant.density_kg_m3"), lub.density_kg_m3)?;
+        rules.positive(field("lubricant.viscosity_pa_s"), lub.viscosity_pa_s)?;
+        let oil = Lubricant::new(lub.density_kg_m3, lub.viscosity_pa_s)
+            .map_err(|e| rules.error(field("lubricant"), format!("{lub:?}"), e))?;
+        let law = match &lub.viscosity_temperature {
+            Some(spec) => Some(spec.checked_law(&lub, &field("lubricant"), rules)?),
+            None => None,
+        };
+        Ok((oil, law))
+    }
+
+    /// The constant coefficients of entry `i`.
+    fn linear(&self, i: usize, rules: &Rules) -> Result<FilmCoefficients, ConfigError> {
+        let field = |name: &str| format!("bearings[{i}].{name}");
+        let Some(k) = self.stiffness_n_per_m else {
+            return Err(rules.error(
+                field("stiffness_n_per_m"),
+                "(missing)",
+                "is required for a linear bearing",
+            ));
+        };
+        rules.finite_matrix(field("stiffness_n_per_m"), &k)?;
+        let c = self.damping_n_s_per_m.unwrap_or_default();
+        rules.finite_matrix(field("damping_n_s_per_m"), &c)?;
+        // a support that pushes the journal away (or holds it not at all) carries no rotor
+        for d in 0..2 {
+            if k[d][d] <= 0.0 {
+                return Err(rules.error(
+                    format!("bearings[{i}].stiffness_n_per_m[{d}][{d}]"),
+                    k[d][d],
+                    "a direct stiffness must be greater than zero (a linear bearing with none, or a negative one, cannot carry the rotor)",
+                ));
+            }
+            if c[d][d] < 0.0 {
+                return Err(rules.error(
+                    format!("bearings[{i}].damping_n_s_per_m[{d}][{d}]"),
+                    c[d][d],
+                    "a direct damping must be zero or more (a negative one feeds energy into the rotor)",
+                ));
+            }
+        }
+        Ok(FilmCoefficients {
+            stiffness_n_per_m: k,
+            damping_n_s_per_m: c,
+        })
+    }
+}
