@@ -222,36 +222,80 @@ fn lu_solve_column(lu: &[f64], n: usize, x: &mut [f64], col: usize) {
     }
 }
 
-/// Solves the small dense system A x = b in place (A row-major n × n, overwritten), by Gaussian
-/// elimination with partial pivoting. False if A is singular. Allocates nothing.
-pub(crate) fn solve_small(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
-    for k in 0..n {
-        let p = (k..n)
-            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
-            .unwrap_or(k);
-        if a[p * n + k] == 0.0 || !a[p * n + k].is_finite() {
-            return false;
-        }
-        if p != k {
-            for j in 0..n {
-                a.swap(k * n + j, p * n + j);
+/// Most condensed bearing DOFs the step's Newton system may have: 16 (two per film bearing
+/// and two per flexible pedestal under one: eight film bearings on rigid supports or four on
+/// pedestals). The system is solved on the stack by nalgebra's fixed-size LU; the machine file
+/// is refused beyond it (`MachineDescription::validate`).
+pub const MAX_CONDENSED_DOFS: usize = 16;
+
+/// Solves the small dense system A x = b (A row-major n × n; x returned in `b`) by LU with
+/// partial pivoting (nalgebra, fixed size, on the stack). False if A is singular, the solution
+/// not finite, or n odd or above [`MAX_CONDENSED_DOFS`]. Allocates nothing.
+pub(crate) fn solve_small(a: &[f64], b: &mut [f64], n: usize) -> bool {
+    // one arm per size: nalgebra's fixed-size LU is typed by its dimension
+    macro_rules! fixed {
+        ($($size:literal)*) => {
+            match n {
+                $($size => {
+                    let m = nalgebra::SMatrix::<f64, $size, $size>::from_row_slice(&a[..$size * $size]);
+                    let mut x = nalgebra::SVector::<f64, $size>::from_column_slice(&b[..$size]);
+                    let solved = m.lu().solve_mut(&mut x) && x.iter().all(|v| v.is_finite());
+                    if solved {
+                        b[..$size].copy_from_slice(x.as_slice());
+                    }
+                    solved
+                })*
+                _ => false,
             }
-            b.swap(k, p);
-        }
-        for i in k + 1..n {
-            let f = a[i * n + k] / a[k * n + k];
-            for j in k..n {
-                a[i * n + j] -= f * a[k * n + j];
+        };
+    }
+    fixed!(2 4 6 8 10 12 14 16)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The stack LU against faer's dense partial-pivoting LU, every size the step uses, on
+    /// seeded random systems (diagonally weighted like I + S D, and general).
+    #[test]
+    fn small_solve_agrees_with_faer() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for n in (2..=MAX_CONDENSED_DOFS).step_by(2) {
+            for trial in 0..20 {
+                let diag = if trial % 2 == 0 { 3.0 } else { 0.0 };
+                let a: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        rng.random_range(-1.0..1.0) + if k % (n + 1) == 0 { diag } else { 0.0 }
+                    })
+                    .collect();
+                let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+                let mut x = b.clone();
+                assert!(solve_small(&a, &mut x, n), "n {n}");
+                let am = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+                let bm = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+                use faer::linalg::solvers::Solve;
+                let want = am.partial_piv_lu().solve(&bm);
+                for i in 0..n {
+                    let tol = 1e-9 * want[(i, 0)].abs().max(1.0);
+                    assert!((x[i] - want[(i, 0)]).abs() < tol, "n {n} row {i}");
+                }
             }
-            b[i] -= f * b[k];
         }
     }
-    for k in (0..n).rev() {
-        let mut s = b[k];
-        for j in k + 1..n {
-            s -= a[k * n + j] * b[j];
-        }
-        b[k] = s / a[k * n + k];
+
+    #[test]
+    fn singular_and_unsupported_sizes_are_refused() {
+        let mut b = [1.0, 2.0];
+        assert!(!solve_small(&[1.0, 2.0, 2.0, 4.0], &mut b, 2));
+        let mut b = [1.0; 3];
+        assert!(!solve_small(&[1.0; 9], &mut b, 3));
+        let n = MAX_CONDENSED_DOFS + 2;
+        let mut b = vec![1.0; n];
+        let eye: Vec<f64> = (0..n * n)
+            .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+            .collect();
+        assert!(!solve_small(&eye, &mut b, n));
     }
-    true
 }

@@ -15,6 +15,7 @@
 
 mod bearing_link;
 mod linear;
+pub use linear::MAX_CONDENSED_DOFS;
 mod twin;
 
 pub use bearing_link::{ContactModel, LinkEvaluation};

@@ -1,6 +1,18 @@
 //! The eight linearised film coefficients (seed eq. 3–4).
 
+use nalgebra::{Matrix2, Rotation2};
 use serde::Serialize;
+
+/// The 2 × 2 matrix written as rows `[[a00, a01], [a10, a11]]` (the machine file's and the JSON
+/// outputs' form).
+pub fn matrix2(rows: &[[f64; 2]; 2]) -> Matrix2<f64> {
+    Matrix2::new(rows[0][0], rows[0][1], rows[1][0], rows[1][1])
+}
+
+/// The rows of a 2 × 2 matrix.
+pub fn rows2(m: &Matrix2<f64>) -> [[f64; 2]; 2] {
+    [[m[(0, 0)], m[(0, 1)]], [m[(1, 0)], m[(1, 1)]]]
+}
 
 /// Stiffness and damping of the film about one journal state: the film force changes by
 /// `ΔF = −k Δq − c Δq̇`, with `k[i][j] = −∂F_i/∂q_j` and `c[i][j] = −∂F_i/∂q̇_j`, indices 0 = x,
@@ -31,6 +43,34 @@ impl FilmCoefficients {
     ) -> [[f64; 2]; 2] {
         self.damping_n_s_per_m
             .map(|row| row.map(|b| b * speed_rad_s.abs() * clearance_m / load_n))
+    }
+
+    /// The coefficients of the same film seen from a frame turned by `r` against this one:
+    /// `Rᵀ k R` and `Rᵀ c R` (for a state turned by R, these are the fixed frame's again).
+    pub fn turned_back(&self, r: &Rotation2<f64>) -> Self {
+        let m = r.matrix();
+        let back = |a: &[[f64; 2]; 2]| rows2(&(m.transpose() * matrix2(a) * m));
+        Self {
+            stiffness_n_per_m: back(&self.stiffness_n_per_m),
+            damping_n_s_per_m: back(&self.damping_n_s_per_m),
+        }
+    }
+
+    /// Every coefficient times `s`.
+    pub fn scaled(&self, s: f64) -> Self {
+        Self {
+            stiffness_n_per_m: self.stiffness_n_per_m.map(|r| r.map(|v| s * v)),
+            damping_n_s_per_m: self.damping_n_s_per_m.map(|r| r.map(|v| s * v)),
+        }
+    }
+
+    /// The sum of two sets of coefficients.
+    pub fn plus(&self, o: &Self) -> Self {
+        let add = |a: &[[f64; 2]; 2], b: &[[f64; 2]; 2]| rows2(&(matrix2(a) + matrix2(b)));
+        Self {
+            stiffness_n_per_m: add(&self.stiffness_n_per_m, &o.stiffness_n_per_m),
+            damping_n_s_per_m: add(&self.damping_n_s_per_m, &o.damping_n_s_per_m),
+        }
     }
 
     /// True if every coefficient is a finite number.

@@ -31,6 +31,7 @@ use super::coefficients::FilmCoefficients;
 use super::error::FilmError;
 use super::geometry::{BearingGeometry, FilmGrid, Lubricant};
 use super::{FilmModel, FilmResult, JournalKinematics};
+use nalgebra::{Rotation2, Vector2};
 use std::f64::consts::TAU;
 
 /// Marks a node that is not in the current linear system.
@@ -597,37 +598,15 @@ impl FilmModel for FiniteFilm {
         let mut sum = FilmCoefficients::default();
         // the unrotated state last, so that the warm start is that of a solve at `kin`
         for k in (0..m).rev() {
-            let alpha = k as f64 * self.dtheta / m as f64;
-            let (c, s) = (alpha.cos(), alpha.sin());
-            let turn = |v: [f64; 2]| [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+            let r = Rotation2::new(k as f64 * self.dtheta / m as f64);
+            let turn = |v: [f64; 2]| (r * Vector2::from(v)).into();
             let turned = JournalKinematics {
                 position_m: turn(kin.position_m),
                 velocity_m_s: turn(kin.velocity_m_s),
                 speed_rad_s: kin.speed_rad_s,
             };
             let (_, coef) = self.solve_with_coefficients(&turned)?;
-            // k = Rᵀ k' R with R the rotation by α
-            let back = |a: [[f64; 2]; 2]| {
-                let r = [[c, -s], [s, c]];
-                let mut out = [[0.0; 2]; 2];
-                for (i, row) in out.iter_mut().enumerate() {
-                    for (j, v) in row.iter_mut().enumerate() {
-                        for p in 0..2 {
-                            for q in 0..2 {
-                                *v += r[p][i] * a[p][q] * r[q][j];
-                            }
-                        }
-                    }
-                }
-                out
-            };
-            let (kb, db) = (back(coef.stiffness_n_per_m), back(coef.damping_n_s_per_m));
-            for i in 0..2 {
-                for j in 0..2 {
-                    sum.stiffness_n_per_m[i][j] += kb[i][j] / m as f64;
-                    sum.damping_n_s_per_m[i][j] += db[i][j] / m as f64;
-                }
-            }
+            sum = sum.plus(&coef.turned_back(&r).scaled(1.0 / m as f64));
         }
         Ok(sum)
     }

@@ -23,7 +23,7 @@ mod short;
 mod table;
 mod viscosity;
 
-pub use coefficients::FilmCoefficients;
+pub use coefficients::{matrix2, rows2, FilmCoefficients};
 pub use equilibrium::{
     equilibrium_at_eccentricity, equilibrium_under_load, short_bearing_eccentricity,
     sommerfeld_number, Equilibrium,

@@ -400,14 +400,11 @@ fn pedestal_stiffness(rotor: &Rotor, p: Option<[usize; 2]>) -> Option<[[f64; 2];
 
 /// x = A⁻¹ b for a 2 × 2 matrix (zero if singular).
 fn solve2(a: &[[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
-    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-    if det == 0.0 || !det.is_finite() {
-        return [0.0, 0.0];
-    }
-    [
-        (a[1][1] * b[0] - a[0][1] * b[1]) / det,
-        (-a[1][0] * b[0] + a[0][0] * b[1]) / det,
-    ]
+    crate::film::matrix2(a)
+        .try_inverse()
+        .map(|inv| (inv * nalgebra::Vector2::from(b)).into())
+        .filter(|x: &[f64; 2]| x.iter().all(|v| v.is_finite()))
+        .unwrap_or([0.0, 0.0])
 }
 
 /// Least-squares straight lines x(z) = a + b z, y(z) = a + b z through the journal positions:

@@ -263,7 +263,7 @@ impl Twin {
                     self.jac[i * nb + j] = v;
                 }
             }
-            if !solve_small(&mut self.jac, &mut self.delta, nb) {
+            if !solve_small(&self.jac, &mut self.delta, nb) {
                 return Err(None);
             }
             // limit a Newton move to a fifth of the clearance

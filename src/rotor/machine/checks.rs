@@ -153,6 +153,19 @@ impl MachineDescription {
             }
             rules.node(field("node"), b.node, nodes)?;
         }
+        let condensed: usize = (self.bearings.iter().filter(|b| b.film().is_some()))
+            .map(|b| if b.support.is_some() { 4 } else { 2 })
+            .sum();
+        if condensed > crate::dynamics::MAX_CONDENSED_DOFS {
+            return Err(rules.error(
+                "bearings",
+                format!("{condensed} film-bearing degrees of freedom"),
+                format!(
+                    "at most {} (two per film bearing, two more for each on a flexible support): the twin's Newton system is solved on the stack",
+                    crate::dynamics::MAX_CONDENSED_DOFS
+                ),
+            ));
+        }
         let mut at: Vec<usize> = self.bearings.iter().map(|b| b.node).collect();
         at.sort_unstable();
         at.dedup();
