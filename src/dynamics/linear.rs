@@ -11,7 +11,8 @@
 //! condenses exactly onto B: q_B = a + S f_B, a = (K_eff⁻¹ r_n)_B, and the full state follows as
 //! q = K_eff⁻¹ r_n + Z f_B. The nonlinear iteration therefore runs on a handful of unknowns.
 
-use faer::Mat;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::{Mat, Par};
 
 /// A square sparse matrix in compressed rows, for the per-step products (M, C, G).
 #[derive(Debug, Clone)]
@@ -58,17 +59,55 @@ pub(crate) struct StepFactor {
     pub h: f64,
     /// Spin speed the gyroscopic term was factored with (rad/s).
     pub speed_rad_s: f64,
-    /// K_eff⁻¹ (dense, row-major for the per-step product).
-    inverse: Vec<f64>,
+    /// K_eff⁻¹ (dense, for the per-step product).
+    inverse: Mat<f64>,
     /// Z = K_eff⁻¹ E_B, row-major n × nb.
     z: Vec<f64>,
     /// S = E_Bᵀ K_eff⁻¹ E_B, row-major nb × nb.
     pub s: Vec<f64>,
-    /// Scratch: K_eff, overwritten by its LU factors.
-    work: Vec<f64>,
-    pivots: Vec<usize>,
+    /// K_eff, overwritten by its LU factors (faer's partial-pivoting LU, in place).
+    work: Mat<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    scratch: LuScratch,
     n: usize,
     nb: usize,
+}
+
+/// faer's workspace for the LU and the inverse of an n × n matrix, reserved once.
+struct LuScratch {
+    buf: MemBuffer,
+    n: usize,
+}
+
+impl LuScratch {
+    fn new(n: usize) -> Self {
+        use faer::linalg::lu::partial_pivoting::{factor, inverse};
+        let req = StackReq::any_of(&[
+            factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
+            inverse::inverse_scratch::<usize, f64>(n, Par::Seq),
+        ]);
+        Self {
+            buf: MemBuffer::new(req),
+            n,
+        }
+    }
+
+    fn stack(&mut self) -> &mut MemStack {
+        MemStack::new(&mut self.buf)
+    }
+}
+
+impl Clone for LuScratch {
+    fn clone(&self) -> Self {
+        Self::new(self.n)
+    }
+}
+
+impl std::fmt::Debug for LuScratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "LuScratch {{ n: {} }}", self.n)
+    }
 }
 
 impl StepFactor {
@@ -89,11 +128,13 @@ impl StepFactor {
         let mut f = Self {
             h,
             speed_rad_s,
-            inverse: vec![0.0; n * n],
+            inverse: Mat::zeros(n, n),
             z: vec![0.0; n * nb],
             s: vec![0.0; nb * nb],
-            work: vec![0.0; n * n],
-            pivots: vec![0; n],
+            work: Mat::zeros(n, n),
+            perm: vec![0; n],
+            perm_inv: vec![0; n],
+            scratch: LuScratch::new(n),
             n,
             nb,
         };
@@ -101,8 +142,9 @@ impl StepFactor {
             .then_some(f)
     }
 
-    /// Factors K + (2/h)(C + ΩG) + (4/h²) M again for spin `speed_rad_s` (rad/s), in place.
-    /// False if singular (the previous factor is then invalid).
+    /// Factors K + (2/h)(C + ΩG) + (4/h²) M again for spin `speed_rad_s` (rad/s), in place
+    /// (faer's partial-pivoting LU and the inverse from it). False if singular (the previous
+    /// factor is then invalid).
     pub(crate) fn refactor(
         &mut self,
         m: &Mat<f64>,
@@ -112,36 +154,44 @@ impl StepFactor {
         speed_rad_s: f64,
         bearing_dofs: &[usize],
     ) -> bool {
+        use faer::linalg::lu::partial_pivoting::{factor, inverse};
         let (n, h) = (self.n, self.h);
-        for i in 0..n {
-            for j in 0..n {
-                self.work[i * n + j] = k[(i, j)]
+        for j in 0..n {
+            for i in 0..n {
+                self.work[(i, j)] = k[(i, j)]
                     + 2.0 / h * (c[(i, j)] + speed_rad_s * g[(i, j)])
                     + 4.0 / (h * h) * m[(i, j)];
             }
         }
-        if !lu_in_place(&mut self.work, &mut self.pivots, n) {
+        let (_, perm) = factor::lu_in_place(
+            self.work.as_mut(),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            self.scratch.stack(),
+            Default::default(),
+        );
+        if (0..n).any(|i| !(self.work[(i, i)] != 0.0 && self.work[(i, i)].is_finite())) {
             return false;
         }
-        // columns of the inverse: solve LU x = e_j
-        self.inverse.fill(0.0);
-        for j in 0..n {
-            // column j of the inverse: L U x = P e_j, (P e_j)_i = 1 where pivots[i] = j
-            for i in 0..n {
-                self.inverse[i * n + j] = if self.pivots[i] == j { 1.0 } else { 0.0 };
-            }
-            lu_solve_column(&self.work, n, &mut self.inverse, j);
-        }
+        inverse::inverse(
+            self.inverse.as_mut(),
+            self.work.as_ref(),
+            self.work.as_ref(),
+            perm,
+            Par::Seq,
+            self.scratch.stack(),
+        );
         for (r, &b) in bearing_dofs.iter().enumerate() {
             for i in 0..n {
-                self.z[i * self.nb + r] = self.inverse[i * n + b];
+                self.z[i * self.nb + r] = self.inverse[(i, b)];
             }
             for (q, &a) in bearing_dofs.iter().enumerate() {
-                self.s[q * self.nb + r] = self.inverse[a * n + b];
+                self.s[q * self.nb + r] = self.inverse[(a, b)];
             }
         }
         self.speed_rad_s = speed_rad_s;
-        self.inverse.iter().all(|v| v.is_finite())
+        (0..n).all(|j| (0..n).all(|i| self.inverse[(i, j)].is_finite()))
     }
 
     /// out = K_eff⁻¹ r (faer's matrix–vector product, vectorised for the CPU it runs on).
@@ -151,7 +201,7 @@ impl StepFactor {
         faer::linalg::matmul::matmul(
             faer::MatMut::from_column_major_slice_mut(&mut out[..n], n, 1),
             faer::Accum::Replace,
-            faer::MatRef::from_row_major_slice(&self.inverse, n, n),
+            self.inverse.as_ref(),
             faer::MatRef::from_column_major_slice(&r[..n], n, 1),
             1.0,
             faer::Par::Seq,
@@ -164,61 +214,6 @@ impl StepFactor {
             let row = &self.z[i * self.nb..(i + 1) * self.nb];
             *qi += row.iter().zip(f_b).map(|(a, b)| a * b).sum::<f64>();
         }
-    }
-}
-
-/// LU factorisation with partial pivoting, in place (row-major n × n). `perm[i]` is the original
-/// row now at position i. False if singular.
-fn lu_in_place(a: &mut [f64], perm: &mut [usize], n: usize) -> bool {
-    for (i, p) in perm.iter_mut().enumerate() {
-        *p = i;
-    }
-    for k in 0..n {
-        let p = (k..n)
-            .max_by(|&i, &j| a[i * n + k].abs().total_cmp(&a[j * n + k].abs()))
-            .unwrap_or(k);
-        let pivot = a[p * n + k];
-        if pivot == 0.0 || !pivot.is_finite() {
-            return false;
-        }
-        if p != k {
-            for j in 0..n {
-                a.swap(k * n + j, p * n + j);
-            }
-            perm.swap(k, p);
-        }
-        let inv = 1.0 / a[k * n + k];
-        for i in k + 1..n {
-            let f = a[i * n + k] * inv;
-            a[i * n + k] = f;
-            if f != 0.0 {
-                let (upper, lower) = a.split_at_mut(i * n);
-                let pivot_row = &upper[k * n + k + 1..k * n + n];
-                for (x, u) in lower[k + 1..n].iter_mut().zip(pivot_row) {
-                    *x -= f * u;
-                }
-            }
-        }
-    }
-    true
-}
-
-/// Solves L U x = b for column `col` of the row-major n × n array `x` (b there on entry, the
-/// right-hand side already permuted).
-fn lu_solve_column(lu: &[f64], n: usize, x: &mut [f64], col: usize) {
-    for i in 0..n {
-        let mut s = x[i * n + col];
-        for j in 0..i {
-            s -= lu[i * n + j] * x[j * n + col];
-        }
-        x[i * n + col] = s;
-    }
-    for i in (0..n).rev() {
-        let mut s = x[i * n + col];
-        for j in i + 1..n {
-            s -= lu[i * n + j] * x[j * n + col];
-        }
-        x[i * n + col] = s / lu[i * n + i];
     }
 }
 
@@ -280,6 +275,40 @@ mod tests {
                 for i in 0..n {
                     let tol = 1e-9 * want[(i, 0)].abs().max(1.0);
                     assert!((x[i] - want[(i, 0)]).abs() < tol, "n {n} row {i}");
+                }
+            }
+        }
+    }
+
+    /// K_eff⁻¹ from faer's in-place LU: K_eff · K_eff⁻¹ = I on a seeded non-symmetric system
+    /// (C + ΩG is not symmetric), S and Z its entries at the bearing DOFs; refactoring at another
+    /// speed gives the inverse at that speed.
+    #[test]
+    fn step_factor_inverts_k_eff() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let n = 24;
+        let mut r =
+            |scale: f64| Mat::<f64>::from_fn(n, n, |_, _| scale * rng.random_range(-1.0..1.0));
+        let (m, c, g) = (r(1.0), r(1.0), r(1.0));
+        let k = Mat::<f64>::from_fn(n, n, |i, j| if i == j { 50.0 } else { 0.0 }) + r(1.0);
+        let (h, dofs) = (0.05, [3, 4, 17, 18]);
+        let mut f = StepFactor::new(&m, &c, &g, &k, h, 10.0, &dofs).expect("regular");
+        for speed in [10.0, -3.0] {
+            assert!(f.refactor(&m, &c, &g, &k, speed, &dofs));
+            let keff = &k + (2.0 / h) * (&c + speed * &g) + (4.0 / (h * h)) * &m;
+            let product = &keff * &f.inverse;
+            for i in 0..n {
+                for j in 0..n {
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!(
+                        (product[(i, j)] - want).abs() < 1e-10,
+                        "({i}, {j}) at {speed}"
+                    );
+                }
+            }
+            for (q, &a) in dofs.iter().enumerate() {
+                for (p, &b) in dofs.iter().enumerate() {
+                    assert_eq!(f.s[q * dofs.len() + p], f.inverse[(a, b)]);
                 }
             }
         }
