@@ -6,8 +6,8 @@ use ros2_client::rcl_interfaces::{
     GetParametersRequest, GetParametersResponse, SetParametersRequest, SetParametersResponse,
 };
 use ros2_client::{
-    Context, Name, NodeName, NodeOptions, Parameter, ParameterValue, QosProfile, ServiceMapping,
-    ServiceTypeName,
+    Client, Context, Name, NodeName, NodeOptions, Parameter, ParameterValue, QosProfile,
+    ServiceMapping, ServiceTypeName,
 };
 use std::time::Duration;
 
@@ -50,107 +50,158 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
             .map_err(|e| anyhow::anyhow!("{e:?}"))?;
         let spinner = me.spinner().map_err(|e| anyhow::anyhow!("{e:?}"))?;
         tokio::spawn(spinner.spin());
-        // the QoS ros2-client's parameter servers use
-        let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 1 });
-        let service = |name: &str| {
-            Name::new(node, name).map_err(|e| anyhow::anyhow!("node name '{node}': {e:?}"))
-        };
-        let within = |what: &'static str| {
-            anyhow::anyhow!("node {node} did not answer {what} within {timeout:?}")
-        };
-        let getter = me
-            .create_client::<GetParametersRequest, GetParametersResponse>(
-                ServiceMapping::Enhanced,
-                &service("get_parameters")?,
-                &ServiceTypeName::new("rcl_interfaces", "GetParameters"),
-                qos.clone(),
-                qos.clone(),
-            )
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        tokio::time::timeout(timeout, getter.wait_for_service(&me))
-            .await
-            .map_err(|_| within("get_parameters"))?;
-        let get = |names: Vec<String>| async {
-            let id = getter
-                .async_send_request(GetParametersRequest { names })
-                .await
-                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-            let response = tokio::time::timeout(timeout, getter.async_receive_response(id))
-                .await
-                .map_err(|_| within("get_parameters"))?
-                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-            anyhow::Ok(
-                response
-                    .values
-                    .into_iter()
-                    .map(ParameterValue::from)
-                    .collect::<Vec<_>>(),
-            )
-        };
+        let peer = Peer { node, timeout };
+        let getter: Client<GetParametersRequest, GetParametersResponse> = peer
+            .client(&mut me, "get_parameters", "GetParameters")
+            .await?;
         match call {
             ParamCall::Get(names) => {
-                let values = get(names.clone()).await?;
+                let values = peer.get(&getter, names.clone()).await?;
                 for (name, value) in names.iter().zip(values) {
                     println!("{name}: {}", shown(&value));
                 }
                 Ok(())
             }
             ParamCall::Set(items) => {
-                let client = me
-                    .create_client::<SetParametersRequest, SetParametersResponse>(
-                        ServiceMapping::Enhanced,
-                        &service("set_parameters")?,
-                        &ServiceTypeName::new("rcl_interfaces", "SetParameters"),
-                        qos.clone(),
-                        qos,
-                    )
-                    .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-                tokio::time::timeout(timeout, client.wait_for_service(&me))
-                    .await
-                    .map_err(|_| within("set_parameters"))?;
-                // a whole number given for a parameter that is a double is meant as a double
-                let current = get(items.iter().map(|(n, _)| n.clone()).collect()).await?;
-                let request = SetParametersRequest {
-                    parameter: items
-                        .iter()
-                        .zip(&current)
-                        .map(|((name, value), now)| {
-                            let value = match (value_of(value), now) {
-                                (ParameterValue::Integer(i), ParameterValue::Double(_)) => {
-                                    ParameterValue::Double(i as f64)
-                                }
-                                (v, _) => v,
-                            };
-                            Parameter {
-                                name: name.clone(),
-                                value,
-                            }
-                            .into()
-                        })
-                        .collect(),
-                };
-                let id = client
-                    .async_send_request(request)
-                    .await
-                    .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-                let response = tokio::time::timeout(timeout, client.async_receive_response(id))
-                    .await
-                    .map_err(|_| within("set_parameters"))?
-                    .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-                let mut refused = Vec::new();
-                for ((name, value), result) in items.iter().zip(response.results) {
-                    if result.successful {
-                        println!("{name}:={value}: set");
-                    } else {
-                        println!("{name}:={value}: REFUSED: {}", result.reason);
-                        refused.push(name.clone());
-                    }
-                }
-                anyhow::ensure!(refused.is_empty(), "refused: {}", refused.join(", "));
-                Ok(())
+                let setter: Client<SetParametersRequest, SetParametersResponse> = peer
+                    .client(&mut me, "set_parameters", "SetParameters")
+                    .await?;
+                let current = peer
+                    .get(&getter, items.iter().map(|(n, _)| n.clone()).collect())
+                    .await?;
+                let request = set_request(&items, &current);
+                let response = peer.call(&setter, request, "set_parameters").await?;
+                let outcomes = response.results.iter();
+                report_set(&items, outcomes.map(|r| (r.successful, r.reason.as_str())))
             }
         }
     })
+}
+
+/// The node whose parameter services are called, and how long it may take to answer.
+struct Peer<'a> {
+    node: &'a str,
+    timeout: Duration,
+}
+
+impl Peer<'_> {
+    /// A client of the node's service `service` (type rcl_interfaces/`type_name`), once the
+    /// service is there.
+    async fn client<Req, Resp>(
+        &self,
+        me: &mut ros2_client::Node,
+        service: &'static str,
+        type_name: &str,
+    ) -> anyhow::Result<Client<Req, Resp>>
+    where
+        Req: ros2_client::Message + Clone + 'static,
+        Resp: ros2_client::Message + 'static,
+    {
+        // the QoS ros2-client's parameter servers use
+        let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 1 });
+        let name = Name::new(self.node, service)
+            .map_err(|e| anyhow::anyhow!("node name '{}': {e:?}", self.node))?;
+        let client = me
+            .create_client::<Req, Resp>(
+                ServiceMapping::Enhanced,
+                &name,
+                &ServiceTypeName::new("rcl_interfaces", type_name),
+                qos.clone(),
+                qos,
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        tokio::time::timeout(self.timeout, client.wait_for_service(me))
+            .await
+            .map_err(|_| self.late(service))?;
+        Ok(client)
+    }
+
+    /// One request and its response.
+    async fn call<Req, Resp>(
+        &self,
+        client: &Client<Req, Resp>,
+        request: Req,
+        service: &'static str,
+    ) -> anyhow::Result<Resp>
+    where
+        Req: ros2_client::Message + Clone + 'static,
+        Resp: ros2_client::Message + 'static,
+    {
+        let id = client
+            .async_send_request(request)
+            .await
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        tokio::time::timeout(self.timeout, client.async_receive_response(id))
+            .await
+            .map_err(|_| self.late(service))?
+            .map_err(|e| anyhow::anyhow!("{e:?}"))
+    }
+
+    /// The values of parameters `names`.
+    async fn get(
+        &self,
+        getter: &Client<GetParametersRequest, GetParametersResponse>,
+        names: Vec<String>,
+    ) -> anyhow::Result<Vec<ParameterValue>> {
+        let response = self
+            .call(getter, GetParametersRequest { names }, "get_parameters")
+            .await?;
+        Ok(response
+            .values
+            .into_iter()
+            .map(ParameterValue::from)
+            .collect())
+    }
+
+    fn late(&self, service: &str) -> anyhow::Error {
+        anyhow::anyhow!(
+            "node {} did not answer {service} within {:?}",
+            self.node,
+            self.timeout
+        )
+    }
+}
+
+/// The set request for `items` (name, value as text); a whole number given for a parameter that
+/// is a double now (`current`) is meant as a double.
+fn set_request(items: &[(String, String)], current: &[ParameterValue]) -> SetParametersRequest {
+    SetParametersRequest {
+        parameter: items
+            .iter()
+            .zip(current)
+            .map(|((name, value), now)| {
+                let value = match (value_of(value), now) {
+                    (ParameterValue::Integer(i), ParameterValue::Double(_)) => {
+                        ParameterValue::Double(i as f64)
+                    }
+                    (v, _) => v,
+                };
+                Parameter {
+                    name: name.clone(),
+                    value,
+                }
+                .into()
+            })
+            .collect(),
+    }
+}
+
+/// Prints each set's outcome (successful, reason); Err naming the refused ones.
+fn report_set<'a>(
+    items: &[(String, String)],
+    outcomes: impl Iterator<Item = (bool, &'a str)>,
+) -> anyhow::Result<()> {
+    let mut refused = Vec::new();
+    for ((name, value), (successful, reason)) in items.iter().zip(outcomes) {
+        if successful {
+            println!("{name}:={value}: set");
+        } else {
+            println!("{name}:={value}: REFUSED: {reason}");
+            refused.push(name.clone());
+        }
+    }
+    anyhow::ensure!(refused.is_empty(), "refused: {}", refused.join(", "));
+    Ok(())
 }
 
 /// A parameter value as `ros2 param get` shows it: the type, then the value.
