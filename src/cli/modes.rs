@@ -70,10 +70,9 @@ struct ModesReport {
     campbell: Vec<CampbellPoint>,
 }
 
-pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
-    let desc = MachineDescription::load(args.config.as_deref())?;
-    let rotor = Rotor::from_description(&desc);
-    let rated = desc.rated_speed_rpm;
+/// The speeds of the Campbell diagram and threshold search, checked: (speeds, from, to, step)
+/// in rpm; by default 10 % to 150 % of the rated speed `rated` in 40 steps.
+fn speed_range(args: &ModesArgs, rated: f64) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
     let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));
     let to = args.to_rpm.unwrap_or(1.5 * rated);
     for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
@@ -100,14 +99,20 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         "invalid --modes {}: must be 1 to 100",
         args.modes
     );
+    let n_speeds = ((to - from) / step).round() as usize;
+    let speeds = (0..=n_speeds)
+        .map(|k| (from + k as f64 * step).min(to))
+        .collect();
+    Ok((speeds, from, to, step))
+}
 
+pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
+    let desc = MachineDescription::load(args.config.as_deref())?;
+    let rotor = Rotor::from_description(&desc);
+    let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     let statics = static_solution(&rotor).context("static deflection")?;
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
-    let n_speeds = ((to - from) / step).round() as usize;
-    let speeds: Vec<f64> = (0..=n_speeds)
-        .map(|k| (from + k as f64 * step).min(to))
-        .collect();
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
     let threshold =
         stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
@@ -161,6 +166,14 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
 }
 
 fn print_tables(r: &ModesReport) {
+    print_statics(r);
+    print_frequencies(r);
+    print_campbell(r);
+    print_criticals(r);
+}
+
+/// Mass, size and the static loads and deflection.
+fn print_statics(r: &ModesReport) {
     println!("rotor-twin modes: {}", r.machine);
     println!(
         "  rotor {:.2} kg, {} nodes, {} Timoshenko elements, rated {:.0} rpm",
@@ -174,6 +187,10 @@ fn print_tables(r: &ModesReport) {
         "  largest static deflection {:.2} µm",
         r.static_max_deflection_m * 1e6
     );
+}
+
+/// Natural frequencies at rest, and a note on the massless-shaft modes left out.
+fn print_frequencies(r: &ModesReport) {
     let list = |v: &[f64]| {
         v.iter()
             .map(|f| format!("{f:.1}"))
@@ -209,6 +226,10 @@ fn print_tables(r: &ModesReport) {
             lowest / 1e3
         );
     }
+}
+
+/// The Campbell diagram as a table.
+fn print_campbell(r: &ModesReport) {
     println!("  Campbell diagram (film bearings linearised at their static equilibrium):");
     println!(
         "    {:>8}  modes: frequency Hz / log dec / F(orward) B(ackward) and mode id (followed by shape)",
@@ -230,6 +251,10 @@ fn print_tables(r: &ModesReport) {
             .collect();
         println!("    {:>8.0}  {}", p.speed_rpm, modes.join("  "));
     }
+}
+
+/// Forward critical speeds and the stability threshold.
+fn print_criticals(r: &ModesReport) {
     let criticals: Vec<String> = r
         .critical_speeds
         .iter()
