@@ -77,6 +77,14 @@ pub struct NodeParams {
     /// `--film-cache-dir`, else $ROTOR_TWIN_CACHE_DIR, $XDG_CACHE_HOME/rotor-twin,
     /// ~/.cache/rotor-twin).
     pub film_cache_dir: String,
+    /// `forecast_period_s`: model time between forecasts (s); 0 (the default): no forecast. A
+    /// forecast takes about one core for a second per run (see the README's "Forecast").
+    pub forecast_period_s: f64,
+    /// `forecast_horizon_s`: how far a forecast looks ahead (s).
+    pub forecast_horizon_s: f64,
+    /// `forecast_offsets_rpm`: constant speeds a forecast probes above the present one (rpm,
+    /// ascending, comma separated; empty: the expected path only, no margin).
+    pub forecast_offsets_rpm: Vec<f64>,
 }
 
 impl Default for NodeParams {
@@ -99,6 +107,9 @@ impl Default for NodeParams {
             probe_point_topics: Vec::new(),
             film_cache: true,
             film_cache_dir: String::new(),
+            forecast_period_s: 0.0,
+            forecast_horizon_s: crate::forecast::DEFAULT_HORIZON_S,
+            forecast_offsets_rpm: crate::forecast::DEFAULT_OFFSETS_RPM.to_vec(),
         }
     }
 }
@@ -181,6 +192,57 @@ impl NodeParams {
             "use_sim_time" => self.use_sim_time = boolean(name, value)?,
             "film_cache" => self.film_cache = boolean(name, value)?,
             "film_cache_dir" => self.film_cache_dir = value.trim().to_string(),
+            "forecast_period_s" | "forecast_horizon_s" | "forecast_offsets_rpm" => {
+                self.set_forecast(name, value)?
+            }
+            _ => return Err(format!("unknown parameter '{name}'")),
+        }
+        Ok(())
+    }
+}
+
+impl NodeParams {
+    /// Sets one of the forecast's parameters (issue 14) from its text value.
+    fn set_forecast(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let num = |v: &str| -> Result<f64, String> {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("parameter {name}: '{v}' is not a number"))
+        };
+        match name {
+            "forecast_period_s" => {
+                let p = num(value)?;
+                if !(p.is_finite() && p >= 0.0) {
+                    return Err(format!(
+                        "parameter forecast_period_s: {p} must be 0 (off) or a time above zero"
+                    ));
+                }
+                self.forecast_period_s = p;
+            }
+            "forecast_horizon_s" => {
+                let h = num(value)?;
+                if !(h.is_finite() && h > 0.0 && h <= 60.0) {
+                    return Err(format!(
+                        "parameter forecast_horizon_s: {h} must be above 0 and at most 60"
+                    ));
+                }
+                self.forecast_horizon_s = h
+            }
+            "forecast_offsets_rpm" => {
+                let offsets = value
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|v| !v.is_empty())
+                    .map(num)
+                    .collect::<Result<Vec<f64>, String>>()?;
+                crate::forecast::ForecastSettings {
+                    offsets_rpm: offsets.clone(),
+                    ..Default::default()
+                }
+                .check()
+                .map_err(|e| format!("parameter forecast_offsets_rpm: {e}"))?;
+                self.forecast_offsets_rpm = offsets;
+            }
             _ => return Err(format!("unknown parameter '{name}'")),
         }
         Ok(())
