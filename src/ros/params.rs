@@ -192,17 +192,16 @@ impl NodeParams {
             "use_sim_time" => self.use_sim_time = boolean(name, value)?,
             "film_cache" => self.film_cache = boolean(name, value)?,
             "film_cache_dir" => self.film_cache_dir = value.trim().to_string(),
-            "forecast_period_s" | "forecast_horizon_s" | "forecast_offsets_rpm" => {
-                self.set_forecast(name, value)?
-            }
-            _ => return Err(format!("unknown parameter '{name}'")),
+            // the forecast's, or unknown
+            _ => return self.set_forecast(name, value),
         }
         Ok(())
     }
 }
 
 impl NodeParams {
-    /// Sets one of the forecast's parameters (issue 14) from its text value.
+    /// Sets one of the forecast's parameters (issue 14) from its text value; any other name is
+    /// unknown.
     fn set_forecast(&mut self, name: &str, value: &str) -> Result<(), String> {
         let num = |v: &str| -> Result<f64, String> {
             v.trim()
