@@ -443,3 +443,66 @@ impl Forecast {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The persistence rule by hand: a whirl stretch interrupted after 23 revolutions is no
+    /// onset; one held 24 revolutions is, from its first revolution; a whip likewise; a stretch
+    /// held to the end of a run counts from 3 revolutions on.
+    #[test]
+    fn an_onset_must_persist_24_revolutions() {
+        let mut t = Track::default();
+        for k in 0..23 {
+            t.revolution(RotorState::Whirl, k as f64);
+        }
+        t.revolution(RotorState::Growing, 23.0);
+        assert_eq!(t.finish(), (None, None));
+        for k in 24..48 {
+            t.revolution(RotorState::Whirl, k as f64);
+        }
+        assert_eq!(t.onset_at, Some(24.0));
+        for k in 48..60 {
+            t.revolution(RotorState::Whip, k as f64);
+        }
+        // the whip has held 12 revolutions to the end of the run: counted, from 48
+        assert_eq!(t.finish(), (Some(24.0), Some(48.0)));
+        let mut short = Track::default();
+        short.revolution(RotorState::Whip, 0.0);
+        short.revolution(RotorState::Whip, 1.0);
+        assert_eq!(
+            short.finish(),
+            (None, None),
+            "two revolutions are not enough"
+        );
+    }
+
+    /// Settings refused with the field and the value.
+    #[test]
+    fn bad_settings_are_refused() {
+        let bad = |s: ForecastSettings| s.check().unwrap_err();
+        let d = ForecastSettings::default;
+        assert!(bad(ForecastSettings {
+            horizon_s: 0.0,
+            ..d()
+        })
+        .contains("horizon"));
+        assert!(bad(ForecastSettings {
+            horizon_s: f64::NAN,
+            ..d()
+        })
+        .contains("NaN"));
+        assert!(bad(ForecastSettings {
+            offsets_rpm: vec![0.0, 0.0],
+            ..d()
+        })
+        .contains("ascending"));
+        assert!(bad(ForecastSettings {
+            offsets_rpm: vec![-1.0],
+            ..d()
+        })
+        .contains("-1"));
+        assert!(d().check().is_ok());
+    }
+}

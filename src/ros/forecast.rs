@@ -28,6 +28,8 @@ pub struct ForecastStats {
     pub completed: AtomicU64,
     /// Due checkpoints skipped because the last forecast was still running.
     pub skipped: AtomicU64,
+    /// `skipped` at the last diagnostics (the status warns of skips in its interval).
+    pub skipped_reported: AtomicU64,
     /// Wall time of the last forecast (µs).
     pub last_duration_us: AtomicU64,
     /// Longest wall time of a forecast (µs).

@@ -465,13 +465,15 @@ impl ModelLoop {
     }
 
     /// `<node>: forecast`: the last and longest forecast duration, forecasts done, cycles skipped
-    /// because one was still running, the checkpoint's cost in the model thread; WARN when
-    /// cycles were skipped (the period is shorter than a forecast), ERROR when it cannot run.
+    /// because one was still running, the checkpoint's cost in the model thread; WARN when a
+    /// cycle was skipped in the interval (a forecast took longer than the period), ERROR when it
+    /// cannot run.
     fn forecast_status(&self) -> Option<DiagnosticStatus> {
         let f = self.forecast.as_ref()?;
         let st = &f.stats;
         let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
         let skipped = get(&st.skipped);
+        let skipped_now = skipped - st.skipped_reported.swap(skipped, Ordering::Relaxed);
         let values = vec![
             kv("period_s", format!("{:.3}", self.params.forecast_period_s)),
             kv(
@@ -501,10 +503,10 @@ impl ModelLoop {
                 DiagnosticStatus::ERROR,
                 "the forecast cannot run (see the node's log)".into(),
             )
-        } else if skipped > 0 {
+        } else if skipped_now > 0 {
             (
                 DiagnosticStatus::WARN,
-                format!("{skipped} cycle(s) skipped: a forecast takes longer than the period"),
+                format!("{skipped_now} cycle(s) skipped: a forecast took longer than the period"),
             )
         } else {
             (DiagnosticStatus::OK, "forecasting".into())

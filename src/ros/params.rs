@@ -522,6 +522,42 @@ impl NodeParams {
 mod tests {
     use super::*;
 
+    /// The forecast's parameters: defaults (off, 3 s, +0/100/250/500 rpm), good values taken,
+    /// bad ones refused naming the parameter and the value; an unknown name stays unknown.
+    #[test]
+    fn forecast_parameters_are_checked() {
+        let mut p = NodeParams::default();
+        assert_eq!(p.forecast_period_s, 0.0);
+        assert_eq!(p.forecast_horizon_s, 3.0);
+        assert_eq!(p.forecast_offsets_rpm, vec![0.0, 100.0, 250.0, 500.0]);
+        p.set("forecast_period_s", "2.5").unwrap();
+        p.set("forecast_offsets_rpm", "0, 200").unwrap();
+        p.set("forecast_horizon_s", "1.5").unwrap();
+        assert_eq!(
+            (
+                p.forecast_period_s,
+                p.forecast_horizon_s,
+                p.forecast_offsets_rpm.clone()
+            ),
+            (2.5, 1.5, vec![0.0, 200.0])
+        );
+        let refused = |name: &str, value: &str| {
+            let e = NodeParams::default().set(name, value).unwrap_err();
+            assert!(e.contains(name) || e.contains(value), "{name}={value}: {e}");
+        };
+        refused("forecast_period_s", "-1");
+        refused("forecast_period_s", "NaN");
+        refused("forecast_horizon_s", "0");
+        refused("forecast_horizon_s", "100");
+        refused("forecast_offsets_rpm", "100,50");
+        refused("forecast_offsets_rpm", "-10");
+        refused("forecast_offsets_rpm", "x");
+        assert!(NodeParams::default()
+            .set("forecast_nonsense", "1")
+            .unwrap_err()
+            .contains("unknown parameter"));
+    }
+
     #[test]
     fn ros_args_and_parameters() {
         let args: Vec<String> = [
