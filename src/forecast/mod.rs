@@ -21,7 +21,8 @@ use serde::Serialize;
 /// Default look-ahead horizon (s). Three seconds is 450 revolutions at 9,000 rpm: long enough
 /// for a whirl growing at the classifier's threshold rate plus half again (0.003/rev) to grow
 /// e-fold 1.35 times, for the twin's whirl on the shipped run-up to develop into whip (whirl at
-/// 6.10 s, whip at 6.83 s), and short enough that a run costs about a second of one core.
+/// 6.10 s, whip at 6.83 s), and short enough that a forecast of the default four runs costs
+/// about a second of one core at 8,000 rpm (measured in the node: 1.0–1.3 s median).
 pub const DEFAULT_HORIZON_S: f64 = 3.0;
 
 /// Default constant speeds probed, above the present speed (rpm): 0 (the present speed), +100,
