@@ -10,6 +10,7 @@ pub mod cli;
 pub mod driver;
 pub mod dynamics;
 pub mod film;
+pub mod forecast;
 pub mod messages;
 pub mod monitor;
 pub mod plant;

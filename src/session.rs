@@ -73,6 +73,8 @@ pub enum Outgoing {
     Residual(OrbitResidual),
     /// Distance from the linear stability threshold.
     Margin(StabilityMargin),
+    /// The twin's look-ahead ([`crate::forecast`]; boxed: it is the largest message).
+    Forecast(Box<Forecast>),
 }
 
 /// A message header stamped `ns` (ns since the epoch) in frame `frame`.
@@ -217,6 +219,11 @@ impl Session {
     /// The twin (read only).
     pub fn twin(&self) -> &Twin {
         &self.twin
+    }
+
+    /// The monitor (read only; the forecast continues a copy of it).
+    pub fn monitor(&self) -> &Monitor {
+        &self.monitor
     }
 
     /// The twin, to change its unbalance or forces.

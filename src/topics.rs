@@ -23,6 +23,8 @@ pub const PROBE_SIGNAL: &str = "/rotor_twin/probe_signal";
 pub const RESIDUAL: &str = "/rotor_twin/residual";
 /// Distance from the linear stability threshold, out.
 pub const MARGIN: &str = "/rotor_twin/stability_margin";
+/// The twin's look-ahead (rotor_twin_msgs/Forecast), out (issue 14).
+pub const FORECAST: &str = "/rotor_twin/forecast";
 /// Journal state of each bearing, out.
 pub const JOURNAL: &str = "/rotor_twin/journal_state";
 /// Film state of each bearing, out.
@@ -63,3 +65,6 @@ pub const MARGIN_QOS: TopicQos = TopicQos::latched(1);
 
 /// QoS of the /clock subscription: best effort, keep last 10 (as rclcpp's clock subscription).
 pub const CLOCK_READER: TopicQos = TopicQos::sensor(10);
+
+/// QoS of the forecast: latched, keep last 1 (a late subscriber gets the last look-ahead).
+pub const FORECAST_QOS: TopicQos = TopicQos::latched(1);

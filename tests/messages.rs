@@ -45,6 +45,7 @@ fn rust_types_mirror_the_msg_files() {
     check::<OrbitResidual>();
     check::<Keyphasor>();
     check::<ProbeSignal>();
+    check::<Forecast>();
     check::<Float64>();
     check::<PointStamped>();
     check::<Clock>();
@@ -69,6 +70,7 @@ fn every_msg_file_is_mirrored_listed_and_documented() {
         OrbitResidual::TYPE_NAME,
         Keyphasor::TYPE_NAME,
         ProbeSignal::TYPE_NAME,
+        Forecast::TYPE_NAME,
     ];
     for entry in std::fs::read_dir(dir.join("msg")).unwrap() {
         let path = entry.unwrap().path();

@@ -82,6 +82,57 @@ pub struct ReplayArgs {
     /// windows with non-synchronous motion are left out).
     #[arg(long, value_parser = parse_window, requires = "calibrate")]
     pub calibrate_window: Option<(f64, f64)>,
+    /// Run the forecast (look-ahead) offline at bag time every --forecast-period-s, and score it
+    /// against the plant's observed onset (lead time, false announcements; issue 14).
+    #[arg(long)]
+    pub forecast: bool,
+    /// Bag time between forecasts (s).
+    #[arg(long, default_value_t = crate::replay::DEFAULT_REPLAY_FORECAST_PERIOD_S, requires = "forecast")]
+    pub forecast_period_s: f64,
+    /// How far each forecast looks ahead (s).
+    #[arg(long, default_value_t = crate::forecast::DEFAULT_HORIZON_S, requires = "forecast")]
+    pub forecast_horizon_s: f64,
+    /// Constant speeds probed above the present one (rpm, comma separated, ascending; "none":
+    /// the expected path only, no nonlinear margin).
+    #[arg(long, default_value = "0,100,250,500", value_parser = parse_offsets, requires = "forecast")]
+    pub forecast_offsets_rpm: Offsets,
+}
+
+/// The `--forecast-offsets-rpm` list (rpm).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Offsets(pub Vec<f64>);
+
+fn parse_offsets(s: &str) -> Result<Offsets, String> {
+    if s.trim() == "none" {
+        return Ok(Offsets(Vec::new()));
+    }
+    let v = s
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|e| format!("--forecast-offsets-rpm '{v}': {e}"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    crate::forecast::ForecastSettings {
+        offsets_rpm: v.clone(),
+        ..Default::default()
+    }
+    .check()
+    .map_err(|e| format!("--forecast-offsets-rpm: {e}"))?;
+    Ok(Offsets(v))
+}
+
+/// The forecast the options ask for (None without `--forecast`).
+fn forecast_options(args: &ReplayArgs) -> Option<crate::replay::ReplayForecast> {
+    args.forecast.then(|| crate::replay::ReplayForecast {
+        period_s: args.forecast_period_s,
+        settings: crate::forecast::ForecastSettings {
+            horizon_s: args.forecast_horizon_s,
+            offsets_rpm: args.forecast_offsets_rpm.0.clone(),
+            ..Default::default()
+        },
+    })
 }
 
 fn parse_window(s: &str) -> Result<(f64, f64), String> {
@@ -198,6 +249,14 @@ fn check_args(args: &ReplayArgs) -> anyhow::Result<()> {
         "--steps-per-rev {}: must be 16 to 4096",
         args.steps_per_rev
     );
+    if let Some(f) = forecast_options(args) {
+        f.settings.check().map_err(anyhow::Error::msg)?;
+        anyhow::ensure!(
+            f.period_s.is_finite() && f.period_s > 0.0,
+            "--forecast-period-s {}: must be positive (s)",
+            f.period_s
+        );
+    }
     Ok(())
 }
 
@@ -241,6 +300,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         rate: if args.fast { None } else { args.rate },
         duration_s: args.duration,
         out_bag: (!args.no_bag).then(|| out_dir.join("bag")),
+        forecast: forecast_options(args),
         ..ReplayOptions::default()
     };
     crate::replay::check_mapping(&bag, &rotor, &options)?;

@@ -167,6 +167,17 @@ impl Driver {
         self.speed.map(|s| s.0)
     }
 
+    /// The latest accepted speed and acceleration (rad/s, rad/s²): what the twin is stepped at
+    /// (the forecast's starting point).
+    pub fn speed_input(&self) -> Option<(f64, f64)> {
+        self.speed.map(|s| (s.0, s.1))
+    }
+
+    /// The linear stability threshold (rad/s, whirl ratio), if known and found.
+    pub fn linear_threshold(&self) -> Option<(f64, f64)> {
+        self.threshold.flatten()
+    }
+
     /// Age (s) of the latest accepted speed at `now_ns`.
     pub fn speed_age_s(&self, now_ns: i64) -> Option<f64> {
         self.speed.map(|s| (now_ns - s.2) as f64 * 1e-9)

@@ -351,6 +351,57 @@ ros_message!(
 );
 // --- end plant signals ---
 
+// --- forecast (issue 14) ---
+
+ros_message!(
+    /// The twin's look-ahead from a checkpoint of its present state (see `msg/msg/Forecast.msg`).
+    Forecast, "Forecast.msg" {
+        /// Time of the checkpoint the forecast starts from.
+        header: Header = "std_msgs/Header",
+        /// Look-ahead horizon (s).
+        horizon: f64 = "float64",
+        /// Speed at the checkpoint (rad/s).
+        speed: f64 = "float64",
+        /// Acceleration at the checkpoint (rad/s²).
+        acceleration: f64 = "float64",
+        /// Expected state at the end of the expected path.
+        expected_state: String = "string",
+        /// Time to a persisting whirl or whip on the expected path (s); −1 if none.
+        time_to_onset: f64 = "float64",
+        /// Time to a persisting whip on the expected path (s); −1 if none.
+        time_to_whip: f64 = "float64",
+        /// Largest orbit amplitude on the expected path (m).
+        amplitude: f64 = "float64",
+        /// Speeds of the constant-speed runs (rad/s).
+        speeds: Vec<f64> = "float64[]",
+        /// State at the end of each run.
+        states: Vec<String> = "string[]",
+        /// Time to onset per run (s); −1 if none.
+        onset_times: Vec<f64> = "float64[]",
+        /// Time to whip per run (s); −1 if none.
+        whip_times: Vec<f64> = "float64[]",
+        /// Largest amplitude per run (m).
+        amplitudes: Vec<f64> = "float64[]",
+        /// A constant-speed run went into whip.
+        nonlinear_threshold_found: bool = "bool",
+        /// Lowest speed going into whip within the horizon (rad/s).
+        nonlinear_threshold_speed: f64 = "float64",
+        /// Width of its bracket (rad/s).
+        nonlinear_threshold_resolution: f64 = "float64",
+        /// Nonlinear threshold − speed (rad/s).
+        nonlinear_margin: f64 = "float64",
+        /// The linear threshold is known.
+        linear_threshold_found: bool = "bool",
+        /// Linear threshold (rad/s).
+        linear_threshold_speed: f64 = "float64",
+        /// Linear threshold − speed (rad/s).
+        linear_margin: f64 = "float64",
+        /// Wall time of the computation (s).
+        compute_duration: f64 = "float64",
+    }
+);
+// --- end forecast ---
+
 /// CDR (XCDR1, little endian) payload with its 4-byte encapsulation header `00 01 00 00`: what
 /// DDS puts on the wire and rosbag2 stores.
 pub fn to_cdr<T: Serialize>(message: &T) -> Result<Vec<u8>, String> {

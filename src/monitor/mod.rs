@@ -158,6 +158,7 @@ fn growth_words(b: &BearingRevolution) -> String {
 }
 
 /// Ring buffers of the recent samples of one bearing.
+#[derive(Clone)]
 struct BearingHistory {
     clearance_m: f64,
     /// sub-synchronous semi-major axes (m) of the last GROWTH_REVOLUTIONS full windows,
@@ -174,7 +175,8 @@ struct BearingHistory {
     pressure: Vec<f64>,
 }
 
-/// The per-revolution monitor.
+/// The per-revolution monitor (Clone: the forecast continues a copy of the live one).
+#[derive(Clone)]
 pub struct Monitor {
     settings: ClassifierSettings,
     capacity: usize,

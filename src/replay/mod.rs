@@ -7,7 +7,10 @@
 
 pub mod calibration;
 pub mod compare;
+mod forecast;
 mod report;
+
+pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
 
 pub use report::{OnsetReport, ReplayReport, StateChange, StationReport};
 
@@ -57,6 +60,8 @@ pub struct ReplayOptions {
     /// A gap between messages longer than this (s) stops the twin; it restarts at the next
     /// speed message (a bag spanning a pause is not modelled through the pause).
     pub max_gap_s: f64,
+    /// Forecasts at bag time, scored in the report (`--forecast`; None: none).
+    pub forecast: Option<ReplayForecast>,
 }
 
 impl Default for ReplayOptions {
@@ -75,6 +80,7 @@ impl Default for ReplayOptions {
             duration_s: None,
             out_bag: None,
             max_gap_s: 5.0,
+            forecast: None,
         }
     }
 }
@@ -129,6 +135,9 @@ pub enum ReplayError {
     /// An option names a probe station the machine does not have.
     #[error("probe station '{0}' is not in the machine description (its stations: {1})")]
     UnknownStation(String, String),
+    /// The forecast's settings are refused.
+    #[error("{0}")]
+    Forecast(String),
     /// The output bag could not be written.
     #[error("output bag: {0}")]
     Record(#[from] crate::record::RecordError),
@@ -204,6 +213,7 @@ pub fn replay(
         comparisons,
         emitted: Vec::new(),
         t0_ns: t0 as i64,
+        forecasting: forecast::Forecasting::for_options(rotor, options, t0 as i64)?,
     };
     let mut last_progress = std::time::Instant::now();
     for m in &bag.messages {
@@ -211,6 +221,7 @@ pub fn replay(
             break;
         }
         run.message(bag, m, roles[m.topic], options.speed_unit);
+        run.forecast();
         // the report and the output bag
         for o in run.emitted.drain(..) {
             run.report.note_output(&o, t0, run.driver.session_slot());
@@ -237,9 +248,11 @@ pub fn replay(
     let Replaying {
         mut report,
         comparisons,
+        forecasting,
         ..
     } = run;
     report.finish(&comparisons, wall.elapsed().as_secs_f64());
+    report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
     if let Some(out) = out {
         report.messages_out = out.finish()?;
     }
@@ -266,9 +279,18 @@ struct Replaying {
     comparisons: Vec<StationComparison>,
     emitted: Vec<Outgoing>,
     t0_ns: i64,
+    /// `--forecast` (issue 14)
+    forecasting: Option<forecast::Forecasting>,
 }
 
 impl Replaying {
+    /// A forecast from the twin's present state, when one is due (`--forecast`).
+    fn forecast(&mut self) {
+        if let Some(f) = self.forecasting.as_mut() {
+            f.after_message(&self.driver, &mut |o| self.emitted.push(o));
+        }
+    }
+
     /// One bag message of role `role` through the driver, at its receive time.
     fn message(&mut self, bag: &Bag, m: &BagMessage, role: Role, unit: SpeedUnit) {
         let t_ns = m.log_time_ns.min(i64::MAX as u64) as i64;
@@ -502,6 +524,8 @@ struct OutputBag {
     warning: usize,
     residual: usize,
     margin: usize,
+    /// the forecast topic, when forecasting
+    forecast: Option<usize>,
 }
 
 impl OutputBag {
@@ -541,6 +565,12 @@ impl OutputBag {
             residual: rec.add_topic::<messages::OrbitResidual>(topics::RESIDUAL, topics::STATE)?,
             margin: rec
                 .add_topic::<messages::StabilityMargin>(topics::MARGIN, topics::MARGIN_QOS)?,
+            forecast: match options.forecast {
+                Some(_) => Some(
+                    rec.add_topic::<messages::Forecast>(topics::FORECAST, topics::FORECAST_QOS)?,
+                ),
+                None => None,
+            },
             rec,
             inputs,
         })
@@ -563,6 +593,10 @@ impl OutputBag {
             Outgoing::Warning(m) => self.rec.write(self.warning, m, t(&m.header), t(&m.header)),
             Outgoing::Residual(m) => self.rec.write(self.residual, m, t(&m.header), t(&m.header)),
             Outgoing::Margin(m) => self.rec.write(self.margin, m, t(&m.header), t(&m.header)),
+            Outgoing::Forecast(m) => match self.forecast {
+                Some(h) => self.rec.write(h, &**m, t(&m.header), t(&m.header)),
+                None => Ok(()),
+            },
             // the replay has no diagnostics of its own
             Outgoing::Diagnostics(_) => Ok(()),
         }?;

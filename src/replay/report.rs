@@ -138,6 +138,9 @@ pub struct ReplayReport {
     pub onset: OnsetReport,
     /// The twin's classification over time (its changes).
     pub states: Vec<StateChange>,
+    /// The forecast's score (`--forecast`; absent without).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub forecast: Option<crate::forecast::score::ForecastScore>,
 }
 
 impl ReplayReport {
@@ -155,6 +158,7 @@ impl ReplayReport {
             stations: Vec::new(),
             onset: OnsetReport::default(),
             states: Vec::new(),
+            forecast: None,
         }
     }
 
@@ -326,6 +330,9 @@ impl ReplayReport {
             .map(|c| format!("{} at {:.2} s", c.state, c.time_s))
             .collect();
         s += &format!("states: {}\n", states.join(" → "));
+        if let Some(f) = &self.forecast {
+            s += &f.summary();
+        }
         s
     }
 }

@@ -20,6 +20,7 @@
 //! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
 //!   outputs are stamped in simulation time.
 
+mod forecast;
 pub mod model;
 mod param_client;
 mod params;
@@ -466,7 +467,31 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
     ] {
         options = options.declare_parameter(name, value);
     }
+    for (name, value) in forecast_parameters(params) {
+        options = options.declare_parameter(name, value);
+    }
     options
+}
+
+/// The forecast's parameters (issue 14) as declared.
+fn forecast_parameters(params: &NodeParams) -> [(&'static str, ParameterValue); 3] {
+    let offsets = params
+        .forecast_offsets_rpm
+        .iter()
+        .map(f64::to_string)
+        .collect::<Vec<_>>()
+        .join(",");
+    [
+        (
+            "forecast_period_s",
+            ParameterValue::Double(params.forecast_period_s),
+        ),
+        (
+            "forecast_horizon_s",
+            ParameterValue::Double(params.forecast_horizon_s),
+        ),
+        ("forecast_offsets_rpm", ParameterValue::String(offsets)),
+    ]
 }
 
 /// The node's publishers, one per output topic (QoS from [`crate::topics`]).
@@ -478,6 +503,7 @@ struct Publishers {
     diagnostics: ros2_client::Publisher<messages::DiagnosticArray>,
     residual: ros2_client::Publisher<messages::OrbitResidual>,
     margin: ros2_client::Publisher<messages::StabilityMargin>,
+    forecast: ros2_client::Publisher<messages::Forecast>,
 }
 
 fn publisher<M: RosMessage>(
@@ -504,6 +530,7 @@ impl Publishers {
             diagnostics: publisher(node, ros, DIAGNOSTICS, qos::STATE)?,
             residual: publisher(node, ros, RESIDUAL, qos::STATE)?,
             margin: publisher(node, ros, MARGIN, qos::MARGIN_QOS)?,
+            forecast: publisher(node, ros, qos::FORECAST, qos::FORECAST_QOS)?,
         })
     }
 
@@ -528,6 +555,7 @@ impl Publishers {
                         Outgoing::Diagnostics(m) => self.diagnostics.publish(m.clone()).is_ok(),
                         Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
                         Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
+                        Outgoing::Forecast(m) => self.forecast.publish((**m).clone()).is_ok(),
                     };
                     if !sent {
                         counters.publish_failed.fetch_add(1, Ordering::Relaxed);

@@ -168,6 +168,8 @@ pub struct ModelLoop {
     counters: Arc<NodeCounters>,
     /// counts at the last diagnostics, to tell what happened in the interval
     counts_before: crate::driver::DriverCounts,
+    /// the forecast thread's link, when `forecast_period_s` > 0 (issue 14)
+    forecast: Option<super::forecast::ForecastLink>,
 }
 
 impl ModelLoop {
@@ -203,12 +205,14 @@ impl ModelLoop {
             node_name: "rotor_twin".into(),
             counters: Arc::default(),
             counts_before: Default::default(),
+            forecast: None,
         }
     }
 
     /// Runs until `stop` is set. Messages go to `out`; when `out` is full a message is dropped
     /// and counted (the model never waits for the bus).
     pub fn run(mut self, out: SyncSender<Outgoing>, stop: Arc<AtomicBool>) {
+        self.start_forecast(&out);
         let mut dropped = 0u64;
         while !stop.load(Ordering::Relaxed) {
             let mut emit = |m: Outgoing| {
@@ -235,8 +239,35 @@ impl ModelLoop {
         };
         let fed = self.feed_inputs(now, emit);
         let steps = self.step_until(now, emit);
+        if let Some(f) = self.forecast.as_mut() {
+            f.after_wake(&self.driver);
+        }
         self.report(now, emit);
         fed || steps > 0
+    }
+
+    /// Starts the forecast thread when `forecast_period_s` > 0; its messages go to `out`.
+    fn start_forecast(&mut self, out: &SyncSender<Outgoing>) {
+        let p = &self.params;
+        if p.forecast_period_s <= 0.0 {
+            return;
+        }
+        let settings = crate::forecast::ForecastSettings {
+            horizon_s: p.forecast_horizon_s,
+            offsets_rpm: p.forecast_offsets_rpm.clone(),
+            ..Default::default()
+        };
+        let s = self.driver.settings();
+        match super::forecast::ForecastLink::spawn(
+            self.driver.rotor(),
+            s.twin,
+            settings,
+            p.forecast_period_s,
+            out.clone(),
+        ) {
+            Ok(link) => self.forecast = Some(link),
+            Err(e) => eprintln!("rotor_twin: ERROR: the forecast thread did not start: {e}"),
+        }
     }
 
     /// The node's name as the diagnostics show it (default `rotor_twin`).
@@ -348,10 +379,13 @@ impl ModelLoop {
     fn diagnostics(&mut self, now: i64) -> DiagnosticArray {
         let counts = self.driver.counts();
         let before = std::mem::replace(&mut self.counts_before, counts);
-        let status = vec![
+        let mut status = vec![
             self.model_status(counts.step_failures - before.step_failures),
             self.input_status(now, counts.refused - before.refused),
         ];
+        if let Some(f) = self.forecast_status() {
+            status.push(f);
+        }
         DiagnosticArray {
             header: crate::session::header(now, ""),
             status,
@@ -428,6 +462,56 @@ impl ModelLoop {
             (DiagnosticStatus::OK, "keeping up".into())
         };
         self.status("model", level, message, values)
+    }
+
+    /// `<node>: forecast`: the last and longest forecast duration, forecasts done, cycles skipped
+    /// because one was still running, the checkpoint's cost in the model thread; WARN when a
+    /// cycle was skipped in the interval (a forecast took longer than the period), ERROR when it
+    /// cannot run.
+    fn forecast_status(&self) -> Option<DiagnosticStatus> {
+        let f = self.forecast.as_ref()?;
+        let st = &f.stats;
+        let get = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        let skipped = get(&st.skipped);
+        let skipped_now = skipped - st.skipped_reported.swap(skipped, Ordering::Relaxed);
+        let values = vec![
+            kv("period_s", format!("{:.3}", self.params.forecast_period_s)),
+            kv(
+                "horizon_s",
+                format!("{:.3}", self.params.forecast_horizon_s),
+            ),
+            kv("completed", get(&st.completed).to_string()),
+            kv("skipped_cycles", skipped.to_string()),
+            kv(
+                "last_duration_s",
+                format!("{:.3}", get(&st.last_duration_us) as f64 * 1e-6),
+            ),
+            kv(
+                "worst_duration_s",
+                format!("{:.3}", get(&st.worst_duration_us) as f64 * 1e-6),
+            ),
+            kv("checkpoint_us", get(&st.checkpoint_us).to_string()),
+            kv("dropped", get(&st.dropped).to_string()),
+            kv(
+                "lower_priority",
+                st.niced.load(Ordering::Relaxed).to_string(),
+            ),
+            kv("model_lag_s", format!("{:.4}", self.timing.lag_s)),
+        ];
+        let (level, message) = if st.failed.load(Ordering::Relaxed) {
+            (
+                DiagnosticStatus::ERROR,
+                "the forecast cannot run (see the node's log)".into(),
+            )
+        } else if skipped_now > 0 {
+            (
+                DiagnosticStatus::WARN,
+                format!("{skipped_now} cycle(s) skipped: a forecast took longer than the period"),
+            )
+        } else {
+            (DiagnosticStatus::OK, "forecasting".into())
+        };
+        Some(self.status("forecast", level, message, values))
     }
 
     fn input_status(&self, now: i64, refused: u64) -> DiagnosticStatus {

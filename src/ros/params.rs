@@ -77,6 +77,14 @@ pub struct NodeParams {
     /// `--film-cache-dir`, else $ROTOR_TWIN_CACHE_DIR, $XDG_CACHE_HOME/rotor-twin,
     /// ~/.cache/rotor-twin).
     pub film_cache_dir: String,
+    /// `forecast_period_s`: model time between forecasts (s); 0 (the default): no forecast. A
+    /// forecast takes about one core for a second per run (see the README's "Forecast").
+    pub forecast_period_s: f64,
+    /// `forecast_horizon_s`: how far a forecast looks ahead (s).
+    pub forecast_horizon_s: f64,
+    /// `forecast_offsets_rpm`: constant speeds a forecast probes above the present one (rpm,
+    /// ascending, comma separated; empty: the expected path only, no margin).
+    pub forecast_offsets_rpm: Vec<f64>,
 }
 
 impl Default for NodeParams {
@@ -99,6 +107,9 @@ impl Default for NodeParams {
             probe_point_topics: Vec::new(),
             film_cache: true,
             film_cache_dir: String::new(),
+            forecast_period_s: 0.0,
+            forecast_horizon_s: crate::forecast::DEFAULT_HORIZON_S,
+            forecast_offsets_rpm: crate::forecast::DEFAULT_OFFSETS_RPM.to_vec(),
         }
     }
 }
@@ -181,6 +192,56 @@ impl NodeParams {
             "use_sim_time" => self.use_sim_time = boolean(name, value)?,
             "film_cache" => self.film_cache = boolean(name, value)?,
             "film_cache_dir" => self.film_cache_dir = value.trim().to_string(),
+            // the forecast's, or unknown
+            _ => return self.set_forecast(name, value),
+        }
+        Ok(())
+    }
+}
+
+impl NodeParams {
+    /// Sets one of the forecast's parameters (issue 14) from its text value; any other name is
+    /// unknown.
+    fn set_forecast(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let num = |v: &str| -> Result<f64, String> {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("parameter {name}: '{v}' is not a number"))
+        };
+        match name {
+            "forecast_period_s" => {
+                let p = num(value)?;
+                if !(p.is_finite() && p >= 0.0) {
+                    return Err(format!(
+                        "parameter forecast_period_s: {p} must be 0 (off) or a time above zero"
+                    ));
+                }
+                self.forecast_period_s = p;
+            }
+            "forecast_horizon_s" => {
+                let h = num(value)?;
+                if !(h.is_finite() && h > 0.0 && h <= 60.0) {
+                    return Err(format!(
+                        "parameter forecast_horizon_s: {h} must be above 0 and at most 60"
+                    ));
+                }
+                self.forecast_horizon_s = h
+            }
+            "forecast_offsets_rpm" => {
+                let offsets = value
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|v| !v.is_empty())
+                    .map(num)
+                    .collect::<Result<Vec<f64>, String>>()?;
+                crate::forecast::ForecastSettings {
+                    offsets_rpm: offsets.clone(),
+                    ..Default::default()
+                }
+                .check()
+                .map_err(|e| format!("parameter forecast_offsets_rpm: {e}"))?;
+                self.forecast_offsets_rpm = offsets;
+            }
             _ => return Err(format!("unknown parameter '{name}'")),
         }
         Ok(())
@@ -460,6 +521,42 @@ impl NodeParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The forecast's parameters: defaults (off, 3 s, +0/100/250/500 rpm), good values taken,
+    /// bad ones refused naming the parameter and the value; an unknown name stays unknown.
+    #[test]
+    fn forecast_parameters_are_checked() {
+        let mut p = NodeParams::default();
+        assert_eq!(p.forecast_period_s, 0.0);
+        assert_eq!(p.forecast_horizon_s, 3.0);
+        assert_eq!(p.forecast_offsets_rpm, vec![0.0, 100.0, 250.0, 500.0]);
+        p.set("forecast_period_s", "2.5").unwrap();
+        p.set("forecast_offsets_rpm", "0, 200").unwrap();
+        p.set("forecast_horizon_s", "1.5").unwrap();
+        assert_eq!(
+            (
+                p.forecast_period_s,
+                p.forecast_horizon_s,
+                p.forecast_offsets_rpm.clone()
+            ),
+            (2.5, 1.5, vec![0.0, 200.0])
+        );
+        let refused = |name: &str, value: &str| {
+            let e = NodeParams::default().set(name, value).unwrap_err();
+            assert!(e.contains(name) || e.contains(value), "{name}={value}: {e}");
+        };
+        refused("forecast_period_s", "-1");
+        refused("forecast_period_s", "NaN");
+        refused("forecast_horizon_s", "0");
+        refused("forecast_horizon_s", "100");
+        refused("forecast_offsets_rpm", "100,50");
+        refused("forecast_offsets_rpm", "-10");
+        refused("forecast_offsets_rpm", "x");
+        assert!(NodeParams::default()
+            .set("forecast_nonsense", "1")
+            .unwrap_err()
+            .contains("unknown parameter"));
+    }
 
     #[test]
     fn ros_args_and_parameters() {

@@ -57,6 +57,8 @@ pub(super) fn spawn(
     let h_probe = rec.add_topic::<messages::ProbeDisplacement>(PROBE, input)?;
     let h_residual = rec.add_topic::<messages::OrbitResidual>(RESIDUAL, qos::STATE)?;
     let h_margin = rec.add_topic::<messages::StabilityMargin>(MARGIN, qos::MARGIN_QOS)?;
+    let h_forecast =
+        rec.add_topic::<messages::Forecast>(crate::topics::FORECAST, qos::FORECAST_QOS)?;
     let h_oil = rec.add_topic::<messages::Temperature>(crate::topics::OIL_TEMPERATURE, input)?;
     let h_keyphasor = rec.add_topic::<messages::Keyphasor>(crate::topics::KEYPHASOR, input)?;
     let h_signal = rec.add_topic::<messages::ProbeSignal>(crate::topics::PROBE_SIGNAL, input)?;
@@ -86,6 +88,7 @@ pub(super) fn spawn(
                             Outgoing::Diagnostics(m) => rec.write(h_diag, m, t(ns), t(ns))?,
                             Outgoing::Residual(m) => rec.write(h_residual, m, t(ns), t(ns))?,
                             Outgoing::Margin(m) => rec.write(h_margin, m, t(ns), t(ns))?,
+                            Outgoing::Forecast(m) => rec.write(h_forecast, &**m, t(ns), t(ns))?,
                         },
                     }
                 }
