@@ -157,10 +157,18 @@ impl SpeedHistory {
                 return bad("speed history time (s)", t, "must be finite and at least 0");
             }
             if k > 0 && t <= points[k - 1].0 {
-                return bad("speed history time (s)", t, "must increase from point to point");
+                return bad(
+                    "speed history time (s)",
+                    t,
+                    "must increase from point to point",
+                );
             }
             if !(rpm.is_finite() && rpm > 0.0) {
-                return bad("speed history speed (rpm)", rpm, "must be finite and above zero");
+                return bad(
+                    "speed history speed (rpm)",
+                    rpm,
+                    "must be finite and above zero",
+                );
             }
         }
         Ok(Self { points })
@@ -208,7 +216,9 @@ impl SpeedHistory {
     pub fn range_rpm(&self) -> (f64, f64) {
         self.points
             .iter()
-            .fold((f64::INFINITY, 0.0), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)))
+            .fold((f64::INFINITY, 0.0), |(lo, hi), p| {
+                (lo.min(p.1), hi.max(p.1))
+            })
     }
 }
 
@@ -241,7 +251,10 @@ pub fn apply_kicks(
         let mut f = [0.0, 0.0];
         for (m, other) in kicks.iter().enumerate() {
             if other.node == kick.node && due(m) {
-                f = [f[0] + other.impulse_n_s[0] / h_s, f[1] + other.impulse_n_s[1] / h_s];
+                f = [
+                    f[0] + other.impulse_n_s[0] / h_s,
+                    f[1] + other.impulse_n_s[1] / h_s,
+                ];
             }
         }
         twin.set_external_force(kick.node, f)?;

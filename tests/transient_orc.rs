@@ -95,6 +95,20 @@ fn stable_at_8000_whip_at_9000_and_converged_in_step_and_grid() {
     assert!(rep.rev_to_rev_pressure_diff > 0.1);
     assert!(path < 0.02, "path diff {path}");
     assert!(max_pressure(&whip) >= 2.3 * max_pressure(&stable));
+    // labelled a whip, with wall contact a flag beside it (not a state "contact"); at grazing
+    // (film below the full-film limit of 1.5 µm) its pressures are flagged as no physical
+    // figure, while the 8,000 rpm ones are valid
+    let contacts: u32 = whip
+        .history
+        .iter()
+        .flat_map(|r| r.bearings.iter().map(|b| b.contact_events))
+        .sum();
+    println!("9000 rpm: {contacts} wall contacts begun in the run, pressure valid {:?}, min film {:?} µm",
+        rep.bearings.iter().map(|b| b.pressure_valid).collect::<Vec<_>>(),
+        rep.bearings.iter().map(|b| b.min_film_thickness_m * 1e6).collect::<Vec<_>>());
+    assert!(contacts > 0);
+    assert!(rep.bearings.iter().any(|b| !b.pressure_valid));
+    assert!(stable.report.bearings.iter().all(|b| b.pressure_valid));
 
     // continue the developed whip: reference, half time step, finer film grid
     let cont = |s: TransientSpec| run_transient_from(&rotor, &s, Some(&whip.final_state)).unwrap();

@@ -10,9 +10,7 @@ use common::run_cli;
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::monitor::{ClassifierSettings, Monitor};
 use rotor_twin::rotor::{static_solution, unbalance_response, MachineDescription, Rotor};
-use rotor_twin::transient::{
-    apply_kicks, run_transient, Kick, SpeedHistory, TransientSpec,
-};
+use rotor_twin::transient::{apply_kicks, run_transient, Kick, SpeedHistory, TransientSpec};
 use rotor_twin::units::rpm_to_rad_s;
 use std::f64::consts::TAU;
 
@@ -47,7 +45,10 @@ fn one_x_phase_matches_the_exact_linear_steady_state() {
     for (b, name) in run.report.bearings.iter().zip(&run.bearing_names) {
         let s = exact.stations.iter().position(|s| &s.name == name).unwrap();
         let r = exact.response[s][0];
-        let (lx, ly) = (r.x_phase_lag_deg.to_radians(), r.y_phase_lag_deg.to_radians());
+        let (lx, ly) = (
+            r.x_phase_lag_deg.to_radians(),
+            r.y_phase_lag_deg.to_radians(),
+        );
         // X + iY with X = A_x e^{−i lag_x}, Y = A_y e^{−i lag_y}
         let re = r.x_amplitude_m * lx.cos() + r.y_amplitude_m * ly.sin();
         let im = -r.x_amplitude_m * lx.sin() + r.y_amplitude_m * ly.cos();

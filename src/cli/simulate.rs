@@ -4,7 +4,9 @@ use crate::dynamics::Coupling;
 use crate::film::FilmGrid;
 use crate::monitor::RotorState;
 use crate::rotor::{MachineDescription, Rotor};
-use crate::transient::{run_driven, run_transient, Drive, Kick, SpeedHistory, TransientResult, TransientSpec};
+use crate::transient::{
+    run_driven, run_transient, Drive, Kick, SpeedHistory, TransientResult, TransientSpec,
+};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -108,6 +110,7 @@ impl RunOptions {
 /// A nonlinear transient at constant speed or along a speed history, with kicks: orbits,
 /// spectrum, classification.
 #[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct SimulateArgs {
     /// Speed (rpm); not with --ramp or --speed-history.
     #[arg(long, required_unless_present_any = ["ramp", "speed_history"],
@@ -152,7 +155,9 @@ fn numbers(option: &str, text: &str, fields: &[&str]) -> anyhow::Result<Vec<f64>
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| anyhow::anyhow!("invalid {option} '{text}': {f} = '{p}' is not a finite number"))
+                .ok_or_else(|| {
+                    anyhow::anyhow!("invalid {option} '{text}': {f} = '{p}' is not a finite number")
+                })
         })
         .collect()
 }
@@ -280,7 +285,9 @@ struct SimulateReport {
 /// beyond the contact onset of at most the film left there) in every revolution.
 fn validity(model: ModelArg, r: &TransientResult) -> (bool, String) {
     let all = || r.history.iter().flat_map(|rev| rev.bearings.iter());
-    let worst = all().map(|b| b.max_eccentricity_ratio).fold(0.0_f64, f64::max);
+    let worst = all()
+        .map(|b| b.max_eccentricity_ratio)
+        .fold(0.0_f64, f64::max);
     let mut why = Vec::new();
     if model == ModelArg::Linear && worst >= 1.0 {
         why.push(format!(
@@ -411,8 +418,7 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             .with_context(|| format!("writing plots into {}", dir.display()))?;
     }
     if let Some(path) = &args.history_csv {
-        write_history_csv(path, &result)
-            .with_context(|| format!("writing {}", path.display()))?;
+        write_history_csv(path, &result).with_context(|| format!("writing {}", path.display()))?;
     }
     let report = summarise(&desc, args, &drive, &result);
     if args.json {

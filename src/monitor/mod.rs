@@ -139,7 +139,20 @@ impl RevolutionReport {
                     .total_cmp(&b.1.max_eccentricity_ratio),
             )
         });
-        match worst {
+        // a journal beyond the clearance is named even when another bearing is worse
+        let beyond: String = self
+            .bearings
+            .iter()
+            .enumerate()
+            .filter(|(k, b)| b.beyond_clearance && Some(*k) != worst.map(|w| w.0))
+            .map(|(k, b)| {
+                format!(
+                    "; bearing {k}: JOURNAL BEYOND THE CLEARANCE at ε = {:.3} (the model knows no wall: outside its validity)",
+                    b.max_eccentricity_ratio
+                )
+            })
+            .collect();
+        let text = match worst {
             Some((i, b)) => format!(
                 "bearing {i}: sub-synchronous {:.2} µm at {:.3}X vs 1X {:.2} µm, max eccentricity {:.3}, rev-to-rev orbit diff {:.2e}, pressure diff {:.2e}{}",
                 b.subsync_amplitude_m * 1e6,
@@ -151,7 +164,8 @@ impl RevolutionReport {
                 growth_words(b),
             ),
             None => "no bearings".into(),
-        }
+        };
+        text + &beyond
     }
 }
 
@@ -427,7 +441,13 @@ impl Monitor {
             let nodes = [k - 1, k, k + 1, k + 2];
             let w = lagrange_weights(nodes.map(angle), target);
             let i = self.idx(back);
-            let at = |v: &[f64]| nodes.iter().zip(&w).map(|(&n, w)| w * v[self.idx(n)]).sum::<f64>();
+            let at = |v: &[f64]| {
+                nodes
+                    .iter()
+                    .zip(&w)
+                    .map(|(&n, w)| w * v[self.idx(n)])
+                    .sum::<f64>()
+            };
             d2 += (h.x[i] - at(&h.x)).powi(2) + (h.y[i] - at(&h.y)).powi(2);
             let a = &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS];
             for (m, u) in a.iter().enumerate() {
@@ -627,8 +647,16 @@ impl Monitor {
             pressure_valid: min_film >= self.full_film_min_thickness_m,
             orbit_path_diff: path_diff,
             // not comparable (too little stored): keep the last value
-            orbit_diff: if orbit_diff.is_finite() { orbit_diff } else { old.orbit_diff },
-            pressure_diff: if pressure_diff.is_finite() { pressure_diff } else { old.pressure_diff },
+            orbit_diff: if orbit_diff.is_finite() {
+                orbit_diff
+            } else {
+                old.orbit_diff
+            },
+            pressure_diff: if pressure_diff.is_finite() {
+                pressure_diff
+            } else {
+                old.pressure_diff
+            },
             contact: rub.contact,
             contact_events: rub.contact_events,
             max_penetration_m: rub.penetration,
