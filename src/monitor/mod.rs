@@ -580,7 +580,7 @@ impl Monitor {
     fn whirl_span(&self, peak: &OrderComponent, clearance_m: f64) -> usize {
         let present =
             peak.semi_major_m() > self.settings.subsync_floor_clearance_share * clearance_m;
-        if !present || !(peak.order > 0.0 && peak.order < 1.0) {
+        if !(present && peak.order > 0.0 && peak.order < 1.0) {
             return 1;
         }
         ((1.0 / peak.order - 1e-6).ceil() as usize).clamp(1, self.rev_lengths.len().max(1))
