@@ -586,16 +586,33 @@ impl Monitor {
         ((1.0 / peak.order - 1e-6).ceil() as usize).clamp(1, self.rev_lengths.len().max(1))
     }
 
+    /// Alert and danger amplitudes (m) at this speed, and the time to the alert level at the
+    /// growth rate (s of model time), if the component grows beyond the threshold.
+    fn alarms(
+        &self,
+        clearance_m: f64,
+        speed_rad_s: f64,
+        subsync_m: f64,
+        growth: Option<f64>,
+    ) -> (f64, f64, Option<f64>) {
+        let s = &self.settings;
+        let (alert, danger) =
+            s.alarm_amplitudes_m(clearance_m, speed_rad_s * 30.0 / std::f64::consts::PI);
+        let time_to_alert_s = growth
+            .filter(|&g| g > s.growth_threshold_per_rev && speed_rad_s > 0.0)
+            .map(|g| (alert / subsync_m).ln().max(0.0) / g * TAU / speed_rad_s);
+        (alert, danger, time_to_alert_s)
+    }
+
     /// The report of bearing `bi` for the revolution just completed, with its orbit and
     /// pressure differences (NaN when not comparable).
     fn analyse_bearing(&mut self, bi: usize, speed_rad_s: f64) -> (BearingRevolution, f64, f64) {
         let last = (*self.rev_lengths.last().unwrap_or(&0)).min(self.len);
-        let window = self.recent_samples(SPECTRUM_REVOLUTIONS);
         // a window shorter than its resolution cannot resolve orders: no verdict on
         // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
         let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
         let c = self.bearings[bi].clearance_m;
-        self.window_spectrum(bi, window);
+        self.window_spectrum(bi, self.recent_samples(SPECTRUM_REVOLUTIONS));
         let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
         let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
         let subsync_m = peak.semi_major_m();
@@ -612,11 +629,9 @@ impl Monitor {
         let beyond_clearance = r.ecc > 1.0 && !rub.contact;
         let dominant = full_window && s.subsync_counts(subsync_m, one_x.semi_major_m(), c);
         let whip_size = dominant && !beyond_clearance && r.ecc > s.whip_eccentricity_ratio;
-        let growth = if full_window {
-            self.growth(bi, subsync_m, orbit_diff, whip_size)
-        } else {
-            None
-        };
+        let growth = full_window
+            .then(|| self.growth(bi, subsync_m, orbit_diff, whip_size))
+            .flatten();
         let b_state = s.classify(&Evidence {
             clearance_m: c,
             subsync_m,
@@ -625,10 +640,7 @@ impl Monitor {
             full_window,
             growth_per_rev: growth,
         });
-        let (alert, danger) = s.alarm_amplitudes_m(c, speed_rad_s * 30.0 / std::f64::consts::PI);
-        let time_to_alert_s = growth
-            .filter(|&g| g > s.growth_threshold_per_rev && speed_rad_s > 0.0)
-            .map(|g| (alert / subsync_m).ln().max(0.0) / g * TAU / speed_rad_s);
+        let (alert, danger, time_to_alert_s) = self.alarms(c, speed_rad_s, subsync_m, growth);
         let old = self.report.bearings[bi];
         let (pp_x, pp_y) = ((r.x[1] - r.x[0]).max(0.0), (r.y[1] - r.y[0]).max(0.0));
         let min_film = (1.0 - r.ecc.min(self.contact_onset_ratio)).max(0.0) * c;
