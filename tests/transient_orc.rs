@@ -297,7 +297,7 @@ fn second_reading_d63_is_linear_stable_and_whips_at_9000() {
     assert_eq!(stable.report.state, RotorState::Stable);
     assert_eq!(rep.state, RotorState::Whip, "{}", rep.evidence());
     assert!(amplitude(&whip) > 30e-6);
-    assert!(ratio >= 2.3 && ratio < 4.0, "{ratio}");
+    assert!((2.3..4.0).contains(&ratio), "{ratio}");
     assert!(rep.bearings.iter().all(|b| b.pressure_valid));
     assert!(path < 0.02 && rep.rev_to_rev_pressure_diff > 0.1);
     assert_eq!(linear.report.state, RotorState::Stable);
