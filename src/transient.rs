@@ -122,46 +122,193 @@ pub fn run_transient_from(
     spec: &TransientSpec,
     initial: Option<&StateVectors>,
 ) -> Result<TransientResult, TwinError> {
-    if !(spec.speed_rpm.is_finite() && spec.speed_rpm > 0.0) {
-        return Err(TwinError::InvalidInput {
-            name: "speed (rpm)",
-            value: spec.speed_rpm,
-            rule: "must be finite and above zero",
-        });
+    run_driven(rotor, spec, initial, &Drive::default())
+}
+
+/// An impulse on a shaft node: the force J/h over the one time step whose end first reaches
+/// `time_s` (Newmark's trapezoidal rule integrates that force to exactly J).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Kick {
+    /// When (s of model time).
+    pub time_s: f64,
+    /// Shaft node (from 0 at z = 0).
+    pub node: usize,
+    /// Impulse `[J_x, J_y]` (N·s).
+    pub impulse_n_s: [f64; 2],
+}
+
+/// A speed history: (time (s), speed (rpm)) points, piecewise linear between them, constant
+/// before the first and after the last.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpeedHistory {
+    points: Vec<(f64, f64)>,
+}
+
+impl SpeedHistory {
+    /// From points (t (s), speed (rpm)); refused unless there is at least one, the times are
+    /// finite, from 0 and strictly increasing, and every speed finite and above zero.
+    pub fn new(points: Vec<(f64, f64)>) -> Result<Self, TwinError> {
+        let bad = |name, value, rule| Err(TwinError::InvalidInput { name, value, rule });
+        if points.is_empty() {
+            return bad("speed history points", 0.0, "must be at least one");
+        }
+        for (k, &(t, rpm)) in points.iter().enumerate() {
+            if !(t.is_finite() && t >= 0.0) {
+                return bad("speed history time (s)", t, "must be finite and at least 0");
+            }
+            if k > 0 && t <= points[k - 1].0 {
+                return bad(
+                    "speed history time (s)",
+                    t,
+                    "must increase from point to point",
+                );
+            }
+            if !(rpm.is_finite() && rpm > 0.0) {
+                return bad(
+                    "speed history speed (rpm)",
+                    rpm,
+                    "must be finite and above zero",
+                );
+            }
+        }
+        Ok(Self { points })
     }
-    if !(2..=100_000).contains(&spec.revolutions) {
-        return Err(TwinError::InvalidInput {
-            name: "revolutions",
-            value: spec.revolutions as f64,
-            rule: "must be 2 to 100,000",
-        });
+
+    /// A ramp from `from_rpm` to `to_rpm` at `rate_rpm_s` (rpm/s, above zero; the sign follows
+    /// the direction), starting at t = 0.
+    pub fn ramp(from_rpm: f64, to_rpm: f64, rate_rpm_s: f64) -> Result<Self, TwinError> {
+        if !(rate_rpm_s.is_finite() && rate_rpm_s > 0.0) {
+            return Err(TwinError::InvalidInput {
+                name: "ramp rate (rpm/s)",
+                value: rate_rpm_s,
+                rule: "must be finite and above zero",
+            });
+        }
+        let duration = (to_rpm - from_rpm).abs() / rate_rpm_s;
+        if duration > 0.0 {
+            Self::new(vec![(0.0, from_rpm), (duration, to_rpm)])
+        } else {
+            Self::new(vec![(0.0, from_rpm)])
+        }
     }
-    if !(16..=4096).contains(&spec.steps_per_rev) {
-        return Err(TwinError::InvalidInput {
-            name: "steps per revolution",
-            value: spec.steps_per_rev as f64,
-            rule: "must be 16 to 4096",
-        });
+
+    /// Speed (rpm) and its rate (rpm/s) at time `t_s`.
+    pub fn at(&self, t_s: f64) -> (f64, f64) {
+        let p = &self.points;
+        let k = p.partition_point(|&(t, _)| t <= t_s);
+        if k == 0 {
+            return (p[0].1, 0.0);
+        }
+        if k == p.len() {
+            return (p[k - 1].1, 0.0);
+        }
+        let ((t0, s0), (t1, s1)) = (p[k - 1], p[k]);
+        let rate = (s1 - s0) / (t1 - t0);
+        (s0 + rate * (t_s - t0), rate)
     }
+
+    /// Time of the last point (s).
+    pub fn duration_s(&self) -> f64 {
+        self.points.last().map_or(0.0, |p| p.0)
+    }
+
+    /// Lowest and highest speed (rpm).
+    pub fn range_rpm(&self) -> (f64, f64) {
+        self.points
+            .iter()
+            .fold((f64::INFINITY, 0.0), |(lo, hi), p| {
+                (lo.min(p.1), hi.max(p.1))
+            })
+    }
+}
+
+/// What drives a run besides its constant speed: a speed history (then `speed_rpm` of the spec
+/// is ignored and the run lasts the history and `revolutions` more at its last speed) and kicks.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Drive {
+    /// Speed against time; None: the spec's constant speed.
+    pub speed: Option<SpeedHistory>,
+    /// Impulses, applied in time order.
+    pub kicks: Vec<Kick>,
+}
+
+/// Sets the external forces of the kicks for the step from `t_s` to `t_s + h_s`: J/h on its node
+/// for each kick not yet applied whose time is at most the step's end (a kick before the start
+/// goes into the first step), zero on the nodes of the others; `applied[k]` marks kick k done.
+/// True if one is applied in this step.
+pub fn apply_kicks(
+    twin: &mut Twin,
+    kicks: &[Kick],
+    applied: &mut [bool],
+    t_s: f64,
+    h_s: f64,
+) -> Result<bool, TwinError> {
+    let end = t_s + h_s * (1.0 + 1e-9);
+    let due = |k: usize| !applied[k] && kicks[k].time_s <= end;
+    let mut any = false;
+    for (k, kick) in kicks.iter().enumerate() {
+        // the sum of the due kicks on this node (several may share one)
+        let mut f = [0.0, 0.0];
+        for (m, other) in kicks.iter().enumerate() {
+            if other.node == kick.node && due(m) {
+                f = [
+                    f[0] + other.impulse_n_s[0] / h_s,
+                    f[1] + other.impulse_n_s[1] / h_s,
+                ];
+            }
+        }
+        twin.set_external_force(kick.node, f)?;
+        any |= due(k);
+    }
+    for (done, kick) in applied.iter_mut().zip(kicks) {
+        *done |= kick.time_s <= end;
+    }
+    Ok(any)
+}
+
+/// Runs `spec` on `rotor` under `drive` (speed history, kicks), from `initial` if given.
+pub fn run_driven(
+    rotor: &Rotor,
+    spec: &TransientSpec,
+    initial: Option<&StateVectors>,
+    drive: &Drive,
+) -> Result<TransientResult, TwinError> {
+    check_spec(spec)?;
     let rotor = with_grid(rotor, spec.grid);
-    let omega = rpm_to_rad_s(spec.speed_rpm);
+    let (lo_rpm, hi_rpm) = drive
+        .speed
+        .as_ref()
+        .map_or((spec.speed_rpm, spec.speed_rpm), SpeedHistory::range_rpm);
+    let speed_at = |t: f64| match &drive.speed {
+        Some(h) => h.at(t),
+        None => (spec.speed_rpm, 0.0),
+    };
+    // the time step gives `steps_per_rev` steps a revolution at the highest speed (more below)
     let config = TwinConfig {
         film: spec.film,
-        ..TwinConfig::with_steps_per_rev(spec.coupling, omega, spec.steps_per_rev)
+        ..TwinConfig::with_steps_per_rev(spec.coupling, rpm_to_rad_s(hi_rpm), spec.steps_per_rev)
     };
-    let mut twin = Twin::new(&rotor, config, omega)?;
+    let h = config.time_step_s;
+    let mut twin = Twin::new(&rotor, config, rpm_to_rad_s(speed_at(0.0).0))?;
     if let Some((q, qd, qdd)) = initial {
         twin.set_state_vectors(q, qd, qdd)?;
     }
-    let mut monitor = Monitor::new(&twin, spec.steps_per_rev + 2, ClassifierSettings::default());
+    let per_rev = (spec.steps_per_rev as f64 * hi_rpm / lo_rpm).ceil() as usize + 2;
+    let mut monitor = Monitor::new(&twin, per_rev, ClassifierSettings::default());
     let mut history = Vec::with_capacity(spec.revolutions);
-    let input = StepInput {
-        speed_rad_s: omega,
-        accel_rad_s2: 0.0,
-    };
+    let mut applied = vec![false; drive.kicks.len()];
+    let duration = drive.speed.as_ref().map_or(0.0, SpeedHistory::duration_s);
+    let mut revs_at_end = (duration <= 0.0).then_some(0);
     let (mut steps, mut iterations, mut max_substeps, mut fallbacks) = (0, 0, 1, 0);
     let start = Instant::now();
-    while history.len() < spec.revolutions {
+    while revs_at_end.is_none_or(|r| history.len() < r + spec.revolutions) {
+        let t = twin.time_s();
+        let (rpm, rate) = speed_at(t + h);
+        let input = StepInput {
+            speed_rad_s: rpm_to_rad_s(rpm),
+            accel_rad_s2: rpm_to_rad_s(rate),
+        };
+        apply_kicks(&mut twin, &drive.kicks, &mut applied, t, h)?;
         let out = twin.step(&input)?;
         steps += 1;
         iterations += out.newton_iterations;
@@ -169,6 +316,9 @@ pub fn run_transient_from(
         fallbacks += out.prehistory_fallbacks;
         if let Some(r) = monitor.record(&twin) {
             history.push(r.clone());
+        }
+        if revs_at_end.is_none() && twin.time_s() >= duration {
+            revs_at_end = Some(history.len());
         }
     }
     let wall_time_s = start.elapsed().as_secs_f64();
@@ -191,4 +341,30 @@ pub fn run_transient_from(
         prehistory_fallbacks: fallbacks,
         final_state,
     })
+}
+
+/// The spec's own checks (speed, revolutions, steps a revolution).
+fn check_spec(spec: &TransientSpec) -> Result<(), TwinError> {
+    if !(spec.speed_rpm.is_finite() && spec.speed_rpm > 0.0) {
+        return Err(TwinError::InvalidInput {
+            name: "speed (rpm)",
+            value: spec.speed_rpm,
+            rule: "must be finite and above zero",
+        });
+    }
+    if !(2..=100_000).contains(&spec.revolutions) {
+        return Err(TwinError::InvalidInput {
+            name: "revolutions",
+            value: spec.revolutions as f64,
+            rule: "must be 2 to 100,000",
+        });
+    }
+    if !(16..=4096).contains(&spec.steps_per_rev) {
+        return Err(TwinError::InvalidInput {
+            name: "steps per revolution",
+            value: spec.steps_per_rev as f64,
+            rule: "must be 16 to 4096",
+        });
+    }
+    Ok(())
 }

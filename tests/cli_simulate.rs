@@ -157,3 +157,115 @@ fn bad_simulation_input_is_named() {
         assert!(!out.contains("NaN"));
     }
 }
+
+/// Bistability from the command line (issue 11): at 8,000 rpm, below the linear threshold
+/// (8,471 rpm), the shipped rotor started quietly stays stable, while a 2 N·s push at mid-span
+/// (node 15) starts an oil whip that persists (sub-synchronous above 30 µm at ≈ 0.48X, ε above
+/// 0.75) — the hysteresis loop of the README's "Existence range of the whip". Tabulated film at
+/// 64 steps a revolution, as the README's study.
+#[test]
+fn a_kick_below_the_threshold_starts_a_lasting_whip() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            "--speed-rpm",
+            "8000",
+            "--revs",
+            "400",
+            "--film",
+            "table",
+            "--steps-per-rev",
+            "64",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let (ok, out, err) = run_cli(&args);
+        assert!(ok, "{err}");
+        serde_json::from_str::<Value>(&out).unwrap()
+    };
+    let quiet = run(&[]);
+    let kicked = run(&["--kick", "0.05:15:2:0"]);
+    let sub = |v: &Value| {
+        v["bearings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["subsync_amplitude_m"].as_f64().unwrap())
+            .fold(0.0, f64::max)
+    };
+    println!(
+        "8000 rpm quiet: {} ({:.2} µm); kicked: {} ({:.2} µm), {}",
+        quiet["state"],
+        sub(&quiet) * 1e6,
+        kicked["state"],
+        sub(&kicked) * 1e6,
+        kicked["evidence"]
+    );
+    assert_eq!(quiet["state"], "stable");
+    assert!(sub(&quiet) < 1e-6);
+    assert_eq!(kicked["state"], "whip", "{}", kicked["evidence"]);
+    assert!(sub(&kicked) > 30e-6);
+    assert_eq!(kicked["kicks"][0][1], 15.0);
+}
+
+/// A run-up by `--ramp FROM:TO:RATE`: the speed of each revolution in `--history-csv` follows
+/// FROM + RATE·t within a revolution's change, the run ends at TO after `--revs` more
+/// revolutions; bad ramps and kicks are refused naming the field.
+#[test]
+fn ramp_follows_its_rate_and_bad_drives_are_named() {
+    let dir = scratch("ramp");
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("history.csv");
+    let (ok, out, err) = run_cli(&[
+        "simulate",
+        "--ramp",
+        "8000:8100:200",
+        "--revs",
+        "4",
+        "--steps-per-rev",
+        "32",
+        "--history-csv",
+        csv.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["speed_rpm"], 8000.0);
+    assert_eq!(v["final_speed_rpm"].as_f64().unwrap().round(), 8100.0);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .enumerate()
+                .filter(|(i, _)| *i != 3)
+                .map(|(_, x)| x.parse().unwrap())
+                .collect()
+        })
+        .collect();
+    // 0.5 s of ramp (≈ 67.5 revolutions) and 4 at the top
+    assert!((70..=73).contains(&rows.len()), "{} rows", rows.len());
+    for r in &rows {
+        let (t, rpm) = (r[1], r[2]);
+        let expected = (8000.0 + 200.0 * t).min(8100.0);
+        assert!(
+            (rpm - expected).abs() < 2.0,
+            "t {t}: {rpm} rpm vs {expected}"
+        );
+    }
+    for (args, word) in [
+        (vec!["--ramp", "8000:9000:0"], "rate"),
+        (vec!["--ramp", "8000:9000"], "FROM:TO:RATE"),
+        (vec!["--speed-history", "0:8000,0:9000"], "time"),
+        (vec!["--speed-rpm", "8000", "--kick", "0.1:15:x:0"], "JX"),
+        (vec!["--speed-rpm", "8000", "--kick", "0.1:99:1:0"], "node"),
+    ] {
+        let mut a = vec!["simulate", "--revs", "2"];
+        a.extend(args.iter());
+        let (ok, _, err) = run_cli(&a);
+        assert!(!ok, "{a:?} should fail");
+        assert!(err.contains(word), "{a:?}: '{err}' does not name {word}");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

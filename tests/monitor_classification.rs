@@ -139,7 +139,8 @@ fn a_sudden_unbalance_at_8000_rpm_decays_and_stays_stable() {
 /// The linear model at 9,000 rpm run on until its orbit passes the clearance circle (the
 /// eigenvalue's growth takes the orbit from ε ≈ 0.6 beyond 1 in some 450 revolutions): the
 /// journal is flagged beyond the clearance (the linear model knows no wall), the warning level
-/// is ERROR, and the state is a whirl or whip, not stable.
+/// is ERROR, and the state is a whirl or whip, not stable; the bearing beyond the clearance is a
+/// whirl (without a wall, no whip on that alone).
 #[test]
 fn a_linear_orbit_beyond_the_clearance_is_flagged() {
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
@@ -161,6 +162,9 @@ fn a_linear_orbit_beyond_the_clearance_is_flagged() {
         rotor_twin::messages::InstabilityWarning::ERROR
     );
     assert!(matches!(r.state, RotorState::Whirl | RotorState::Whip));
+    // the linear model has no wall: the bearing beyond the clearance is a whirl, never a whip
+    // on that eccentricity alone (it used to read "whip" at ε = 970)
+    assert_eq!(b.state, RotorState::Whirl, "{}", r.evidence());
     // before it, every revolution with a known growth rate and a sub-synchronous component
     // above the floor (10⁻³ of the clearance) was growing or worse, never stable
     let mut judged = 0;

@@ -228,6 +228,20 @@ fn unbalance_force_is_minus_m_times_the_acceleration_of_the_mass() {
             -accel[i]
         );
     }
+    // and against the analytic second derivative of r: r̈ = e [−ω² cos ψ − α sin ψ,
+    // −ω² sin ψ + α cos ψ], so −m r̈ = m e (ω² cos ψ + α sin ψ, ω² sin ψ − α cos ψ)
+    let exact = [
+        me * (w0 * w0 * psi0.cos() + alpha * psi0.sin()),
+        me * (w0 * w0 * psi0.sin() - alpha * psi0.cos()),
+    ];
+    for i in 0..2 {
+        assert!(
+            (f[i] - exact[i]).abs() < 1e-12 * scale,
+            "{i}: {} vs {}",
+            f[i],
+            exact[i]
+        );
+    }
     // the tangential part alone: m e α against the rotation (ψ̂ = (−sin ψ, cos ψ))
     let tangential = unbalance_force(me, psi0, 0.0, alpha);
     let along = -tangential[0] * psi0.sin() + tangential[1] * psi0.cos();

@@ -46,6 +46,13 @@ fn linear_orbit_beyond_the_clearance_is_flagged() {
         .unwrap()
         .contains("beyond the clearance"));
     assert_eq!(v["prehistory_fallbacks"], 0);
+    // never a whip on an eccentricity beyond a clearance that has no wall
+    assert_ne!(v["state"], "whip", "{}", v["evidence"]);
+    assert!(v["bearings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|b| b["state"] != "whip"));
 
     let (ok, out, err) = run_cli(&[
         "simulate",

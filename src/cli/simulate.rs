@@ -4,7 +4,9 @@ use crate::dynamics::Coupling;
 use crate::film::FilmGrid;
 use crate::monitor::RotorState;
 use crate::rotor::{MachineDescription, Rotor};
-use crate::transient::{run_transient, TransientResult, TransientSpec};
+use crate::transient::{
+    run_driven, run_transient, Drive, Kick, SpeedHistory, TransientResult, TransientSpec,
+};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -105,12 +107,28 @@ impl RunOptions {
     }
 }
 
-/// A nonlinear transient at constant speed: orbits, spectrum, classification.
+/// A nonlinear transient at constant speed or along a speed history, with kicks: orbits,
+/// spectrum, classification.
 #[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct SimulateArgs {
-    /// Speed (rpm).
-    #[arg(long)]
-    speed_rpm: f64,
+    /// Speed (rpm); not with --ramp or --speed-history.
+    #[arg(long, required_unless_present_any = ["ramp", "speed_history"],
+          conflicts_with_all = ["ramp", "speed_history"])]
+    speed_rpm: Option<f64>,
+    /// Run-up or run-down FROM:TO:RATE (rpm, rpm, rpm/s), then --revs revolutions at TO.
+    #[arg(long, value_name = "FROM:TO:RATE", conflicts_with = "speed_history")]
+    ramp: Option<String>,
+    /// Speed history T:RPM,T:RPM,… (s from 0, increasing; rpm), linear between the points, then
+    /// --revs revolutions at the last speed.
+    #[arg(long, value_name = "T:RPM,…")]
+    speed_history: Option<String>,
+    /// An impulse T:NODE:JX:JY (s, shaft node, N·s, N·s) on the shaft; repeatable.
+    #[arg(long, value_name = "T:NODE:JX:JY")]
+    kick: Vec<String>,
+    /// Write one line a revolution (time, speed, state, amplitudes, ε) to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    history_csv: Option<PathBuf>,
     #[command(flatten)]
     options: RunOptions,
     /// Write orbit, spectrum and pressure-map SVGs of each bearing into this directory.
@@ -119,6 +137,74 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+}
+
+/// `A:B:…` into numbers, naming the option and the field that is not one.
+fn numbers(option: &str, text: &str, fields: &[&str]) -> anyhow::Result<Vec<f64>> {
+    let parts: Vec<&str> = text.split(':').collect();
+    anyhow::ensure!(
+        parts.len() == fields.len(),
+        "invalid {option} '{text}': expected {}",
+        fields.join(":")
+    );
+    parts
+        .iter()
+        .zip(fields)
+        .map(|(p, f)| {
+            p.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    anyhow::anyhow!("invalid {option} '{text}': {f} = '{p}' is not a finite number")
+                })
+        })
+        .collect()
+}
+
+impl SimulateArgs {
+    /// The speed history and kicks the options ask for, checked.
+    fn drive(&self) -> anyhow::Result<Drive> {
+        let speed = match (&self.ramp, &self.speed_history) {
+            (Some(r), _) => {
+                let v = numbers("--ramp", r, &["FROM", "TO", "RATE"])?;
+                Some(SpeedHistory::ramp(v[0], v[1], v[2]).context("--ramp")?)
+            }
+            (None, Some(h)) => {
+                let points = h
+                    .split(',')
+                    .map(|p| numbers("--speed-history", p, &["T", "RPM"]).map(|v| (v[0], v[1])))
+                    .collect::<anyhow::Result<Vec<_>>>()?;
+                Some(SpeedHistory::new(points).context("--speed-history")?)
+            }
+            (None, None) => None,
+        };
+        let kicks = self
+            .kick
+            .iter()
+            .map(|k| {
+                let v = numbers("--kick", k, &["T", "NODE", "JX", "JY"])?;
+                anyhow::ensure!(
+                    v[0] >= 0.0 && v[1] >= 0.0 && v[1].fract() == 0.0,
+                    "invalid --kick '{k}': T must be at least 0 and NODE a shaft node number"
+                );
+                Ok(Kick {
+                    time_s: v[0],
+                    node: v[1] as usize,
+                    impulse_n_s: [v[2], v[3]],
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(Drive { speed, kicks })
+    }
+
+    /// The speed the run starts at (rpm).
+    fn start_speed_rpm(&self, drive: &Drive) -> f64 {
+        match &drive.speed {
+            Some(h) => h.at(0.0).0,
+            None => self.speed_rpm.unwrap_or(f64::NAN),
+        }
+    }
 }
 
 /// One bearing in the `--json` report.
@@ -143,6 +229,12 @@ struct BearingSummary {
     danger_level_m: f64,
     contact_events: u32,
     max_penetration_m: f64,
+    wall_valid: bool,
+    max_rub_power_w: f64,
+    mean_rub_power_w: f64,
+    min_film_thickness_m: f64,
+    pressure_valid: bool,
+    span_revolutions: usize,
     beyond_clearance: bool,
     state: RotorState,
 }
@@ -173,40 +265,95 @@ struct SimulateReport {
     valid: bool,
     /// Why `valid` is false (empty when valid).
     validity: String,
+    /// False when a bearing's film was thinner than the full-film limit in the last revolution:
+    /// its `max_pressure_pa` is then no physical figure (grazing).
+    pressure_valid: bool,
+    /// Why `pressure_valid` is false (empty when valid).
+    pressure_validity: String,
+    /// Largest rubbing power of the wall contact in any revolution and bearing (W).
+    max_rub_power_w: f64,
+    /// The speed at the end of the run (rpm; `speed_rpm` is the start).
+    final_speed_rpm: f64,
+    /// The kicks applied: [t (s), node, J_x, J_y (N·s)].
+    kicks: Vec<[f64; 4]>,
     bearings: Vec<BearingSummary>,
 }
 
-/// Whether run `r` stayed inside what its model can represent: with the linear coupling (no
-/// film nonlinearity, no wall) every journal must stay inside its clearance circle.
+/// Whether run `r` stayed inside what its model can represent, and why not: with the linear
+/// coupling (no film nonlinearity, no wall) every journal must stay inside its clearance circle;
+/// with the wall, its penalty spring must hold the journal centre inside the bore (a penetration
+/// beyond the contact onset of at most the film left there) in every revolution.
 fn validity(model: ModelArg, r: &TransientResult) -> (bool, String) {
-    let worst = r
-        .history
-        .iter()
-        .flat_map(|rev| rev.bearings.iter().map(|b| b.max_eccentricity_ratio))
+    let all = || r.history.iter().flat_map(|rev| rev.bearings.iter());
+    let worst = all()
+        .map(|b| b.max_eccentricity_ratio)
         .fold(0.0_f64, f64::max);
+    let mut why = Vec::new();
     if model == ModelArg::Linear && worst >= 1.0 {
-        (
-            false,
-            format!(
-                "linear model beyond the clearance: eccentricity ratio reached {worst:.3} \
-                 (the linear coupling has no wall; use the nonlinear model)"
-            ),
-        )
-    } else {
-        (true, String::new())
+        why.push(format!(
+            "linear model beyond the clearance: eccentricity ratio reached {worst:.3} \
+             (the linear coupling has no wall; use the nonlinear model)"
+        ));
     }
+    let through = all().filter(|b| !b.wall_valid).count();
+    if through > 0 {
+        let pen = all().map(|b| b.max_penetration_m).fold(0.0_f64, f64::max);
+        why.push(format!(
+            "wall penetration up to {:.2} µm beyond the contact onset in {through} bearing-\
+             revolutions: the journal centre passed the bore (the wall spring is a penalty, too \
+             soft for the load there)",
+            pen * 1e6
+        ));
+    }
+    (why.is_empty(), why.join("; "))
+}
+
+/// Whether the last revolution's film pressures are physical figures, and why not: at grazing
+/// (film thinner than the full-film limit) the isoviscous rigid-surface pressure is not.
+fn pressure_validity(r: &TransientResult) -> (bool, String) {
+    let bad: Vec<String> = r
+        .report
+        .bearings
+        .iter()
+        .zip(&r.bearing_names)
+        .filter(|(b, _)| !b.pressure_valid)
+        .map(|(b, name)| {
+            format!(
+                "{name}: p_max {:.1} MPa at a film of {:.2} µm, below the full-film limit \
+                 (Λ = h/σ < 3): grazing, not a physical pressure",
+                b.max_pressure_pa * 1e-6,
+                b.min_film_thickness_m * 1e6
+            )
+        })
+        .collect();
+    (bad.is_empty(), bad.join("; "))
 }
 
 fn summarise(
     desc: &MachineDescription,
     args: &SimulateArgs,
+    drive: &Drive,
     r: &TransientResult,
 ) -> SimulateReport {
     let rep = &r.report;
     let (valid, why) = validity(args.options.model, r);
+    let (pressure_valid, pressure_why) = pressure_validity(r);
     SimulateReport {
         machine: desc.name.clone(),
-        speed_rpm: args.speed_rpm,
+        speed_rpm: args.start_speed_rpm(drive),
+        final_speed_rpm: crate::units::rad_s_to_rpm(rep.speed_rad_s),
+        kicks: drive
+            .kicks
+            .iter()
+            .map(|k| [k.time_s, k.node as f64, k.impulse_n_s[0], k.impulse_n_s[1]])
+            .collect(),
+        pressure_valid,
+        pressure_validity: pressure_why,
+        max_rub_power_w: r
+            .history
+            .iter()
+            .flat_map(|rev| rev.bearings.iter().map(|b| b.max_rub_power_w))
+            .fold(0.0, f64::max),
         model: args.options.model,
         delta: (args.options.model == ModelArg::Prehistory).then_some(args.options.delta),
         revs: args.options.revs,
@@ -248,6 +395,12 @@ fn summarise(
                 danger_level_m: b.danger_level_m,
                 contact_events: b.contact_events,
                 max_penetration_m: b.max_penetration_m,
+                wall_valid: b.wall_valid,
+                max_rub_power_w: b.max_rub_power_w,
+                mean_rub_power_w: b.mean_rub_power_w,
+                min_film_thickness_m: b.min_film_thickness_m,
+                pressure_valid: b.pressure_valid,
+                span_revolutions: b.span_revolutions,
                 beyond_clearance: b.beyond_clearance,
                 state: b.state,
             })
@@ -257,13 +410,17 @@ fn summarise(
 
 pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let (desc, rotor) = args.options.machine()?;
-    let spec = args.options.spec(args.speed_rpm)?;
-    let result = run_transient(&rotor, &spec).context("transient")?;
+    let drive = args.drive()?;
+    let spec = args.options.spec(args.start_speed_rpm(&drive))?;
+    let result = run_driven(&rotor, &spec, None, &drive).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
             .with_context(|| format!("writing plots into {}", dir.display()))?;
     }
-    let report = summarise(&desc, args, &result);
+    if let Some(path) = &args.history_csv {
+        write_history_csv(path, &result).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let report = summarise(&desc, args, &drive, &result);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -281,6 +438,9 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         println!("  state: {:?} — {}", report.state, report.evidence);
         if !report.valid {
             println!("  NOT VALID: {}", report.validity);
+        }
+        if !report.pressure_valid {
+            println!("  PRESSURES NOT VALID: {}", report.pressure_validity);
         }
         if report.prehistory_fallbacks > 0 {
             println!(
@@ -311,6 +471,37 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             report.simulated_time_s, report.wall_time_s, report.real_time_factor, report.newton_iterations_per_step
         );
     }
+    Ok(())
+}
+
+/// One line a revolution: time, speed, state, and per bearing the amplitude (half the larger
+/// peak-to-peak over the whirl span), the sub-synchronous semi-major axis, the largest ε and
+/// the contacts begun.
+fn write_history_csv(path: &Path, r: &TransientResult) -> anyhow::Result<()> {
+    let mut csv = String::from("revolution,time_s,speed_rpm,state");
+    for name in &r.bearing_names {
+        csv += &format!(
+            ",{name}_amplitude_m,{name}_subsync_amplitude_m,{name}_max_eccentricity_ratio,{name}_contact_events"
+        );
+    }
+    csv.push('\n');
+    for rev in &r.history {
+        csv += &format!(
+            "{},{},{},{}",
+            rev.revolution,
+            rev.time_s,
+            crate::units::rad_s_to_rpm(rev.speed_rad_s),
+            rev.state.warning_kind().replace("none", "stable")
+        );
+        for b in &rev.bearings {
+            csv += &format!(
+                ",{},{},{},{}",
+                b.amplitude_m, b.subsync_amplitude_m, b.max_eccentricity_ratio, b.contact_events
+            );
+        }
+        csv.push('\n');
+    }
+    std::fs::write(path, csv)?;
     Ok(())
 }
 

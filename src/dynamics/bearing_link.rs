@@ -15,6 +15,13 @@ pub struct ContactModel {
     pub wall_stiffness_n_per_m: f64,
     /// Coulomb friction coefficient of the rubbing contact.
     pub friction_coefficient: f64,
+    /// Smallest film thickness (m) at which the film pressure is reported as valid: full-film
+    /// lubrication needs a film thickness ratio Λ = h_min/σ ≥ 3 (Hamrock, Schmid & Jacobson,
+    /// Fundamentals of Machine Elements, §8.8), σ the composite roughness of journal and bush;
+    /// ASSUMED σ = 0.5 µm (ground journal Ra ≈ 0.2 µm, bored bush Ra ≈ 0.4 µm, σ ≈ 1.25 √(Ra₁² +
+    /// Ra₂²)), so 1.5 µm. Thinner, the mixed-lubrication regime begins and the isoviscous
+    /// rigid-surface pressure, rising as h⁻³ towards the wall, is no physical figure.
+    pub full_film_min_thickness_m: f64,
 }
 
 impl Default for ContactModel {
@@ -23,6 +30,7 @@ impl Default for ContactModel {
             onset_eccentricity_ratio: 0.99,
             wall_stiffness_n_per_m: 2e9,
             friction_coefficient: 0.15,
+            full_film_min_thickness_m: 1.5e-6,
         }
     }
 }
@@ -42,6 +50,8 @@ pub struct LinkEvaluation {
     pub film: FilmResult,
     /// True if the journal was in contact with the wall.
     pub contact: bool,
+    /// Power dissipated by the wall's Coulomb friction (W): μ N |ωR + v_t|, zero without contact.
+    pub rub_power_w: f64,
 }
 
 /// The static equilibrium a linear coupling linearises about.
@@ -131,6 +141,7 @@ impl BearingLink {
             film_stiffness: coef.stiffness_n_per_m,
             film,
             contact: in_contact,
+            rub_power_w: 0.0,
         };
         if in_contact {
             let n = [d[0] / e, d[1] / e];
@@ -153,6 +164,7 @@ impl BearingLink {
             let normal = contact.wall_stiffness_n_per_m * penetration;
             let slide = speed * self.radius_m + (v[0] * t[0] + v[1] * t[1]);
             let friction = -contact.friction_coefficient * normal * slide.signum();
+            out.rub_power_w = (friction * slide).abs();
             for i in 0..2 {
                 out.force_n[i] += -normal * n[i] + friction * t[i];
                 for j in 0..2 {
@@ -188,6 +200,7 @@ impl BearingLink {
             film_stiffness: k,
             film: self.last.film,
             contact: false,
+            rub_power_w: 0.0,
         };
         self.last = out;
         out

@@ -144,6 +144,8 @@ pub struct BearingState {
     pub power_loss_w: f64,
     /// True if the journal touched the wall in this step.
     pub contact: bool,
+    /// Power dissipated by rubbing on the wall in this step (W; zero without contact).
+    pub rub_power_w: f64,
 }
 
 /// A probe station after a step.

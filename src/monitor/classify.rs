@@ -136,7 +136,16 @@ impl ClassifierSettings {
             };
         };
         let present = e.subsync_m > self.subsync_floor_clearance_share * e.clearance_m;
-        if !present || g < -self.growth_threshold_per_rev {
+        // a whip's amplitude is modulated (±3 % over ~30 revolutions at 7,500 rpm on the shipped
+        // rotor) and its median increment over 16 revolutions swings by ±0.004/rev: at whip size
+        // it is called stable only when it collapses, decaying faster than
+        // WHIP_COLLAPSE_FACTOR × the threshold (0.02/rev, an e-fold in 50 revolutions)
+        let decay = if dominant && size_state == RotorState::Whip {
+            WHIP_COLLAPSE_FACTOR * self.growth_threshold_per_rev
+        } else {
+            self.growth_threshold_per_rev
+        };
+        if !present || g < -decay {
             RotorState::Stable
         } else if dominant {
             size_state
@@ -149,6 +158,10 @@ impl ClassifierSettings {
         }
     }
 }
+
+/// A dominant component at whip size counts as decaying (stable) only beyond this multiple of
+/// [`ClassifierSettings::growth_threshold_per_rev`] (see [`ClassifierSettings::classify`]).
+pub const WHIP_COLLAPSE_FACTOR: f64 = 10.0;
 
 /// Most values [`log_growth_per_rev`] takes.
 pub const MAX_GROWTH_VALUES: usize = 32;
@@ -333,6 +346,12 @@ mod tests {
         assert_eq!(s.classify(&ev(5e-6, Some(-0.01), 0.6)), RotorState::Stable);
         assert_eq!(s.classify(&ev(5e-6, Some(0.02), 0.6)), RotorState::Whirl);
         assert_eq!(s.classify(&ev(30e-6, Some(0.0), 0.95)), RotorState::Whip);
+        // a modulated whip on its way down is still a whip; a collapsing one is not
+        assert_eq!(s.classify(&ev(30e-6, Some(-0.004), 0.86)), RotorState::Whip);
+        assert_eq!(
+            s.classify(&ev(30e-6, Some(-0.03), 0.86)),
+            RotorState::Stable
+        );
         assert_eq!(s.classify(&ev(0.3e-6, Some(0.0), 0.6)), RotorState::Stable);
         assert_eq!(s.classify(&ev(5e-6, Some(0.0), 0.6)), RotorState::Whirl);
         assert_eq!(s.classify(&ev(5e-6, None, 0.6)), RotorState::Stable);

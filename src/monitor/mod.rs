@@ -28,11 +28,19 @@ pub const PRESSURE_POINTS: usize = 60;
 /// One bearing over the last revolution (and the spectrum window).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct BearingRevolution {
-    /// Peak-to-peak orbit in x (m) over the last revolution.
+    /// Peak-to-peak orbit in x (m) over the last whole whirl period ([`span_revolutions`]
+    /// revolutions).
+    ///
+    /// [`span_revolutions`]: Self::span_revolutions
     pub orbit_pp_x_m: f64,
-    /// Peak-to-peak orbit in y (m).
+    /// Peak-to-peak orbit in y (m), over the same span.
     pub orbit_pp_y_m: f64,
-    /// Largest eccentricity ratio in the last revolution.
+    /// Revolutions the peak-to-peak values, the largest eccentricity ratio and pressure span:
+    /// 1, or ⌈1/r⌉ when a sub-synchronous component of order r is present (above the floor of
+    /// [`ClassifierSettings::subsync_floor_clearance_share`]), so that a whole whirl period is
+    /// covered (2 for a half-speed whirl).
+    pub span_revolutions: usize,
+    /// Largest eccentricity ratio over the span.
     pub max_eccentricity_ratio: f64,
     /// 1X semi-major axis (m) over the spectrum window.
     pub one_x_amplitude_m: f64,
@@ -44,8 +52,16 @@ pub struct BearingRevolution {
     pub subsync_amplitude_m: f64,
     /// True if the dominant sub-synchronous component whirls forward.
     pub subsync_forward: bool,
-    /// Largest film pressure in the last revolution (Pa).
+    /// Largest film pressure over the span (Pa).
     pub max_pressure_pa: f64,
+    /// Smallest film thickness over the span, c (1 − ε_max) (m; at the contact onset in contact,
+    /// where the film is evaluated).
+    pub min_film_thickness_m: f64,
+    /// The film pressures are within the model's validity: the smallest film thickness is at
+    /// least [`crate::dynamics::ContactModel::full_film_min_thickness_m`] (full-film lubrication,
+    /// Λ = h_min/σ ≥ 3). False at grazing, where the isoviscous rigid-surface Reynolds pressure
+    /// (p ∝ h⁻³ towards the wall) is not a physical figure.
+    pub pressure_valid: bool,
     /// RMS distance between the last two revolutions' orbits, sample by sample, over the
     /// clearance.
     pub orbit_diff: f64,
@@ -63,6 +79,16 @@ pub struct BearingRevolution {
     pub contact_events: u32,
     /// Largest penetration beyond the contact onset in the last revolution (m).
     pub max_penetration_m: f64,
+    /// The wall spring held the journal inside the bore: the penetration beyond the contact
+    /// onset stayed within the film left there, (1 − onset) c, so that ε ≤ 1. False: the journal
+    /// centre passed the real wall (the penalty spring is too soft for the load), outside the
+    /// wall model's validity.
+    pub wall_valid: bool,
+    /// Largest rubbing power of the wall contact in the last revolution (W): the Coulomb
+    /// friction force times the sliding speed of the surfaces, μ N |ωR + v_t|.
+    pub max_rub_power_w: f64,
+    /// Rubbing power averaged over the last revolution's steps (W).
+    pub mean_rub_power_w: f64,
     /// The journal centre went beyond the clearance circle (ε > 1) without wall contact: a
     /// model without a wall (the linear one) outside its validity.
     pub beyond_clearance: bool,
@@ -113,7 +139,20 @@ impl RevolutionReport {
                     .total_cmp(&b.1.max_eccentricity_ratio),
             )
         });
-        match worst {
+        // a journal beyond the clearance is named even when another bearing is worse
+        let beyond: String = self
+            .bearings
+            .iter()
+            .enumerate()
+            .filter(|(k, b)| b.beyond_clearance && Some(*k) != worst.map(|w| w.0))
+            .map(|(k, b)| {
+                format!(
+                    "; bearing {k}: JOURNAL BEYOND THE CLEARANCE at ε = {:.3} (the model knows no wall: outside its validity)",
+                    b.max_eccentricity_ratio
+                )
+            })
+            .collect();
+        let text = match worst {
             Some((i, b)) => format!(
                 "bearing {i}: sub-synchronous {:.2} µm at {:.3}X vs 1X {:.2} µm, max eccentricity {:.3}, rev-to-rev orbit diff {:.2e}, pressure diff {:.2e}{}",
                 b.subsync_amplitude_m * 1e6,
@@ -125,7 +164,8 @@ impl RevolutionReport {
                 growth_words(b),
             ),
             None => "no bearings".into(),
-        }
+        };
+        text + &beyond
     }
 }
 
@@ -171,6 +211,7 @@ struct BearingHistory {
     ecc: Vec<f64>,
     p_max: Vec<f64>,
     contact: Vec<bool>,
+    rub_power: Vec<f64>,
     /// mid-plane pressure profile per sample (PRESSURE_POINTS each)
     pressure: Vec<f64>,
 }
@@ -191,6 +232,8 @@ pub struct Monitor {
     revolutions: u64,
     /// eccentricity ratio at which the wall takes over
     contact_onset_ratio: f64,
+    /// smallest film thickness of full-film lubrication (m), for `pressure_valid`
+    full_film_min_thickness_m: f64,
     spectrum: Vec<OrderComponent>,
     profile: Vec<f64>,
     report: RevolutionReport,
@@ -212,6 +255,7 @@ impl Monitor {
                 ecc: vec![0.0; capacity],
                 p_max: vec![0.0; capacity],
                 contact: vec![false; capacity],
+                rub_power: vec![0.0; capacity],
                 pressure: vec![0.0; capacity * PRESSURE_POINTS],
             })
             .collect::<Vec<_>>();
@@ -227,6 +271,7 @@ impl Monitor {
             current_rev_len: 0,
             revolutions: 0,
             contact_onset_ratio: twin.config().contact.onset_eccentricity_ratio,
+            full_film_min_thickness_m: twin.config().contact.full_film_min_thickness_m,
             spectrum: vec![OrderComponent::default(); SPECTRUM_REVOLUTIONS],
             profile: vec![0.0; PRESSURE_POINTS],
             report: RevolutionReport {
@@ -314,6 +359,7 @@ impl Monitor {
             h.ecc[slot] = b.eccentricity_ratio;
             h.p_max[slot] = b.max_pressure_pa;
             h.contact[slot] = b.contact;
+            h.rub_power[slot] = b.rub_power_w;
             twin.midplane_pressure(k, &mut self.profile);
             h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS]
                 .copy_from_slice(&self.profile);
@@ -355,6 +401,8 @@ impl Monitor {
             r.y = [r.y[0].min(h.y[i]), r.y[1].max(h.y[i])];
             r.ecc = r.ecc.max(h.ecc[i]);
             r.p_max = r.p_max.max(h.p_max[i]);
+            r.rub_max_w = r.rub_max_w.max(h.rub_power[i]);
+            r.rub_sum_w += h.rub_power[i];
             if h.contact[i] {
                 r.contact = true;
                 let before = back + 1 < last && h.contact[self.idx(back + 1)];
@@ -370,30 +418,52 @@ impl Monitor {
     }
 
     /// Rev-to-rev differences of bearing `bi` (orbit over the clearance, pressure relative):
-    /// each sample of the last revolution against the sample one revolution earlier (offset =
-    /// the last revolution's length; at constant speed the lengths differ by at most one step
-    /// from rounding); NaN when not comparable.
-    fn rev_to_rev(&self, bi: usize, last: usize, prev: usize) -> (f64, f64) {
+    /// each sample of the last revolution (`last` samples) against the state at the same shaft
+    /// angle one revolution earlier, interpolated by the cubic through the four samples of that
+    /// revolution around it (Lagrange, in the angle: a time step that is not a whole fraction of
+    /// the revolution, or a speed that changes, leaves no offset, and the interpolation error is
+    /// O(Δψ⁴)); NaN when not enough is stored.
+    fn rev_to_rev(&self, bi: usize, last: usize) -> (f64, f64) {
         let h = &self.bearings[bi];
-        let count = last.min(prev);
-        if count == 0 || last.abs_diff(prev) > 1 || self.len < last + count {
+        if last == 0 || self.len < last + 4 {
             return (f64::NAN, f64::NAN);
         }
+        let angle = |back: usize| self.angle[self.idx(back)];
         let (mut d2, mut pd2, mut p2) = (0.0, 0.0, 0.0);
-        for back in 0..count {
-            let (i, j) = (self.idx(back), self.idx(back + last));
-            d2 += (h.x[i] - h.x[j]).powi(2) + (h.y[i] - h.y[j]).powi(2);
-            let (a, b) = (
-                &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS],
-                &h.pressure[j * PRESSURE_POINTS..(j + 1) * PRESSURE_POINTS],
-            );
-            for (u, v) in a.iter().zip(b) {
+        // k: the newer of the two samples of the earlier revolution that bracket the target
+        let mut k = last.saturating_sub(1).max(1);
+        for back in 0..last {
+            let target = angle(back) - TAU;
+            while k + 2 < self.len && angle(k + 1) > target {
+                k += 1;
+            }
+            if k + 2 >= self.len || angle(k) < target {
+                return (f64::NAN, f64::NAN);
+            }
+            let nodes = [k - 1, k, k + 1, k + 2];
+            let w = lagrange_weights(nodes.map(angle), target);
+            let i = self.idx(back);
+            let at = |v: &[f64]| {
+                nodes
+                    .iter()
+                    .zip(&w)
+                    .map(|(&n, w)| w * v[self.idx(n)])
+                    .sum::<f64>()
+            };
+            d2 += (h.x[i] - at(&h.x)).powi(2) + (h.y[i] - at(&h.y)).powi(2);
+            let a = &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS];
+            for (m, u) in a.iter().enumerate() {
+                let v: f64 = nodes
+                    .iter()
+                    .zip(&w)
+                    .map(|(&n, w)| w * h.pressure[self.idx(n) * PRESSURE_POINTS + m])
+                    .sum();
                 pd2 += (u - v).powi(2);
                 p2 += u * u;
             }
         }
         let pressure = if p2 > 0.0 { (pd2 / p2).sqrt() } else { 0.0 };
-        ((d2 / count as f64).sqrt() / h.clearance_m, pressure)
+        ((d2 / last as f64).sqrt() / h.clearance_m, pressure)
     }
 
     /// Path distance of bearing `bi`: each point of the last revolution to the polyline of the
@@ -448,8 +518,18 @@ impl Monitor {
     /// differences are in). Both grow at the rate of an unstable mode; the window spectrum
     /// alone also rises for one window length after a sudden change (a step of unbalance, the
     /// start) while the free vibration it excites already decays, which the orbit difference,
-    /// with two revolutions of memory, shows at once.
-    fn growth(&mut self, bi: usize, subsync_m: f64, orbit_diff: f64) -> Option<f64> {
+    /// with two revolutions of memory, shows at once. At whip size (`whip_size`: dominant, the
+    /// orbit beyond the whip eccentricity) the spectral rate alone: the rev-to-rev difference of
+    /// a half-speed whirl compares opposite sides of its orbit (≈ 2 c) and its scatter carries
+    /// no growth, while its median increment wandered about −0.002/rev and flipped a steady
+    /// 33 µm whip to "stable" and back, revolution by revolution, in a slow run-down.
+    fn growth(
+        &mut self,
+        bi: usize,
+        subsync_m: f64,
+        orbit_diff: f64,
+        whip_size: bool,
+    ) -> Option<f64> {
         let h = &mut self.bearings[bi];
         if h.subsync_history.len() == GROWTH_REVOLUTIONS {
             h.subsync_history.remove(0);
@@ -467,96 +547,26 @@ impl Monitor {
             return None;
         }
         let spectral = classify::log_growth_per_rev(h.subsync_history.iter().copied())?;
+        if whip_size {
+            return Some(spectral);
+        }
         let diff = classify::log_growth_per_rev(h.diff_history.iter().copied())?;
         Some(spectral.min(diff))
     }
 
     fn analyse(&mut self, time_s: f64, speed_rad_s: f64) {
-        let last = (*self.rev_lengths.last().unwrap_or(&0)).min(self.len);
-        let window = self.recent_samples(SPECTRUM_REVOLUTIONS);
-        let prev = if self.rev_lengths.len() >= 2 {
-            self.rev_lengths[self.rev_lengths.len() - 2]
-        } else {
-            0
-        };
-        // a window shorter than its resolution cannot resolve orders: no verdict on
-        // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
-        let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
-        let speed_rpm = speed_rad_s * 30.0 / std::f64::consts::PI;
         let mut state = RotorState::Stable;
         let (mut od, mut pd) = (0.0_f64, 0.0_f64);
         for bi in 0..self.bearings.len() {
-            let c = self.bearings[bi].clearance_m;
-            let r = self.last_revolution(bi, last);
-            let (orbit_diff, pressure_diff) = self.rev_to_rev(bi, last, prev);
-            let path_diff = self
-                .path_diff(bi, last)
-                .unwrap_or(self.report.bearings[bi].orbit_path_diff);
-            self.window_spectrum(bi, window);
-            let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
-            let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
-            let subsync_m = peak.semi_major_m();
-            let growth = if full_window {
-                self.growth(bi, subsync_m, orbit_diff)
-            } else {
-                None
-            };
-            let s = self.settings;
-            let b_state = s.classify(&Evidence {
-                clearance_m: c,
-                subsync_m,
-                one_x_m: one_x.semi_major_m(),
-                max_eccentricity_ratio: r.ecc,
-                full_window,
-                growth_per_rev: growth,
-            });
-            let dominant = full_window && s.subsync_counts(subsync_m, one_x.semi_major_m(), c);
-            let (alert, danger) = s.alarm_amplitudes_m(c, speed_rpm);
-            let time_to_alert_s = growth
-                .filter(|&g| g > s.growth_threshold_per_rev && speed_rad_s > 0.0)
-                .map(|g| (alert / subsync_m).ln().max(0.0) / g * TAU / speed_rad_s);
-            state = state.max(b_state);
+            let (b, orbit_diff, pressure_diff) = self.analyse_bearing(bi, speed_rad_s);
+            state = state.max(b.state);
             if orbit_diff.is_finite() {
                 od = od.max(orbit_diff);
             }
             if pressure_diff.is_finite() {
                 pd = pd.max(pressure_diff);
             }
-            let old = self.report.bearings[bi];
-            let (pp_x, pp_y) = ((r.x[1] - r.x[0]).max(0.0), (r.y[1] - r.y[0]).max(0.0));
-            self.report.bearings[bi] = BearingRevolution {
-                orbit_pp_x_m: pp_x,
-                orbit_pp_y_m: pp_y,
-                max_eccentricity_ratio: r.ecc,
-                one_x_amplitude_m: one_x.semi_major_m(),
-                one_x_phase_rad: one_x.forward_phase_rad,
-                subsync_ratio: if dominant { peak.order } else { 0.0 },
-                subsync_amplitude_m: subsync_m,
-                subsync_forward: peak.forward_m >= peak.backward_m,
-                max_pressure_pa: r.p_max,
-                // not comparable (speed changed within a revolution): keep the last value
-                orbit_path_diff: path_diff,
-                orbit_diff: if orbit_diff.is_finite() {
-                    orbit_diff
-                } else {
-                    old.orbit_diff
-                },
-                pressure_diff: if pressure_diff.is_finite() {
-                    pressure_diff
-                } else {
-                    old.pressure_diff
-                },
-                contact: r.contact,
-                contact_events: r.contact_events,
-                max_penetration_m: r.penetration,
-                beyond_clearance: r.ecc > 1.0 && !r.contact,
-                amplitude_m: 0.5 * pp_x.max(pp_y),
-                alert_level_m: alert,
-                danger_level_m: danger,
-                subsync_growth_per_rev: growth,
-                time_to_alert_s,
-                state: b_state,
-            };
+            self.report.bearings[bi] = b;
         }
         self.report.revolution = self.revolutions;
         self.report.time_s = time_s;
@@ -564,6 +574,119 @@ impl Monitor {
         self.report.state = state;
         self.report.rev_to_rev_orbit_diff = od;
         self.report.rev_to_rev_pressure_diff = pd;
+    }
+
+    /// Revolutions of whole whirl periods ending now: one, or for a sub-synchronous component
+    /// above the floor at order r < 1, the ⌈1/r⌉ revolutions that hold a whole whirl period
+    /// (a half-speed whirl turns once in two revolutions: one revolution sees half of it).
+    fn whirl_span(&self, peak: &OrderComponent, clearance_m: f64) -> usize {
+        let present =
+            peak.semi_major_m() > self.settings.subsync_floor_clearance_share * clearance_m;
+        if !(present && peak.order > 0.0 && peak.order < 1.0) {
+            return 1;
+        }
+        ((1.0 / peak.order - 1e-6).ceil() as usize).clamp(1, self.rev_lengths.len().max(1))
+    }
+
+    /// Alert and danger amplitudes (m) at this speed, and the time to the alert level at the
+    /// growth rate (s of model time), if the component grows beyond the threshold.
+    fn alarms(
+        &self,
+        clearance_m: f64,
+        speed_rad_s: f64,
+        subsync_m: f64,
+        growth: Option<f64>,
+    ) -> (f64, f64, Option<f64>) {
+        let s = &self.settings;
+        let (alert, danger) =
+            s.alarm_amplitudes_m(clearance_m, speed_rad_s * 30.0 / std::f64::consts::PI);
+        let time_to_alert_s = growth
+            .filter(|&g| g > s.growth_threshold_per_rev && speed_rad_s > 0.0)
+            .map(|g| (alert / subsync_m).ln().max(0.0) / g * TAU / speed_rad_s);
+        (alert, danger, time_to_alert_s)
+    }
+
+    /// The report of bearing `bi` for the revolution just completed, with its orbit and
+    /// pressure differences (NaN when not comparable).
+    fn analyse_bearing(&mut self, bi: usize, speed_rad_s: f64) -> (BearingRevolution, f64, f64) {
+        let last = (*self.rev_lengths.last().unwrap_or(&0)).min(self.len);
+        // a window shorter than its resolution cannot resolve orders: no verdict on
+        // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
+        let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
+        let c = self.bearings[bi].clearance_m;
+        self.window_spectrum(bi, self.recent_samples(SPECTRUM_REVOLUTIONS));
+        let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
+        let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
+        let subsync_m = peak.semi_major_m();
+        let span = self.whirl_span(&peak, c);
+        let r = self.last_revolution(bi, self.recent_samples(span));
+        let rub = self.last_revolution(bi, last);
+        let (orbit_diff, pressure_diff) = self.rev_to_rev(bi, last);
+        let path_diff = self
+            .path_diff(bi, last)
+            .unwrap_or(self.report.bearings[bi].orbit_path_diff);
+        let s = self.settings;
+        // a journal beyond the clearance without a wall (the linear model) is outside the
+        // model's validity: flagged, and never called a whip on its eccentricity alone
+        let beyond_clearance = r.ecc > 1.0 && !rub.contact;
+        let dominant = full_window && s.subsync_counts(subsync_m, one_x.semi_major_m(), c);
+        let whip_size = dominant && !beyond_clearance && r.ecc > s.whip_eccentricity_ratio;
+        let growth = full_window
+            .then(|| self.growth(bi, subsync_m, orbit_diff, whip_size))
+            .flatten();
+        let b_state = s.classify(&Evidence {
+            clearance_m: c,
+            subsync_m,
+            one_x_m: one_x.semi_major_m(),
+            max_eccentricity_ratio: if beyond_clearance { 0.0 } else { r.ecc },
+            full_window,
+            growth_per_rev: growth,
+        });
+        let (alert, danger, time_to_alert_s) = self.alarms(c, speed_rad_s, subsync_m, growth);
+        let old = self.report.bearings[bi];
+        let (pp_x, pp_y) = ((r.x[1] - r.x[0]).max(0.0), (r.y[1] - r.y[0]).max(0.0));
+        let min_film = (1.0 - r.ecc.min(self.contact_onset_ratio)).max(0.0) * c;
+        let b = BearingRevolution {
+            orbit_pp_x_m: pp_x,
+            orbit_pp_y_m: pp_y,
+            span_revolutions: span,
+            max_eccentricity_ratio: r.ecc,
+            one_x_amplitude_m: one_x.semi_major_m(),
+            one_x_phase_rad: one_x.forward_phase_rad,
+            subsync_ratio: if dominant { peak.order } else { 0.0 },
+            subsync_amplitude_m: subsync_m,
+            subsync_forward: peak.forward_m >= peak.backward_m,
+            max_pressure_pa: r.p_max,
+            min_film_thickness_m: min_film,
+            pressure_valid: min_film >= self.full_film_min_thickness_m,
+            orbit_path_diff: path_diff,
+            // not comparable (too little stored): keep the last value
+            orbit_diff: if orbit_diff.is_finite() {
+                orbit_diff
+            } else {
+                old.orbit_diff
+            },
+            pressure_diff: if pressure_diff.is_finite() {
+                pressure_diff
+            } else {
+                old.pressure_diff
+            },
+            contact: rub.contact,
+            contact_events: rub.contact_events,
+            max_penetration_m: rub.penetration,
+            // the film the onset leaves: deeper, the journal centre is past the real wall
+            wall_valid: rub.penetration <= (1.0 - self.contact_onset_ratio) * c,
+            max_rub_power_w: rub.rub_max_w,
+            mean_rub_power_w: rub.rub_sum_w / last.max(1) as f64,
+            beyond_clearance,
+            amplitude_m: 0.5 * pp_x.max(pp_y),
+            alert_level_m: alert,
+            danger_level_m: danger,
+            subsync_growth_per_rev: growth,
+            time_to_alert_s,
+            state: b_state,
+        };
+        (b, orbit_diff, pressure_diff)
     }
 }
 
@@ -577,6 +700,21 @@ struct LastRevolution {
     contact: bool,
     contact_events: u32,
     penetration: f64,
+    rub_max_w: f64,
+    rub_sum_w: f64,
+}
+
+/// Weights of the cubic Lagrange interpolant through nodes `x` (distinct) at `t`.
+fn lagrange_weights(x: [f64; 4], t: f64) -> [f64; 4] {
+    let mut w = [1.0; 4];
+    for (i, wi) in w.iter_mut().enumerate() {
+        for (j, xj) in x.iter().enumerate() {
+            if i != j {
+                *wi *= (t - xj) / (x[i] - xj);
+            }
+        }
+    }
+    w
 }
 
 /// Squared distance from point (px, py) to the segment (ax, ay)–(bx, by).

@@ -17,7 +17,8 @@ pub struct OrderComponent {
     pub forward_m: f64,
     /// Radius of the backward circular component (m).
     pub backward_m: f64,
-    /// Phase of the forward component at the window start (rad).
+    /// Phase of the forward component (rad) against the rotor angle, at the whole revolution
+    /// nearest the window start (for the 1X component: against the rotor's angle-0 mark).
     pub forward_phase_rad: f64,
 }
 
@@ -53,7 +54,11 @@ pub fn order_spectrum(
         x.clone().sum::<f64>() / n as f64,
         y.clone().sum::<f64>() / n as f64,
     );
-    let angle0 = angle.clone().next().unwrap_or(0.0);
+    // phase reference: the whole revolution nearest the first sample (not the first sample
+    // itself, which lies a time step or so past the revolution mark: a reference there put the
+    // 1X phase that step ahead of the rotor angle, 2.8° at 128 steps a revolution)
+    let angle0 = (angle.clone().next().unwrap_or(0.0) / std::f64::consts::TAU).round()
+        * std::f64::consts::TAU;
     // accumulators: forward Σ w z e^{−i r ψ}, backward Σ w z e^{+i r ψ}
     let mut acc = [[0.0_f64; 4]; 64];
     let max_k = max_k.min(acc.len());

@@ -311,6 +311,7 @@ impl Twin {
                 film_end_rad: e.film.film_end_rad,
                 power_loss_w: e.film.power_loss_w,
                 contact: e.contact,
+                rub_power_w: e.rub_power_w,
             };
         }
         for (p, (dofs, angles)) in out.probes.iter_mut().zip(&self.probes) {

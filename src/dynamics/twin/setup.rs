@@ -123,6 +123,7 @@ impl Twin {
                         film_stiffness: eq.coefficients.stiffness_n_per_m,
                         film: eq.film,
                         contact: false,
+                        rub_power_w: 0.0,
                     };
                     eq.position_m
                 }
