@@ -146,6 +146,47 @@ fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
     (code, err)
 }
 
+/// `sweep` refuses a speed beyond the twin's limit and an output it cannot make before computing
+/// any speed (issue 15, item 20): before, the progress bar ran through every speed first.
+#[test]
+fn sweep_checks_its_speeds_and_output_first() {
+    let dir = scratch("sweep-first");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a-file");
+    std::fs::write(&file, "").unwrap();
+    let blocked = file.join("sweep");
+    for (args, expect) in [
+        // 100,000 rpm: above 10× the built-in machine's rated 9,000 rpm
+        (
+            vec!["--to-rpm", "100000", "--out", dir.to_str().unwrap()],
+            "invalid --to-rpm 100000: above 90000 rpm",
+        ),
+        (
+            vec!["--to-rpm", "4000", "--out", blocked.to_str().unwrap()],
+            "--out: creating",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+            .args([
+                "sweep",
+                "--from-rpm",
+                "3000",
+                "--step-rpm",
+                "1000",
+                "--revs",
+                "8",
+            ])
+            .args(["--model", "linear"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(expect), "{args:?}: {err}");
+        assert!(!err.contains("sweep ["), "computed before refusing: {err}");
+    }
+}
+
 /// Every command that prints ends quietly when its reader is gone (issue 15, item 16): no panic
 /// (exit 101) and no error text; it ends as a Unix filter does, by SIGPIPE (the shell's 141), or
 /// with 0 when it had written everything before the reader left.

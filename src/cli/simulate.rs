@@ -382,6 +382,22 @@ struct SweepReport {
 
 // Long (≈170 lines): the sweep's logic still lives in the CLI; moving it into the library
 // beside `transient` (the CLI then parses and prints only) is open in issue 10.
+/// What a sweep can check before computing any speed (issue 15, item 20): every speed within
+/// the twin's limit for this machine, and an output directory that can be made.
+fn check_sweep_first(args: &SweepArgs, rotor: &Rotor) -> anyhow::Result<()> {
+    let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * 30.0
+        / std::f64::consts::PI;
+    anyhow::ensure!(
+        args.to_rpm <= max_rpm,
+        "invalid --to-rpm {}: above {max_rpm:.0} rpm, {}× the rated speed of {}",
+        args.to_rpm,
+        crate::dynamics::MAX_SPEED_OVER_RATED,
+        rotor.name
+    );
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("--out: creating {}", args.out.display()))
+}
+
 pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     for (name, v) in [
         ("--from-rpm", args.from_rpm),
@@ -409,6 +425,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let speeds: Vec<f64> = (0..count)
         .map(|k| (args.from_rpm + k as f64 * args.step_rpm).min(args.to_rpm))
         .collect();
+    check_sweep_first(args, &rotor)?;
     let specs = speeds
         .iter()
         .map(|&s| args.options.spec(s))
@@ -488,8 +505,6 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         .iter()
         .find(|p| p.state != RotorState::Stable || p.growth_per_rev > 0.0)
         .map(|p| p.speed_rpm);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
     let csv_path = args.out.join("sweep.csv");
     let svg_path = args.out.join("sweep.svg");
     let mut csv =

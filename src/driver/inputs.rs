@@ -18,8 +18,7 @@ pub const MAX_PROBE_DISPLACEMENT_M: f64 = 0.01;
 /// 9,000 rpm in 0.1 s, far faster than any turbine is run up.
 pub const MAX_ACCEL_RAD_S2: f64 = 1.0e4;
 
-/// A speed above this multiple of the machine's rated speed is absurd.
-pub const MAX_SPEED_OVER_RATED: f64 = 10.0;
+pub use crate::dynamics::MAX_SPEED_OVER_RATED;
 
 /// Unit of a bare speed value (std_msgs/Float64 on a plant bus).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -20,6 +20,10 @@ mod twin;
 pub use bearing_link::{ContactModel, LinkEvaluation};
 pub use twin::{Checkpoint, Twin};
 
+/// A speed above this multiple of the machine's rated speed is absurd: the twin refuses to step
+/// there, the driver refuses such an input, `sweep` refuses such a speed before computing any.
+pub const MAX_SPEED_OVER_RATED: f64 = 10.0;
+
 use crate::film::FilmError;
 use serde::Serialize;
 use thiserror::Error;
