@@ -197,6 +197,7 @@ fn a_closed_stdout_ends_the_command_quietly() {
     let bag = dir.join("synth");
     std::fs::remove_dir_all(&bag).ok();
     let bag_arg = format!("--out {} --ramp 0.2 --hold-end 0.1", bag.display());
+    let sweep_out = format!("--out {}", dir.join("sweep").display());
     for args in [
         &["bearing"][..],
         &["bearing", "--json"],
@@ -224,6 +225,7 @@ fn a_closed_stdout_ends_the_command_quietly() {
             "8",
             "--model",
             "linear",
+            &sweep_out,
         ],
         &["synth-bag", &bag_arg],
     ] {

@@ -351,6 +351,14 @@ impl SpeedGate {
     ) -> Result<(f64, f64), String> {
         check_speed_value(speed, accel, self.max_speed_rad_s, self.max_accel_rad_s2)?;
         if stamp_ns != 0 {
+            // a last stamp now in the future of the clock means the clock went back (a
+            // simulator reset, a bag looped): it no longer orders anything
+            if self
+                .last_stamp_ns
+                .is_some_and(|last| last.saturating_sub(now_ns) > self.timeout_ns)
+            {
+                self.last_stamp_ns = None;
+            }
             if let Some(last) = self.last_stamp_ns {
                 if stamp_ns < last {
                     return Err(format!(
@@ -490,6 +498,14 @@ mod tests {
             let t = now + k * 10_000_000;
             assert!(g.check(942.0, 0.0, t, t).is_ok(), "sample {k}");
         }
+        // a reordered sample is still refused as going backwards
+        assert!(g
+            .check(942.0, 0.0, now, now + 100_000_000)
+            .unwrap_err()
+            .contains("backwards"));
+        // the clock itself went back 50 s (a simulator reset): speeds stamped on it are taken
+        let back = now - 50_000_000_000;
+        assert!(g.check(942.0, 0.0, back, back).is_ok());
     }
 
     #[test]
