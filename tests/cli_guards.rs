@@ -187,6 +187,40 @@ fn sweep_checks_its_speeds_and_output_first() {
     }
 }
 
+/// `simulate` refuses a speed it cannot run with the reason, before computing (issue 15, item
+/// 21: -100 said "unexpected argument", -inf was read as a flag, 1 rpm gave "invalid time step
+/// 0.46875", a 300-digit speed ran into "equilibrium not found", its text twice).
+#[test]
+fn simulate_names_why_a_speed_cannot_run() {
+    let huge = format!("1{}", "0".repeat(300));
+    for (speed, expect) in [
+        (
+            "-100",
+            "invalid speed -100 rpm: must be finite and above zero",
+        ),
+        (
+            "-inf",
+            "invalid speed -inf rpm: must be finite and above zero",
+        ),
+        // 128 steps a revolution of at most 0.1 s: 60 / 12.8 = 4.69 rpm
+        ("1", "invalid speed 1 rpm: at or below 4.69 rpm"),
+        ("4.6", "at or below 4.69 rpm"),
+        (
+            huge.as_str(),
+            "invalid speed 1.000e300 rpm: above 90000 rpm",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+            .args(["simulate", "--revs", "2", "--speed-rpm", speed])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{speed}: {err}");
+        assert!(err.contains(expect), "{speed}: {err}");
+        assert!(err.len() < 300, "{speed}: {err}");
+    }
+}
+
 /// Every command that prints ends quietly when its reader is gone (issue 15, item 16): no panic
 /// (exit 101) and no error text; it ends as a Unix filter does, by SIGPIPE (the shell's 141), or
 /// with 0 when it had written everything before the reader left.

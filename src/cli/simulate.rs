@@ -89,10 +89,34 @@ impl RunOptions {
         Ok((desc, rotor))
     }
 
-    fn spec(&self, speed_rpm: f64) -> anyhow::Result<TransientSpec> {
+    /// The transient at `speed_rpm`, refused with the reason when the twin cannot run there
+    /// (issue 15, item 21: a negative speed said "equilibrium not found", 1 rpm "invalid time
+    /// step 0.46875", a 300-digit speed was tried and echoed whole).
+    fn spec(&self, speed_rpm: f64, rotor: &Rotor) -> anyhow::Result<TransientSpec> {
+        let shown = if speed_rpm.abs() < 1e9 {
+            format!("{speed_rpm}")
+        } else {
+            format!("{speed_rpm:.3e}")
+        };
         anyhow::ensure!(
             speed_rpm.is_finite() && speed_rpm > 0.0,
-            "invalid speed {speed_rpm} rpm: must be finite and above zero"
+            "invalid speed {shown} rpm: must be finite and above zero"
+        );
+        let rpm = 30.0 / std::f64::consts::PI;
+        let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * rpm;
+        anyhow::ensure!(
+            speed_rpm <= max_rpm,
+            "invalid speed {shown} rpm: above {max_rpm:.0} rpm, {}× the rated speed of {}",
+            crate::dynamics::MAX_SPEED_OVER_RATED,
+            rotor.name
+        );
+        // one revolution in steps_per_rev steps of at most MAX_TIME_STEP_S
+        let min_rpm = 60.0 / (self.steps_per_rev as f64 * crate::dynamics::MAX_TIME_STEP_S);
+        anyhow::ensure!(
+            speed_rpm > min_rpm,
+            "invalid speed {shown} rpm: at or below {min_rpm:.2} rpm, where {} steps a revolution make the time step {} s or longer (raise --steps-per-rev)",
+            self.steps_per_rev,
+            crate::dynamics::MAX_TIME_STEP_S
         );
         Ok(TransientSpec {
             speed_rpm,
@@ -107,9 +131,10 @@ impl RunOptions {
 
 /// A nonlinear transient at constant speed: orbits, spectrum, classification.
 #[derive(Debug, Clone, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct SimulateArgs {
     /// Speed (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     speed_rpm: f64,
     #[command(flatten)]
     options: RunOptions,
@@ -257,7 +282,7 @@ fn summarise(
 
 pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let (desc, rotor) = args.options.machine()?;
-    let spec = args.options.spec(args.speed_rpm)?;
+    let spec = args.options.spec(args.speed_rpm, &rotor)?;
     let result = run_transient(&rotor, &spec).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
@@ -342,13 +367,13 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
 #[command(allow_negative_numbers = true)]
 pub struct SweepArgs {
     /// Lowest speed (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     from_rpm: f64,
     /// Highest speed (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     to_rpm: f64,
     /// Speed step (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     step_rpm: f64,
     #[command(flatten)]
     options: RunOptions,
@@ -428,7 +453,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     check_sweep_first(args, &rotor)?;
     let specs = speeds
         .iter()
-        .map(|&s| args.options.spec(s))
+        .map(|&s| args.options.spec(s, &rotor))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let workers = std::thread::available_parallelism()
         .map_or(1, |n| n.get())

@@ -24,6 +24,10 @@ pub use twin::{Checkpoint, Twin};
 /// there, the driver refuses such an input, `sweep` refuses such a speed before computing any.
 pub const MAX_SPEED_OVER_RATED: f64 = 10.0;
 
+/// Longest time step the twin takes (s): a revolution in `steps_per_rev` steps sets the slowest
+/// speed it can run.
+pub const MAX_TIME_STEP_S: f64 = 0.1;
+
 use crate::film::FilmError;
 use serde::Serialize;
 use thiserror::Error;
@@ -194,14 +198,14 @@ pub enum TwinError {
         rule: &'static str,
     },
     /// A film solve failed.
-    #[error("bearing '{bearing}' at t = {time_s:.6} s: {source}")]
+    #[error("bearing '{bearing}' at t = {time_s:.6} s: {cause}")]
     Film {
         /// Bearing name.
         bearing: String,
         /// Time (s).
         time_s: f64,
-        /// The film model's error.
-        source: FilmError,
+        /// The film model's error (in this error's text, not again as its source).
+        cause: FilmError,
     },
     /// The step did not converge even with a quarter of the time step; the state is unchanged.
     #[error(

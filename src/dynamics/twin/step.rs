@@ -188,11 +188,11 @@ impl Twin {
                     Coupling::Linear => link.evaluate_linear(d, v),
                     _ => link
                         .evaluate(d, v, speed, &self.config.contact, fresh)
-                        .map_err(|source| {
+                        .map_err(|cause| {
                             Some(TwinError::Film {
                                 bearing: link.name.clone(),
                                 time_s: time,
-                                source,
+                                cause,
                             })
                         })?,
                 };
