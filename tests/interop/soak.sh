@@ -13,7 +13,7 @@
 # the run is below 0.1 % of that RSS per minute. The warm-up is the time the node's input readers
 # take to fill their history (KeepLast 20,000 samples a topic, src/topics.rs: 200 s for the speed
 # and the point probe at 100 Hz, 5 s for the probes at 4 kHz); from then on they hold at most that
-# (measured without recording: 92.4 MB at 360 s, 92.5 MB at 600 s).
+# (measured without recording: 90.2 MiB at 360 s, 90.3 MiB at 602 s).
 # --bin PATH: the rotor-twin binary to run (default target/release/rotor-twin; a copy lets you
 # rebuild while a soak runs).
 set -euo pipefail
@@ -75,9 +75,9 @@ half = [r for r in after if r[0] >= (after[0][0] + after[-1][0]) / 2]
 n = len(half)
 mx = sum(t for t, _ in half) / n; my = sum(v for _, v in half) / n
 slope = sum((t - mx) * (v - my) for t, v in half) / sum((t - mx) ** 2 for t, _ in half) * 60
-print(f"soak {minutes:g} min: RSS {rows[0][1] / 1024:.1f} MB at {rows[0][0]} s, {base / 1024:.1f} MB after "
-      f"{warm} s warm-up, {end / 1024:.1f} MB at the end ({100 * (end - base) / base:+.2f} %), max "
-      f"{max(v for _, v in rows) / 1024:.1f} MB; slope over the second half {slope:+.1f} kB/min "
+print(f"soak {minutes:g} min: RSS {rows[0][1] / 1024:.1f} MiB at {rows[0][0]} s, {base / 1024:.1f} MiB after "
+      f"{warm} s warm-up, {end / 1024:.1f} MiB at the end ({100 * (end - base) / base:+.2f} %), max "
+      f"{max(v for _, v in rows) / 1024:.1f} MiB; slope over the second half {slope:+.1f} kB/min "
       f"({100 * slope / base:+.3f} %/min); {len(rows)} samples")
 print(f"load: {peer['sent_speeds']} speeds, {peer['sent_probes']} probes "
       f"({peer['sent_probes'] / (minutes * 60):.0f} /s), {peer['sent_points']} points, "
