@@ -221,6 +221,39 @@ fn simulate_names_why_a_speed_cannot_run() {
     }
 }
 
+/// A `--remap` or `--probe-point` naming a topic the bag does not have is an error naming it and
+/// listing the bag's topics (issue 15, item 21: both were ignored, exit 0).
+#[test]
+fn replay_names_a_remap_or_probe_topic_the_bag_lacks() {
+    let bag = Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/orc_runup_synthetic");
+    let out_dir = scratch("remap-missing");
+    for (args, expect) in [
+        (
+            ["--remap", "/nope:=/rotor_twin/speed"],
+            "the bag has no topic /nope (--remap",
+        ),
+        (
+            ["--probe-point", "probe_outboard=/nope"],
+            "the bag has no topic /nope (--probe-point",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+            .arg("replay")
+            .arg(&bag)
+            .args(["--no-bag", "--duration", "0.1", "--out"])
+            .arg(&out_dir)
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains(expect) && err.contains("/rotor_twin/speed ["),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 /// Every command that prints ends quietly when its reader is gone (issue 15, item 16): no panic
 /// (exit 101) and no error text; it ends as a Unix filter does, by SIGPIPE (the shell's 141), or
 /// with 0 when it had written everything before the reader left.
