@@ -129,7 +129,8 @@ fn node_route(inputs: &[(i64, Msg)]) -> Vec<(u8, i64, Vec<u8>)> {
     }
     for (t, m) in inputs {
         inbox.lock().unwrap().push((Some(*t), Ok(input_of(m))));
-        *clock.sim_now_ns.lock().unwrap() = Some(*t);
+        let taken = clock.sim_clock.lock().unwrap().offer(*t);
+        assert_eq!(taken, rotor_twin::driver::ClockSample::Taken);
         model.wake(&mut |o| out.push(o));
     }
     let mut keys: Vec<_> = out.iter().filter_map(key).collect();

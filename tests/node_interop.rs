@@ -158,10 +158,88 @@ fn node_talks_to_an_independent_peer_and_records() {
     std::fs::remove_dir_all(&out).ok();
 }
 
+/// Malformed samples on the bus (the right type name, a 1-byte body: the node cannot decode them)
+/// on the speed, probe and PointStamped probe topics, every 2 s among a speed ramp 400 → 900 →
+/// 400 rad/s and 4 kHz probes (tests/interop/load_peer.py --bad --no-nan, 6 s): each is counted
+/// (the diagnostics' refused_inputs), reported (a bad_input warning that names the topic), skipped, and the subscriptions live on: the twin follows the ramp after
+/// them and every valid sample is recorded (issue 15, item 1: one such sample ended the input's
+/// subscription, 4 of 524 speeds were recorded).
+#[test]
+fn malformed_samples_are_counted_and_the_inputs_live_on() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let setup = Command::new("bash")
+        .arg(root.join("tests/interop/setup-venv.sh"))
+        .output()
+        .expect("setup-venv.sh");
+    assert!(setup.status.success());
+    let py = root.join("tests/.venv/bin/python");
+    let out = std::env::temp_dir().join(format!("rotor-twin-load-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let status = Command::new("unshare")
+        .env(
+            "ROTOR_TWIN_CACHE_DIR",
+            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
+        )
+        .args(["-n", "bash"])
+        .arg(root.join("tests/interop/load_scenario.sh"))
+        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
+        .arg(&py)
+        .arg(&out)
+        .arg("6")
+        .status()
+        .expect("unshare");
+    assert!(status.success());
+    let read = |name: &str| -> Value {
+        let text = std::fs::read_to_string(out.join(name)).unwrap_or_default();
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}: '{text}'"))
+    };
+    let peer = read("peer.json");
+    let malformed = peer["malformed"].as_u64().unwrap();
+    println!("load peer: {peer}");
+    assert!(malformed >= 6, "{peer}");
+    assert_eq!(peer["nonfinite"], 0);
+    let evidence = peer["warnings"]["bad_input"].to_string();
+    assert!(evidence.contains("does not decode"), "{evidence}");
+    // the twin follows the ramp after the first malformed sample: 400 → 900 → 400 rad/s in 6 s
+    let after = peer["speed_after_malformed"].as_array().unwrap();
+    let (lo, hi) = (after[0].as_f64().unwrap(), after[1].as_f64().unwrap());
+    assert!(
+        hi - lo > 300.0,
+        "speeds after the first malformed sample: {lo}…{hi}"
+    );
+    // counted: the diagnostics' refused_inputs (1 s apart: the last may miss the last second,
+    // 3 malformed samples at most)
+    let refused = read("diagnostics.json")["refused_inputs"].as_u64().unwrap();
+    println!("refused_inputs {refused} of {malformed} malformed samples sent");
+    assert!(
+        refused <= malformed && refused + 3 >= malformed,
+        "refused {refused}, malformed {malformed}"
+    );
+    // every sample that decodes is recorded
+    let bag = Command::new(&py)
+        .arg(root.join("tests/interop/read_bag.py"))
+        .arg(out.join("bag"))
+        .output()
+        .unwrap();
+    assert!(
+        bag.status.success(),
+        "{}",
+        String::from_utf8_lossy(&bag.stderr)
+    );
+    let v: Value = serde_json::from_slice(&bag.stdout).unwrap();
+    let c = &v["rosbags"]["counts"];
+    assert_eq!(c["/rotor_twin/speed"], peer["sent_speeds"], "{c}");
+    assert_eq!(c["/plant/probe_b"], peer["sent_points"], "{c}");
+    assert_eq!(c["/rotor_twin/probe"], peer["sent_probes"], "{c}");
+    std::fs::remove_dir_all(&out).ok();
+}
+
 /// With use_sim_time the model follows `/clock` (rosgraph_msgs/Clock), not the wall clock: a peer
 /// runs the simulation clock at half real time from 1,000 s for 6 s, and the node's journal states
 /// are stamped from 1,000 s on and span half the wall time, 3 s (±20 %: start-up and the peer's
-/// 10 ms loop), where the wall clock would have given 6 s.
+/// 10 ms loop), where the wall clock would have given 6 s. One /clock sample 1 h ahead, 2 s in,
+/// is refused and said so (a bad_input warning naming /clock); before, it moved the node's clock
+/// an hour ahead for good (issue 15, item 10), and the last stamp was 3,600 s later.
 #[test]
 fn node_follows_simulation_time() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -194,6 +272,15 @@ fn node_follows_simulation_time() {
     assert!((1000.0..1001.0).contains(&first), "{first}");
     let span = last - first;
     assert!((span - 3.0).abs() < 0.6, "span {span} s");
+    assert_eq!(peer["outlier_sent"], true, "{peer}");
+    assert!(
+        peer["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w["evidence"].as_str().unwrap_or("").contains("/clock")),
+        "no warning names the refused /clock sample: {peer}"
+    );
     std::fs::remove_dir_all(&out).ok();
 }
 

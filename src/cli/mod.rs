@@ -54,6 +54,14 @@ pub struct Cli {
     no_film_cache: bool,
 }
 
+impl Cli {
+    /// A command that only computes and prints (every one but `node` and `param`, which talk to
+    /// the bus): a closed standard output may end it by SIGPIPE, as it ends a Unix filter.
+    pub fn is_filter(&self) -> bool {
+        !matches!(self.command, Some(Command::Node(_) | Command::Param(_)))
+    }
+}
+
 /// The film-table cache the command line asks for (None: off, or no directory to put it in).
 fn film_cache(cli: &Cli) -> Option<crate::film::TableCache> {
     if cli.no_film_cache {

@@ -91,10 +91,34 @@ impl RunOptions {
         Ok((desc, rotor))
     }
 
-    fn spec(&self, speed_rpm: f64) -> anyhow::Result<TransientSpec> {
+    /// The transient at `speed_rpm`, refused with the reason when the twin cannot run there
+    /// (issue 15, item 21: a negative speed said "equilibrium not found", 1 rpm "invalid time
+    /// step 0.46875", a 300-digit speed was tried and echoed whole).
+    fn spec(&self, speed_rpm: f64, rotor: &Rotor) -> anyhow::Result<TransientSpec> {
+        let shown = if speed_rpm.abs() < 1e9 {
+            format!("{speed_rpm}")
+        } else {
+            format!("{speed_rpm:.3e}")
+        };
         anyhow::ensure!(
             speed_rpm.is_finite() && speed_rpm > 0.0,
-            "invalid speed {speed_rpm} rpm: must be finite and above zero"
+            "invalid speed {shown} rpm: must be finite and above zero"
+        );
+        let rpm = 30.0 / std::f64::consts::PI;
+        let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * rpm;
+        anyhow::ensure!(
+            speed_rpm <= max_rpm,
+            "invalid speed {shown} rpm: above {max_rpm:.0} rpm, {}× the rated speed of {}",
+            crate::dynamics::MAX_SPEED_OVER_RATED,
+            rotor.name
+        );
+        // one revolution in steps_per_rev steps of at most MAX_TIME_STEP_S
+        let min_rpm = 60.0 / (self.steps_per_rev as f64 * crate::dynamics::MAX_TIME_STEP_S);
+        anyhow::ensure!(
+            speed_rpm > min_rpm,
+            "invalid speed {shown} rpm: at or below {min_rpm:.2} rpm, where {} steps a revolution make the time step {} s or longer (raise --steps-per-rev)",
+            self.steps_per_rev,
+            crate::dynamics::MAX_TIME_STEP_S
         );
         Ok(TransientSpec {
             speed_rpm,
@@ -113,7 +137,8 @@ impl RunOptions {
 #[command(allow_negative_numbers = true)]
 pub struct SimulateArgs {
     /// Speed (rpm); not with --ramp or --speed-history.
-    #[arg(long, required_unless_present_any = ["ramp", "speed_history"],
+    #[arg(long, allow_hyphen_values = true,
+          required_unless_present_any = ["ramp", "speed_history"],
           conflicts_with_all = ["ramp", "speed_history"])]
     speed_rpm: Option<f64>,
     /// Run-up or run-down FROM:TO:RATE (rpm, rpm, rpm/s), then --revs revolutions at TO.
@@ -411,7 +436,7 @@ fn summarise(
 pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let (desc, rotor) = args.options.machine()?;
     let drive = args.drive()?;
-    let spec = args.options.spec(args.start_speed_rpm(&drive))?;
+    let spec = args.options.spec(args.start_speed_rpm(&drive), &rotor)?;
     let result = run_driven(&rotor, &spec, None, &drive).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
@@ -533,13 +558,13 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
 #[command(allow_negative_numbers = true)]
 pub struct SweepArgs {
     /// Lowest speed (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     from_rpm: f64,
     /// Highest speed (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     to_rpm: f64,
     /// Speed step (rpm).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     step_rpm: f64,
     #[command(flatten)]
     options: RunOptions,
@@ -573,6 +598,22 @@ struct SweepReport {
 
 // Long (≈170 lines): the sweep's logic still lives in the CLI; moving it into the library
 // beside `transient` (the CLI then parses and prints only) is open in issue 10.
+/// What a sweep can check before computing any speed (issue 15, item 20): every speed within
+/// the twin's limit for this machine, and an output directory that can be made.
+fn check_sweep_first(args: &SweepArgs, rotor: &Rotor) -> anyhow::Result<()> {
+    let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * 30.0
+        / std::f64::consts::PI;
+    anyhow::ensure!(
+        args.to_rpm <= max_rpm,
+        "invalid --to-rpm {}: above {max_rpm:.0} rpm, {}× the rated speed of {}",
+        args.to_rpm,
+        crate::dynamics::MAX_SPEED_OVER_RATED,
+        rotor.name
+    );
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("--out: creating {}", args.out.display()))
+}
+
 pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     for (name, v) in [
         ("--from-rpm", args.from_rpm),
@@ -600,9 +641,10 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let speeds: Vec<f64> = (0..count)
         .map(|k| (args.from_rpm + k as f64 * args.step_rpm).min(args.to_rpm))
         .collect();
+    check_sweep_first(args, &rotor)?;
     let specs = speeds
         .iter()
-        .map(|&s| args.options.spec(s))
+        .map(|&s| args.options.spec(s, &rotor))
         .collect::<anyhow::Result<Vec<_>>>()?;
     let workers = std::thread::available_parallelism()
         .map_or(1, |n| n.get())
@@ -679,8 +721,6 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         .iter()
         .find(|p| p.state != RotorState::Stable || p.growth_per_rev > 0.0)
         .map(|p| p.speed_rpm);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
     let csv_path = args.out.join("sweep.csv");
     let svg_path = args.out.join("sweep.svg");
     let mut csv =

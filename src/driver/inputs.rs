@@ -18,8 +18,7 @@ pub const MAX_PROBE_DISPLACEMENT_M: f64 = 0.01;
 /// 9,000 rpm in 0.1 s, far faster than any turbine is run up.
 pub const MAX_ACCEL_RAD_S2: f64 = 1.0e4;
 
-/// A speed above this multiple of the machine's rated speed is absurd.
-pub const MAX_SPEED_OVER_RATED: f64 = 10.0;
+pub use crate::dynamics::MAX_SPEED_OVER_RATED;
 
 /// Unit of a bare speed value (std_msgs/Float64 on a plant bus).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -352,6 +351,14 @@ impl SpeedGate {
     ) -> Result<(f64, f64), String> {
         check_speed_value(speed, accel, self.max_speed_rad_s, self.max_accel_rad_s2)?;
         if stamp_ns != 0 {
+            // a last stamp now in the future of the clock means the clock went back (a
+            // simulator reset, a bag looped): it no longer orders anything
+            if self
+                .last_stamp_ns
+                .is_some_and(|last| last.saturating_sub(now_ns) > self.timeout_ns)
+            {
+                self.last_stamp_ns = None;
+            }
             if let Some(last) = self.last_stamp_ns {
                 if stamp_ns < last {
                     return Err(format!(
@@ -491,6 +498,14 @@ mod tests {
             let t = now + k * 10_000_000;
             assert!(g.check(942.0, 0.0, t, t).is_ok(), "sample {k}");
         }
+        // a reordered sample is still refused as going backwards
+        assert!(g
+            .check(942.0, 0.0, now, now + 100_000_000)
+            .unwrap_err()
+            .contains("backwards"));
+        // the clock itself went back 50 s (a simulator reset): speeds stamped on it are taken
+        let back = now - 50_000_000_000;
+        assert!(g.check(942.0, 0.0, back, back).is_ok());
     }
 
     #[test]

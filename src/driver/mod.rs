@@ -6,10 +6,12 @@
 //! (bad, stale or missing input; model failures) and the stability margin. It knows no bus, file
 //! or clock: the same inputs at the same times give the same outputs, whoever feeds them.
 
+mod clock;
 pub mod inputs;
 mod plant_signals;
 pub mod settings;
 
+pub use clock::{ClockSample, SimClock, CLOCK_CONFIRM, CLOCK_JUMP_S};
 pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,

@@ -21,6 +21,14 @@ mod twin;
 pub use bearing_link::{ContactModel, LinkEvaluation};
 pub use twin::{Checkpoint, Twin};
 
+/// A speed above this multiple of the machine's rated speed is absurd: the twin refuses to step
+/// there, the driver refuses such an input, `sweep` refuses such a speed before computing any.
+pub const MAX_SPEED_OVER_RATED: f64 = 10.0;
+
+/// Longest time step the twin takes (s): a revolution in `steps_per_rev` steps sets the slowest
+/// speed it can run.
+pub const MAX_TIME_STEP_S: f64 = 0.1;
+
 use crate::film::FilmError;
 use serde::Serialize;
 use thiserror::Error;
@@ -193,14 +201,14 @@ pub enum TwinError {
         rule: &'static str,
     },
     /// A film solve failed.
-    #[error("bearing '{bearing}' at t = {time_s:.6} s: {source}")]
+    #[error("bearing '{bearing}' at t = {time_s:.6} s: {cause}")]
     Film {
         /// Bearing name.
         bearing: String,
         /// Time (s).
         time_s: f64,
-        /// The film model's error.
-        source: FilmError,
+        /// The film model's error (in this error's text, not again as its source).
+        cause: FilmError,
     },
     /// The step did not converge even with a quarter of the time step; the state is unchanged.
     #[error(

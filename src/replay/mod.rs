@@ -433,6 +433,7 @@ fn map_topics(
         }
         roles.push(role);
     }
+    check_named_topics_exist(bag, options, &remap)?;
     // the keyphasor's intervals give the speed where no speed topic does
     let drives = |r: &Role| {
         use Role::*;
@@ -456,6 +457,38 @@ fn map_topics(
         });
     }
     Ok(roles)
+}
+
+/// Every `--remap` source and `--probe-point` topic is a topic of the bag (issue 15, item 21:
+/// they were ignored silently, the station just missing from the summary).
+fn check_named_topics_exist(
+    bag: &Bag,
+    options: &ReplayOptions,
+    remap: &impl Fn(&str) -> String,
+) -> Result<(), ReplayError> {
+    let present = || {
+        bag.topics
+            .iter()
+            .map(|t| format!("{} [{}]", t.name, t.type_name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let missing = |topic: &str, why: &str| ReplayError::MissingTopic {
+        topic: topic.into(),
+        why: why.into(),
+        present: present(),
+    };
+    for (from, _) in &options.remaps {
+        if !bag.topics.iter().any(|t| t.name == *from) {
+            return Err(missing(from, "--remap names it as the topic to map from"));
+        }
+    }
+    for (topic, _) in &options.probe_points {
+        if !bag.topics.iter().any(|t| remap(&t.name) == *topic) {
+            return Err(missing(topic, "--probe-point names it as a probe's topic"));
+        }
+    }
+    Ok(())
 }
 
 /// The raw probes `--probe-signal` names exist in the machine.

@@ -655,7 +655,7 @@ fn subscribe_inputs(
     // --- end plant signals ---
     if params.use_sim_time {
         // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
-        subscribe_clock(node, &topic_name(ros, CLOCK)?, route.clock.clone())?;
+        subscribe_clock(node, &topic_name(ros, CLOCK)?, route)?;
     }
     Ok(())
 }
@@ -694,7 +694,7 @@ impl InputRoute {
             .map_err(|e| anyhow::anyhow!("subscription {name:?}: {e:?}"))?;
         let (inbox, clock, rec) = (self.inbox.clone(), self.clock.clone(), self.rec.clone());
         let counters = self.counters.clone();
-        let label = format!("{name:?}");
+        let label = name.to_string();
         tokio::spawn(async move {
             let mut stream = Box::pin(sub.async_stream());
             while let Some(item) = stream.next().await {
@@ -719,12 +719,15 @@ impl InputRoute {
     }
 }
 
-/// The /clock subscription under use_sim_time: the node's clock follows it, never backwards.
+/// The /clock subscription under use_sim_time: the node's clock follows it as
+/// [`crate::driver::SimClock`] decides; a refused sample is queued as a refusal (counted, warned
+/// about and shown in /diagnostics by the driver), a jump is logged.
 fn subscribe_clock(
     node: &mut ros2_client::Node,
     name: &Name,
-    clock: Arc<NodeClock>,
+    route: &InputRoute,
 ) -> anyhow::Result<()> {
+    use crate::driver::ClockSample;
     let qos = crate::topics::CLOCK_READER;
     let topic = node
         .create_topic(name, type_name::<messages::Clock>(), &qos_profile(qos))
@@ -732,14 +735,37 @@ fn subscribe_clock(
     let sub = node
         .create_subscription::<messages::Clock>(&topic, Some(qos_profile(qos)))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let (clock, inbox) = (route.clock.clone(), route.inbox.clone());
     tokio::spawn(async move {
         let mut stream = Box::pin(sub.async_stream());
         while let Some(item) = stream.next().await {
             let Ok((m, _info)) = item else { continue };
             let ns = m.clock.as_nanos();
-            let mut now = clock.sim_now_ns.lock().unwrap_or_else(|e| e.into_inner());
-            if now.is_none_or(|t| ns >= t) {
-                *now = Some(ns);
+            let s = |t: i64| t as f64 * 1e-9;
+            let taken = clock
+                .sim_clock
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .offer(ns);
+            match taken {
+                ClockSample::Taken => {}
+                ClockSample::Refused { clock_ns } => {
+                    let why = format!(
+                        "/clock {:.6} s refused: {:+.3} s from the clock at {:.6} s (more than {} s ahead, or back; {} samples that agree make it jump)",
+                        s(ns),
+                        s(ns - clock_ns),
+                        s(clock_ns),
+                        crate::driver::CLOCK_JUMP_S,
+                        crate::driver::CLOCK_CONFIRM
+                    );
+                    let mut inbox = inbox.lock().unwrap_or_else(|e| e.into_inner());
+                    inbox.push((Some(clock_ns), Err(why)));
+                }
+                ClockSample::Jumped { from_ns } => eprintln!(
+                    "rotor_twin: /clock jumped from {:.6} s to {:.6} s",
+                    s(from_ns),
+                    s(ns)
+                ),
             }
         }
     });

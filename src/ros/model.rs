@@ -66,20 +66,24 @@ impl NodeCounters {
     }
 }
 
-/// The node's clock: the wall clock, or the latest `/clock` time under use_sim_time.
+/// The node's clock: the wall clock, or `/clock` under use_sim_time as
+/// [`crate::driver::SimClock`] follows it (one bad sample refused, a reset followed).
 #[derive(Debug, Default)]
 pub struct NodeClock {
     /// Follow `/clock`.
     pub sim: bool,
-    /// The latest `/clock` time (ns).
-    pub sim_now_ns: Mutex<Option<i64>>,
+    /// The simulation clock `/clock` drives.
+    pub sim_clock: Mutex<crate::driver::SimClock>,
 }
 
 impl NodeClock {
     /// Now on this clock (ns since the epoch); None before the first `/clock` in sim time.
     pub fn now_ns(&self) -> Option<i64> {
         if self.sim {
-            *self.sim_now_ns.lock().unwrap_or_else(|e| e.into_inner())
+            self.sim_clock
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .now_ns()
         } else {
             Some(now_ns())
         }

@@ -469,9 +469,23 @@ pub fn parse_ros_args(args: &[String]) -> Result<RosArgs, String> {
     Ok(out)
 }
 
+/// Largest params file accepted (bytes): a params file sets some dozens of parameters in a few
+/// kB; this bound and the nesting bounds of [`crate::bag::check_yaml_shape`] are checked before
+/// parsing (the YAML parser's time grows faster than the nesting, issue 15 item 19).
+pub const MAX_PARAMS_FILE_BYTES: usize = 1 << 20;
+
 /// Reads a ROS 2 params file: `<node or /**>: ros__parameters: {name: value}`.
 fn read_params_file(path: &Path) -> Result<Vec<(String, String)>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(MAX_PARAMS_FILE_BYTES as u64 + 1)
+                .read_to_string(&mut text)
+        })
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::bag::check_yaml_shape(&text, MAX_PARAMS_FILE_BYTES)
+        .map_err(|rule| format!("params file {}: {rule}", path.display()))?;
     let doc: serde_yaml_ng::Value =
         serde_yaml_ng::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out = Vec::new();
@@ -644,6 +658,40 @@ mod tests {
             "a namespace is absolute"
         );
         assert!(args(&["-r", "__node:=9lives"]).is_err());
+    }
+
+    /// A params file's size and nesting are bounded before it is parsed (issue 15, item 19: 200
+    /// kB of nesting took minutes); an endless file (/dev/zero) is read no further than the bound.
+    #[test]
+    fn params_files_are_bounded_before_parsing() {
+        let dir = std::env::temp_dir().join(format!("rotor-twin-params-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let refusal = |name: &str, text: &str| {
+            let f = dir.join(name);
+            std::fs::write(&f, text).unwrap();
+            args(&["--params-file", f.to_str().unwrap()]).unwrap_err()
+        };
+        let deep = format!(
+            "rotor_twin: {}{}\n",
+            "[".repeat(100_000),
+            "]".repeat(100_000)
+        );
+        let e = refusal("deep.yaml", &deep);
+        assert!(e.contains("params file") && e.contains("brackets"), "{e}");
+        let e = refusal("big.yaml", &"a: 1\n".repeat(300_000));
+        assert!(e.contains("bytes"), "{e}");
+        let e = args(&["--params-file", "/dev/zero"]).unwrap_err();
+        assert!(e.contains("bytes"), "{e}");
+        let e = refusal("shape.yaml", "rotor_twin:\n  ros__parameters: [1, 2]\n");
+        assert!(e.contains("no ros__parameters"), "{e}");
+        let ok = dir.join("ok.yaml");
+        std::fs::write(&ok, "/**:\n  ros__parameters:\n    model: linear\n").unwrap();
+        let r = args(&["--params-file", ok.to_str().unwrap()]).unwrap();
+        assert_eq!(
+            r.params.iter().find(|(k, _)| k == "model").unwrap().1,
+            "linear"
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

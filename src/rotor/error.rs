@@ -20,14 +20,15 @@ pub struct ConfigError {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum RotorError {
     /// A film computation failed at a bearing.
-    #[error("bearing '{bearing}' at {speed_rpm:.0} rpm: {source}")]
+    #[error("bearing '{bearing}' at {speed_rpm:.0} rpm: {cause}")]
     Film {
         /// Bearing name.
         bearing: String,
         /// Speed (rpm).
         speed_rpm: f64,
-        /// What the film model said.
-        source: crate::film::FilmError,
+        /// What the film model said (shown in this error's text, not again as its source:
+        /// the chain printed it twice).
+        cause: crate::film::FilmError,
     },
     /// A linear-algebra step failed (singular or indefinite matrix, eigen solver).
     #[error("{what}: {why}")]

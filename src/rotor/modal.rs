@@ -446,10 +446,10 @@ impl BearingSolvers {
         for ((b, solver), load) in rotor.bearings.iter().zip(&mut self.0).zip(loads) {
             let (coef, e) = match (&b.model, solver) {
                 (BearingModel::Film(f), Some(s)) => {
-                    let fail = |source| RotorError::Film {
+                    let fail = |cause| RotorError::Film {
                         bearing: b.name.clone(),
                         speed_rpm: rad_s_to_rpm(speed_rad_s),
-                        source,
+                        cause,
                     };
                     if load[0].hypot(load[1]) < 1e-9 {
                         // unloaded: the journal runs centred

@@ -5,6 +5,7 @@ Usage: peer.py SECONDS SPEED_RAD_S [--domain N] [--bad] [--warnings-only] [--sim
   --ns: the node's namespace (its topics are NAMESPACE/rotor_twin/...)
   --best-effort: publish the speed and probes best effort (REP 2003 SensorDataQoS), as sensor drivers do
   --sim-clock RATE: publish /clock from 1000 s at RATE × real time, stamp speeds with it
+  --clock-outlier: with --sim-clock, one /clock sample 1 h ahead after 2 s (the node must refuse it)
   --bad: first send NaN, infinite, negative and absurd speeds (the node must refuse them)
   --warnings-only: only listen for the latched warning (a late subscriber)
 Publishes rotor_twin_msgs/RotorSpeed on /rotor_twin/speed at 100 Hz and listens to the node's
@@ -189,6 +190,10 @@ def main():
         if sim_rate:
             now = 1000 * 1_000_000_000 + int(sim_rate * (time.time() - start) * 1e9)
             clock.write(Clock(Time(now // 1_000_000_000, now % 1_000_000_000)))
+            if "--clock-outlier" in sys.argv and time.time() - start > 2 and "outlier_sent" not in out:
+                ahead = now + 3600 * 1_000_000_000
+                clock.write(Clock(Time(ahead // 1_000_000_000, ahead % 1_000_000_000)))
+                out["outlier_sent"] = True
         value = bad.pop(0) if bad else speed
         if not listen_only:
             stamp = Header(Time(now // 1_000_000_000, now % 1_000_000_000), "")

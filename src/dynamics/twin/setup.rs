@@ -106,10 +106,10 @@ impl Twin {
                     link_index += 1;
                     let mu = link.viscosity();
                     let eq = equilibrium_under_load(&mut link.film, mu, *load, speed_rad_s)
-                        .map_err(|source| TwinError::Film {
+                        .map_err(|cause| TwinError::Film {
                             bearing: link.name.clone(),
                             time_s: 0.0,
-                            source,
+                            cause,
                         })?;
                     link.linear_reference = Some(LinearReference {
                         position_m: eq.position_m,
@@ -312,7 +312,10 @@ fn synchronous_response(
 
 fn validate_config(c: &TwinConfig) -> Result<(), TwinError> {
     let bad = |name, value, rule| Err(TwinError::InvalidInput { name, value, rule });
-    if !(c.time_step_s.is_finite() && c.time_step_s > 0.0 && c.time_step_s < 0.1) {
+    if !(c.time_step_s.is_finite()
+        && c.time_step_s > 0.0
+        && c.time_step_s < crate::dynamics::MAX_TIME_STEP_S)
+    {
         return bad(
             "time step (s)",
             c.time_step_s,

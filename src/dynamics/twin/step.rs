@@ -13,7 +13,7 @@ impl Twin {
     pub fn step(&mut self, input: &StepInput) -> Result<&StepOutput, TwinError> {
         if !(input.speed_rad_s.is_finite()
             && input.speed_rad_s > 0.0
-            && input.speed_rad_s <= 10.0 * self.rated_speed_rad_s)
+            && input.speed_rad_s <= crate::dynamics::MAX_SPEED_OVER_RATED * self.rated_speed_rad_s)
         {
             return Err(TwinError::InvalidInput {
                 name: "speed (rad/s)",
@@ -188,11 +188,11 @@ impl Twin {
                     Coupling::Linear => link.evaluate_linear(d, v),
                     _ => link
                         .evaluate(d, v, speed, &self.config.contact, fresh)
-                        .map_err(|source| {
+                        .map_err(|cause| {
                             Some(TwinError::Film {
                                 bearing: link.name.clone(),
                                 time_s: time,
-                                source,
+                                cause,
                             })
                         })?,
                 };
