@@ -224,13 +224,16 @@ impl StepFactor {
 pub const MAX_CONDENSED_DOFS: usize = 16;
 
 /// Solves the small dense system A x = b (A row-major n × n; x returned in `b`) by LU with
-/// partial pivoting (nalgebra, fixed size, on the stack). False if A is singular, the solution
-/// not finite, or n odd or above [`MAX_CONDENSED_DOFS`]. Allocates nothing.
+/// partial pivoting (nalgebra, fixed size, on the stack); n = 0 (no film bearing) is solved.
+/// False if A is singular, the solution not finite, or n odd or above [`MAX_CONDENSED_DOFS`].
+/// Allocates nothing.
 pub(crate) fn solve_small(a: &[f64], b: &mut [f64], n: usize) -> bool {
     // one arm per size: nalgebra's fixed-size LU is typed by its dimension
     macro_rules! fixed {
         ($($size:literal)*) => {
             match n {
+                // no film bearing: nothing to solve
+                0 => true,
                 $($size => {
                     let m = nalgebra::SMatrix::<f64, $size, $size>::from_row_slice(&a[..$size * $size]);
                     let mut x = nalgebra::SVector::<f64, $size>::from_column_slice(&b[..$size]);

@@ -3,6 +3,7 @@
 
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::rotor::{ResponsePeak, StationResponse};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -84,22 +85,7 @@ pub fn bode_svg(
                 .zip(c.response)
                 .map(|(s, r)| Circle::new((*s, r.x_phase_lag_deg), 2, colour.filled())),
         )?;
-        for p in c.peaks {
-            let label = match p.amplification_factor {
-                Some(af) => format!("{:.0} rpm, AF {af:.1}", p.speed_rpm),
-                None => format!("{:.0} rpm", p.speed_rpm),
-            };
-            let text = Text::new(
-                label,
-                (6, -16),
-                ("sans-serif", 13).into_font().color(colour),
-            );
-            amp.draw_series(std::iter::once(
-                EmptyElement::at((p.speed_rpm, p.amplitude_m * 1e6))
-                    + Circle::new((0, 0), 5, colour.stroke_width(2))
-                    + text,
-            ))?;
-        }
+        draw_peaks(&mut amp, c.peaks, colour)?;
         entries.push(Entry::new(Swatch::Line(*colour, 2), c.name));
     }
     entries.push(Entry::new(
@@ -108,6 +94,32 @@ pub fn bode_svg(
     ));
     draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
+    Ok(())
+}
+
+/// Each peak of one station on the amplitude chart: a ring with its speed and amplification
+/// factor (µm on the y axis).
+fn draw_peaks(
+    amp: &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    peaks: &[ResponsePeak],
+    colour: &RGBColor,
+) -> anyhow::Result<()> {
+    for p in peaks {
+        let label = match p.amplification_factor {
+            Some(af) => format!("{:.0} rpm, AF {af:.1}", p.speed_rpm),
+            None => format!("{:.0} rpm", p.speed_rpm),
+        };
+        let text = Text::new(
+            label,
+            (6, -16),
+            ("sans-serif", 13).into_font().color(colour),
+        );
+        amp.draw_series(std::iter::once(
+            EmptyElement::at((p.speed_rpm, p.amplitude_m * 1e6))
+                + Circle::new((0, 0), 5, colour.stroke_width(2))
+                + text,
+        ))?;
+    }
     Ok(())
 }
 
