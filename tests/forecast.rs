@@ -180,3 +180,42 @@ fn a_stable_recording_gets_no_false_announcement() {
         assert!(x["nonlinear_threshold_rpm"].is_null(), "{x}");
     }
 }
+
+/// The nonlinear threshold when only a far probe whips (referee's finding): the bracket starts at
+/// the present speed, which does not whip at 8,000 rpm, and is bisected to the 50 rpm resolution,
+/// landing near the default probes' value (≈ 8,700–8,800 rpm early in the run-up; linear 8,471),
+/// never reported as the far probe itself with resolution 0. A tiny period and an absurd offset
+/// are refused with the option.
+#[test]
+fn a_far_probe_alone_still_brackets_the_threshold_from_the_present_speed() {
+    let bag = Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/orc_runup_synthetic");
+    let r = replay_forecast(
+        &bag,
+        "far",
+        &["--duration", "0.3", "--forecast-offsets-rpm", "5000"],
+    );
+    let first = &r["forecast"]["forecasts"][0];
+    let t = first["nonlinear_threshold_rpm"].as_f64().unwrap();
+    let res = first["nonlinear_threshold_resolution_rpm"]
+        .as_f64()
+        .unwrap();
+    assert!((8_300.0..9_300.0).contains(&t), "threshold {t} rpm");
+    assert!(res > 0.0 && res <= 50.0, "resolution {res} rpm");
+    for (option, value, says) in [
+        ("--forecast-period-s", "1e-9", "at least 0.1"),
+        ("--forecast-offsets-rpm", "1e300", "from 0 to 10000"),
+    ] {
+        let out = scratch("refused");
+        let args = [
+            "replay",
+            bag.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--forecast",
+            option,
+            value,
+        ];
+        let (ok, _, err) = run_cli(&args);
+        assert!(!ok && err.contains(says), "{option} {value}: {err}");
+    }
+}

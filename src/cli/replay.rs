@@ -252,9 +252,10 @@ fn check_args(args: &ReplayArgs) -> anyhow::Result<()> {
     if let Some(f) = forecast_options(args) {
         f.settings.check().map_err(anyhow::Error::msg)?;
         anyhow::ensure!(
-            f.period_s.is_finite() && f.period_s > 0.0,
-            "--forecast-period-s {}: must be positive (s)",
-            f.period_s
+            f.period_s.is_finite() && f.period_s >= crate::forecast::MIN_PERIOD_S,
+            "--forecast-period-s {}: must be at least {} s",
+            f.period_s,
+            crate::forecast::MIN_PERIOD_S
         );
     }
     Ok(())

@@ -34,6 +34,15 @@ pub const DEFAULT_OFFSETS_RPM: [f64; 4] = [0.0, 100.0, 250.0, 500.0];
 /// this narrow (two or three extra runs between the default probes).
 pub const DEFAULT_MARGIN_RESOLUTION_RPM: f64 = 50.0;
 
+/// Shortest forecast period (s): a forecast of the default runs costs about a second of one
+/// core, so periods below a tenth of a second only queue skipped cycles (node) or multiply a
+/// replay's cost (a period of 1e-9 s would ask for 8·10⁹ forecasts of the sample bag).
+pub const MIN_PERIOD_S: f64 = 0.1;
+
+/// Largest speed offset probed (rpm): a forecast looks at the operator's next set-point changes,
+/// not at speeds the machine file's limits would refuse anyway.
+pub const MAX_OFFSET_RPM: f64 = 10_000.0;
+
 /// Revolutions a whirl (or whip) must hold in a run to count as its onset: 24, the replay's
 /// onset rule (3 consecutive blocks of 8 revolutions), so that a forecast onset and an observed
 /// one mean the same. A run ending before that counts a state held to its end.
@@ -82,10 +91,10 @@ impl ForecastSettings {
         if let Some(bad) = self
             .offsets_rpm
             .iter()
-            .find(|o| !(o.is_finite() && **o >= 0.0))
+            .find(|o| !(o.is_finite() && (0.0..=MAX_OFFSET_RPM).contains(*o)))
         {
             return Err(format!(
-                "forecast speed offset (rpm): {bad} must be a finite number ≥ 0"
+                "forecast speed offset (rpm): {bad} must be a finite number from 0 to {MAX_OFFSET_RPM}"
             ));
         }
         if self.offsets_rpm.windows(2).any(|w| w[1] <= w[0]) {
@@ -184,7 +193,8 @@ pub struct Forecast {
     /// The constant-speed runs, the probes and the bisection's, ascending in speed.
     pub runs: Vec<RunForecast>,
     /// Lowest speed whose run went into whip (rad/s), with the bracket's width (rad/s): the
-    /// threshold lies in (speed − width, speed]; None if no run whipped.
+    /// threshold lies in (speed − width, speed]; a width equal to the speed means "at or below
+    /// it" (the lowest speed probed whips already); None if no run whipped.
     pub nonlinear_threshold: Option<(f64, f64)>,
     /// The linear threshold (rad/s, whirl ratio), as given.
     pub linear_threshold: Option<(f64, f64)>,
@@ -257,9 +267,22 @@ impl Forecaster {
     fn bisect(&mut self, start: &ForecastStart, runs: &mut Vec<RunForecast>) -> Option<(f64, f64)> {
         let k = runs.iter().position(|r| r.whip_after_s.is_some())?;
         let mut hi = runs[k].speed_rad_s;
-        let Some(mut lo) = k.checked_sub(1).map(|j| runs[j].speed_rad_s) else {
-            // the present speed whips already: the threshold is at or below it
-            return Some((hi, 0.0));
+        let w0 = start.speed_rad_s;
+        let mut lo = match k.checked_sub(1) {
+            Some(j) => runs[j].speed_rad_s,
+            // the lowest probe whips, above the present speed: bracket from the present speed
+            None if hi > w0 => {
+                let run = self.run(start, w0, 0.0);
+                let whips = run.whip_after_s.is_some();
+                runs.insert(0, run);
+                if whips {
+                    // at or below the present speed: nothing below it was probed
+                    return Some((w0, w0));
+                }
+                w0
+            }
+            // the present speed whips already: at or below it (nothing below was probed)
+            None => return Some((hi, hi)),
         };
         let resolution = rpm_to_rad_s(self.settings.margin_resolution_rpm);
         while resolution > 0.0 && hi - lo > resolution {
@@ -431,6 +454,7 @@ impl Forecast {
     pub fn describe(&self) -> String {
         let when = |v: Option<f64>| v.map_or("none".to_string(), |t| format!("{t:.2} s"));
         let nl = match self.nonlinear_threshold {
+            Some((s, r)) if r >= s => format!("at or below {:.0} rpm", rad_s_to_rpm(s)),
             Some((s, r)) => format!("{:.0} rpm (−{:.0})", rad_s_to_rpm(s), rad_s_to_rpm(r)),
             None => "not within the probes".into(),
         };

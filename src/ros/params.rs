@@ -211,9 +211,10 @@ impl NodeParams {
         match name {
             "forecast_period_s" => {
                 let p = num(value)?;
-                if !(p.is_finite() && p >= 0.0) {
+                if !(p.is_finite() && (p == 0.0 || p >= crate::forecast::MIN_PERIOD_S)) {
                     return Err(format!(
-                        "parameter forecast_period_s: {p} must be 0 (off) or a time above zero"
+                        "parameter forecast_period_s: {p} must be 0 (off) or at least {} s",
+                        crate::forecast::MIN_PERIOD_S
                     ));
                 }
                 self.forecast_period_s = p;
