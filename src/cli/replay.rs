@@ -261,33 +261,66 @@ fn check_args(args: &ReplayArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Runs `rotor-twin replay`.
-// Long (≈105 lines): the bag, the replay, the report and the plots in sequence; the plots and
-// the report printing are the next to move out (issue 10).
+/// Runs `rotor-twin replay`: the bag through the twin, the report and the plots.
 pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     check_args(args)?;
-    let coupling = args.model.coupling(args.delta);
     let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
     say_film_tables(&rotor, args.film)?;
-    let out_dir = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .bag
-            .file_stem()
-            .map_or("bag".into(), |s| s.to_string_lossy().into_owned());
-        PathBuf::from(format!("replay_{stem}"))
-    });
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out_dir(&args.bag));
     refuse_overlap(&args.bag, &out_dir)?;
-    // the bag's errors name the file concerned
-    let bag = Bag::read(&args.bag)?;
+    let bag = read_bag(&args.bag)?;
+    let options = replay_options(args, &out_dir);
+    crate::replay::check_mapping(&bag, &rotor, &options)?;
+    prepare_out_dir(&out_dir)?;
+    if args.calibrate {
+        return run_calibrated(args, &bag, &rotor, &options, &out_dir);
+    }
+    let (report, comparisons) = replay_with_progress(&bag, &rotor, &options)?;
+    let json = serde_json::to_string_pretty(&report)?;
+    std::fs::write(out_dir.join("report.json"), &json)?;
+    for c in comparisons.iter().filter(|c| c.samples > 0) {
+        write_station_plots(&out_dir, c)?;
+    }
+    // a closed standard output (e.g. piped into `head`) is not an error of the replay
+    if args.json {
+        super::print_out(&format!("{json}\n"))
+    } else {
+        super::print_out(&format!(
+            "{}output: {}\n",
+            report.summary(),
+            out_dir.display()
+        ))
+    }
+}
+
+/// `replay_STEM` in the working directory, for bag `bag`.
+fn default_out_dir(bag: &Path) -> PathBuf {
+    let stem = bag
+        .file_stem()
+        .map_or("bag".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from(format!("replay_{stem}"))
+}
+
+/// The bag, its damaged ranges and notes warned about (the bag's errors name the file).
+fn read_bag(path: &Path) -> anyhow::Result<Bag> {
+    let bag = Bag::read(path)?;
     for d in &bag.damage {
         eprintln!("warning: {d}; replaying every intact message");
     }
     for n in &bag.notes {
-        eprintln!("warning: {}: {n}", args.bag.display());
+        eprintln!("warning: {}: {n}", path.display());
     }
-    let options = ReplayOptions {
-        coupling,
+    Ok(bag)
+}
+
+/// The replay core's options from the command line; the output bag goes into `out_dir`.
+fn replay_options(args: &ReplayArgs, out_dir: &Path) -> ReplayOptions {
+    ReplayOptions {
+        coupling: args.model.coupling(args.delta),
         steps_per_rev: args.steps_per_rev,
         film: args.film.into(),
         session: SessionSettings {
@@ -303,12 +336,18 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         out_bag: (!args.no_bag).then(|| out_dir.join("bag")),
         forecast: forecast_options(args),
         ..ReplayOptions::default()
-    };
-    crate::replay::check_mapping(&bag, &rotor, &options)?;
-    prepare_out_dir(&out_dir)?;
-    if args.calibrate {
-        return run_calibrated(args, &bag, &rotor, &options, &out_dir);
     }
+}
+
+/// The replay with a progress bar (share of the bag, times real time) on the terminal.
+fn replay_with_progress(
+    bag: &Bag,
+    rotor: &Rotor,
+    options: &ReplayOptions,
+) -> anyhow::Result<(
+    crate::replay::ReplayReport,
+    Vec<crate::replay::compare::StationComparison>,
+)> {
     let bar = indicatif::ProgressBar::new(1000);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -320,7 +359,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let bag_s = bag
         .time_span_ns()
         .map_or(0.0, |(a, b)| (b - a) as f64 * 1e-9);
-    let (report, comparisons) = replay(&bag, &rotor, &options, &mut |done| {
+    let out = replay(bag, rotor, options, &mut |done| {
         bar.set_position((done * 1000.0) as u64);
         let wall = started.elapsed().as_secs_f64();
         if wall > 0.0 {
@@ -328,48 +367,40 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         }
     })?;
     bar.finish_and_clear();
-    let json = serde_json::to_string_pretty(&report)?;
-    std::fs::write(out_dir.join("report.json"), &json)?;
-    for c in &comparisons {
-        if c.samples == 0 {
-            continue;
-        }
-        let name = &c.station;
-        crate::plot::orbit_comparison_svg(
-            &out_dir.join(format!("orbit_{name}.svg")),
-            &format!("{name}: predicted over measured orbit, last 4 revolutions"),
-            &c.recent_samples(4),
-            c.clearance_m(),
-        )?;
-        if let Some((m, p)) = c.summary_spectra() {
-            crate::plot::spectrum_comparison_svg(
-                &out_dir.join(format!("spectrum_{name}.svg")),
-                &format!("{name}: order spectrum, last revolutions of the bag"),
-                &m,
-                &p,
-            )?;
-        }
-        crate::plot::waterfall_svg(
-            &out_dir.join(format!("waterfall_{name}.svg")),
-            &format!("{name}: order spectra through the bag (blocks of 8 revolutions)"),
-            &c.block_spectra,
-        )?;
-        crate::plot::amplitude_speed_svg(
-            &out_dir.join(format!("amplitude_speed_{name}.svg")),
-            &format!("{name}: amplitude against speed (blocks of 8 revolutions)"),
-            &c.blocks,
+    Ok(out)
+}
+
+/// One probe station's plots: predicted over measured orbit, order spectrum, waterfall and
+/// amplitude against speed.
+fn write_station_plots(
+    out_dir: &Path,
+    c: &crate::replay::compare::StationComparison,
+) -> anyhow::Result<()> {
+    let name = &c.station;
+    crate::plot::orbit_comparison_svg(
+        &out_dir.join(format!("orbit_{name}.svg")),
+        &format!("{name}: predicted over measured orbit, last 4 revolutions"),
+        &c.recent_samples(4),
+        c.clearance_m(),
+    )?;
+    if let Some((m, p)) = c.summary_spectra() {
+        crate::plot::spectrum_comparison_svg(
+            &out_dir.join(format!("spectrum_{name}.svg")),
+            &format!("{name}: order spectrum, last revolutions of the bag"),
+            &m,
+            &p,
         )?;
     }
-    // a closed standard output (e.g. piped into `head`) is not an error of the replay
-    if args.json {
-        super::print_out(&format!("{json}\n"))
-    } else {
-        super::print_out(&format!(
-            "{}output: {}\n",
-            report.summary(),
-            out_dir.display()
-        ))
-    }
+    crate::plot::waterfall_svg(
+        &out_dir.join(format!("waterfall_{name}.svg")),
+        &format!("{name}: order spectra through the bag (blocks of 8 revolutions)"),
+        &c.block_spectra,
+    )?;
+    crate::plot::amplitude_speed_svg(
+        &out_dir.join(format!("amplitude_speed_{name}.svg")),
+        &format!("{name}: amplitude against speed (blocks of 8 revolutions)"),
+        &c.blocks,
+    )
 }
 
 /// Refuses an output directory that is the input bag, lies inside it or holds it: the replay
