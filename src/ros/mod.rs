@@ -200,6 +200,9 @@ fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::
     Ok(())
 }
 
+/// The node's life: DDS participant, readers and writers, model thread, until a signal.
+// Long (≈105 lines): start-up in the order DDS requires; splitting it along the publishers, the
+// parameter services and the shutdown is open in issue 10.
 async fn run_async(
     setup: NodeSetup,
     ros: RosArgs,
