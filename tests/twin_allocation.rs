@@ -28,8 +28,11 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn allocations_in_steps(film: FilmEvaluation, warmup: usize, steps: usize) -> usize {
-    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+fn allocations_in_steps(film: FilmEvaluation, inertia: bool, warmup: usize, steps: usize) -> usize {
+    let mut rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    if inertia {
+        rotor.set_fluid_inertia(rotor_twin::film::FluidInertia::Temporal);
+    }
     let omega = 9000.0 * std::f64::consts::PI / 30.0;
     let config = TwinConfig {
         film,
@@ -58,10 +61,18 @@ fn allocations_in_steps(film: FilmEvaluation, warmup: usize, steps: usize) -> us
 /// One test only: the counter is global to the process, and tests run in parallel threads.
 #[test]
 fn the_time_step_allocates_nothing() {
-    assert_eq!(allocations_in_steps(FilmEvaluation::Direct, 10, 1000), 0);
+    assert_eq!(
+        allocations_in_steps(FilmEvaluation::Direct, false, 10, 1000),
+        0
+    );
     // 500 revolutions into the whip (the journal touches the wall), then a thousand steps
     assert_eq!(
-        allocations_in_steps(FilmEvaluation::Table, 500 * 128, 1000),
+        allocations_in_steps(FilmEvaluation::Table, false, 500 * 128, 1000),
+        0
+    );
+    // with the film's fluid inertia (added mass at every iteration)
+    assert_eq!(
+        allocations_in_steps(FilmEvaluation::Table, true, 300 * 128, 1000),
         0
     );
 }

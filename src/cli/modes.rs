@@ -35,6 +35,10 @@ pub struct ModesArgs {
     /// Write the Campbell diagram to this SVG file.
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Give every film bearing its film's temporal fluid inertia (added mass, weightless),
+    /// whatever the machine file's `fluid_inertia` says.
+    #[arg(long)]
+    fluid_inertia: bool,
 }
 
 /// Frequencies set apart as modes of a massless shaft's own mass (Hz).
@@ -108,7 +112,10 @@ fn speed_range(args: &ModesArgs, rated: f64) -> anyhow::Result<(Vec<f64>, f64, f
 
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let desc = MachineDescription::load(args.config.as_deref())?;
-    let rotor = Rotor::from_description(&desc);
+    let mut rotor = Rotor::from_description(&desc);
+    if args.fluid_inertia {
+        rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
+    }
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     let statics = static_solution(&rotor).context("static deflection")?;
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;

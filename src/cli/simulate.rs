@@ -30,6 +30,10 @@ pub(crate) struct RunOptions {
     /// Machine description (YAML); the built-in ORC microturbine if absent.
     #[arg(long)]
     config: Option<PathBuf>,
+    /// Give every film bearing its film's temporal fluid inertia (added mass, weightless),
+    /// whatever the machine file's `fluid_inertia` says.
+    #[arg(long)]
+    fluid_inertia: bool,
     /// Revolutions to simulate.
     #[arg(long, default_value_t = 200)]
     revs: usize,
@@ -87,7 +91,10 @@ impl RunOptions {
 
     fn machine(&self) -> anyhow::Result<(MachineDescription, Rotor)> {
         let desc = MachineDescription::load(self.config.as_deref())?;
-        let rotor = Rotor::from_description(&desc);
+        let mut rotor = Rotor::from_description(&desc);
+        if self.fluid_inertia {
+            rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
+        }
         Ok((desc, rotor))
     }
 

@@ -2,7 +2,8 @@
 //! and the contact with the bearing wall when the film can no longer hold the journal.
 
 use crate::film::{
-    FilmCoefficients, FilmError, FilmModel, FilmResult, JournalKinematics, ViscosityScaledFilm,
+    FilmCoefficients, FilmError, FilmInertia, FilmModel, FilmResult, JournalKinematics,
+    ViscosityScaledFilm,
 };
 
 /// Contact with the bearing wall.
@@ -46,6 +47,9 @@ pub struct LinkEvaluation {
     pub damping: [[f64; 2]; 2],
     /// The film's own share of `stiffness` (the rest is the wall's) (N/m).
     pub film_stiffness: [[f64; 2]; 2],
+    /// −∂F/∂d̈ (kg): the film's fluid inertia, zero without it (its force −m d̈ is added by
+    /// the step, which knows the acceleration).
+    pub added_mass_kg: [[f64; 2]; 2],
     /// The film solution.
     pub film: FilmResult,
     /// True if the journal was in contact with the wall.
@@ -85,6 +89,8 @@ pub(crate) struct BearingLink {
     pub linear_reference: Option<LinearReference>,
     /// Prehistory: the raw coefficients of the previous step, c(k−1) of seed eq. 8.
     pub previous_raw: Option<FilmCoefficients>,
+    /// The film's fluid inertia, if the bearing carries it.
+    pub inertia: Option<FilmInertia>,
     /// The last evaluation.
     pub last: LinkEvaluation,
 }
@@ -93,6 +99,20 @@ impl BearingLink {
     /// The running viscosity (Pa·s).
     pub fn viscosity(&self) -> f64 {
         self.viscosity_pa_s * self.film.scale()
+    }
+
+    /// `coef` with the added mass of the film `film` at relative position `d` (m), if the
+    /// bearing carries its fluid inertia.
+    pub fn with_added_mass(
+        &self,
+        coef: FilmCoefficients,
+        d: [f64; 2],
+        film: &FilmResult,
+    ) -> FilmCoefficients {
+        match &self.inertia {
+            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity()),
+            None => coef,
+        }
     }
 
     /// Number of condensed DOFs of this bearing (journal, and pedestal if any).
@@ -130,15 +150,23 @@ impl BearingLink {
             speed_rad_s: speed,
         };
         let (film, coef) = if with_coefficients {
-            self.film.solve_with_coefficients(&kin)?
+            let (film, coef) = self.film.solve_with_coefficients(&kin)?;
+            (film, self.with_added_mass(coef, d_film, &film))
         } else {
-            (self.film.solve(&kin)?, FilmCoefficients::default())
+            // the added mass of the iteration before (prehistory keeps its matrix for the step)
+            let mass = self.last.added_mass_kg;
+            let coef = FilmCoefficients {
+                added_mass_kg: mass,
+                ..FilmCoefficients::default()
+            };
+            (self.film.solve(&kin)?, coef)
         };
         let mut out = LinkEvaluation {
             force_n: film.force_n,
             stiffness: coef.stiffness_n_per_m,
             damping: coef.damping_n_s_per_m,
             film_stiffness: coef.stiffness_n_per_m,
+            added_mass_kg: coef.added_mass_kg,
             film,
             contact: in_contact,
             rub_power_w: 0.0,
@@ -176,7 +204,8 @@ impl BearingLink {
         Ok(out)
     }
 
-    /// The linear coupling's force law F = F₀ − K₀(d − d₀) − C₀ ḋ about the static equilibrium.
+    /// The linear coupling's force law F = F₀ − K₀(d − d₀) − C₀ ḋ about the static equilibrium
+    /// (and − M₀ d̈ with the film's fluid inertia, added by the step).
     pub fn evaluate_linear(&mut self, d: [f64; 2], v: [f64; 2]) -> LinkEvaluation {
         let LinearReference {
             position_m: d0,
@@ -198,6 +227,7 @@ impl BearingLink {
             stiffness: k,
             damping: cc,
             film_stiffness: k,
+            added_mass_kg: coef.added_mass_kg,
             film: self.last.film,
             contact: false,
             rub_power_w: 0.0,

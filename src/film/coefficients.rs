@@ -14,15 +14,24 @@ pub fn rows2(m: &Matrix2<f64>) -> [[f64; 2]; 2] {
     [[m[(0, 0)], m[(0, 1)]], [m[(1, 0)], m[(1, 1)]]]
 }
 
-/// Stiffness and damping of the film about one journal state: the film force changes by
-/// `ΔF = −k Δq − c Δq̇`, with `k[i][j] = −∂F_i/∂q_j` and `c[i][j] = −∂F_i/∂q̇_j`, indices 0 = x,
-/// 1 = y of the fixed frame.
+/// Stiffness, damping and added mass of the film about one journal state: the film force
+/// changes by `ΔF = −k Δq − c Δq̇ − m Δq̈`, with `k[i][j] = −∂F_i/∂q_j`, `c[i][j] = −∂F_i/∂q̇_j`
+/// and `m[i][j] = −∂F_i/∂q̈_j`, indices 0 = x, 1 = y of the fixed frame. The added mass is zero
+/// unless the bearing carries its film's fluid inertia ([`crate::film::FilmInertia`]); the film
+/// solvers give the eight coefficients only.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct FilmCoefficients {
     /// `[[k_xx, k_xy], [k_yx, k_yy]]` (N/m).
     pub stiffness_n_per_m: [[f64; 2]; 2],
     /// `[[c_xx, c_xy], [c_yx, c_yy]]` (N·s/m).
     pub damping_n_s_per_m: [[f64; 2]; 2],
+    /// `[[m_xx, m_xy], [m_yx, m_yy]]` (kg): the film's fluid inertia, zero without it.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub added_mass_kg: [[f64; 2]; 2],
+}
+
+fn is_zero(m: &[[f64; 2]; 2]) -> bool {
+    m.iter().flatten().all(|&v| v == 0.0)
 }
 
 impl FilmCoefficients {
@@ -53,6 +62,7 @@ impl FilmCoefficients {
         Self {
             stiffness_n_per_m: back(&self.stiffness_n_per_m),
             damping_n_s_per_m: back(&self.damping_n_s_per_m),
+            added_mass_kg: back(&self.added_mass_kg),
         }
     }
 
@@ -61,6 +71,7 @@ impl FilmCoefficients {
         Self {
             stiffness_n_per_m: self.stiffness_n_per_m.map(|r| r.map(|v| s * v)),
             damping_n_s_per_m: self.damping_n_s_per_m.map(|r| r.map(|v| s * v)),
+            added_mass_kg: self.added_mass_kg.map(|r| r.map(|v| s * v)),
         }
     }
 
@@ -70,6 +81,7 @@ impl FilmCoefficients {
         Self {
             stiffness_n_per_m: add(&self.stiffness_n_per_m, &o.stiffness_n_per_m),
             damping_n_s_per_m: add(&self.damping_n_s_per_m, &o.damping_n_s_per_m),
+            added_mass_kg: add(&self.added_mass_kg, &o.added_mass_kg),
         }
     }
 
@@ -78,6 +90,7 @@ impl FilmCoefficients {
         self.stiffness_n_per_m
             .iter()
             .chain(self.damping_n_s_per_m.iter())
+            .chain(self.added_mass_kg.iter())
             .flatten()
             .all(|v| v.is_finite())
     }

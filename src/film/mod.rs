@@ -19,6 +19,7 @@ mod equilibrium;
 mod error;
 mod finite;
 mod geometry;
+mod inertia;
 mod short;
 mod table;
 mod viscosity;
@@ -31,6 +32,7 @@ pub use equilibrium::{
 pub use error::FilmError;
 pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
+pub use inertia::{FilmInertia, FluidInertia};
 pub use short::ShortFilm;
 pub use table::{
     disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,

@@ -204,6 +204,8 @@ impl ViscosityScaledFilm {
         FilmCoefficients {
             stiffness_n_per_m: c.stiffness_n_per_m.map(|row| row.map(|v| s * v)),
             damping_n_s_per_m: c.damping_n_s_per_m.map(|row| row.map(|v| s * v)),
+            // the fluid's inertia is the density's, not the viscosity's
+            added_mass_kg: c.added_mass_kg,
         }
     }
 }

@@ -69,6 +69,8 @@ pub struct FilmBearing {
     /// The films are solved (and tabulated) at `lubricant` and scaled: exact for the isoviscous
     /// film without supply pressure ([`crate::film::ViscosityScaledFilm`]).
     pub viscosity_scale: f64,
+    /// The film's fluid inertia (added mass), if the bearing carries it.
+    pub inertia: Option<crate::film::FilmInertia>,
 }
 
 // --- oil supply temperature (issue 12) ---
@@ -76,6 +78,20 @@ impl FilmBearing {
     /// The viscosity of the running oil (Pa·s): the reference times the scale.
     pub fn viscosity_pa_s(&self) -> f64 {
         self.lubricant.viscosity_pa_s * self.viscosity_scale
+    }
+
+    /// `coef` with the added mass of the film `film` at relative position `d` (m), if the
+    /// bearing carries its fluid inertia.
+    pub fn with_added_mass(
+        &self,
+        coef: FilmCoefficients,
+        d: [f64; 2],
+        film: &crate::film::FilmResult,
+    ) -> FilmCoefficients {
+        match &self.inertia {
+            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity_pa_s()),
+            None => coef,
+        }
     }
 
     /// A film solver at the running viscosity (each user owns one: it carries the warm start).
@@ -100,6 +116,16 @@ impl Rotor {
             }
         }
         Ok(())
+    }
+
+    /// Gives every film bearing its film's fluid inertia, or takes it away (`choice`), whatever
+    /// the machine file said (for studies: `--fluid-inertia`).
+    pub fn set_fluid_inertia(&mut self, choice: crate::film::FluidInertia) {
+        for b in &mut self.bearings {
+            if let BearingModel::Film(f) = &mut b.model {
+                f.inertia = fluid_inertia(&f.geometry, &f.lubricant, choice);
+            }
+        }
     }
 
     /// The viscosity scale of the first film bearing (1 without one).
@@ -425,10 +451,26 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 short: matches!(b.model, BearingModelSpec::Short(_)),
                 viscosity_law: f.viscosity_law,
                 viscosity_scale: 1.0,
+                inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),
         BearingModelSpec::Rigid => BearingModel::Rigid,
+    }
+}
+
+/// The added-mass model of a film bearing, if `choice` asks for it.
+fn fluid_inertia(
+    geometry: &BearingGeometry,
+    lubricant: &Lubricant,
+    choice: crate::film::FluidInertia,
+) -> Option<crate::film::FilmInertia> {
+    match choice {
+        crate::film::FluidInertia::None => None,
+        crate::film::FluidInertia::Temporal => Some(crate::film::FilmInertia::new(
+            geometry,
+            lubricant.density_kg_m3,
+        )),
     }
 }
 

@@ -263,14 +263,27 @@ pub fn damped_mode_shapes(
     Ok(out)
 }
 
-/// The full stiffness K + K_bearings and damping C + ΩG + C_bearings at spin `speed_rad_s`, and
-/// the DOFs left free (all but the rigid bearings' journals).
+/// The linear system at spin `speed_rad_s` with bearing coefficients `coefficients`.
+pub(crate) struct Assembled {
+    /// M + M_bearings (the films' added mass, weightless).
+    pub m: Mat<f64>,
+    /// K + K_bearings.
+    pub k: Mat<f64>,
+    /// C + ΩG + C_bearings.
+    pub c: Mat<f64>,
+    /// The DOFs left free (all but the rigid bearings' journals).
+    pub free: Vec<usize>,
+}
+
+/// The full mass, stiffness and damping of the rotor on its linearised bearings at spin
+/// `speed_rad_s`, and the DOFs left free.
 pub(crate) fn assembled_matrices(
     rotor: &Rotor,
     speed_rad_s: f64,
     coefficients: &[FilmCoefficients],
-) -> (Mat<f64>, Mat<f64>, Vec<usize>) {
+) -> Assembled {
     let n_all = rotor.n_dof();
+    let mut m = rotor.mass.clone();
     let mut k = rotor.stiffness.clone();
     let mut c = Mat::<f64>::from_fn(n_all, n_all, |i, j| {
         rotor.damping[(i, j)] + speed_rad_s * rotor.gyroscopic[(i, j)]
@@ -292,13 +305,14 @@ pub(crate) fn assembled_matrices(
                     for j in 0..2 {
                         k[(di[i], dj[j])] += si * sj * coef.stiffness_n_per_m[i][j];
                         c[(di[i], dj[j])] += si * sj * coef.damping_n_s_per_m[i][j];
+                        m[(di[i], dj[j])] += si * sj * coef.added_mass_kg[i][j];
                     }
                 }
             }
         }
     }
     let free = (0..n_all).filter(|d| !held.contains(d)).collect();
-    (k, c, free)
+    Assembled { m, k, c, free }
 }
 
 /// Eigenvalues λ (Im λ > 0, ascending) of the state-space form ż = A z,
@@ -310,13 +324,18 @@ fn state_eigen(
     coefficients: &[FilmCoefficients],
 ) -> Result<(Vec<faer::c64>, Vec<Shape>), RotorError> {
     let n_all = rotor.n_dof();
-    let (k, c, dofs) = assembled_matrices(rotor, speed_rad_s, coefficients);
+    let Assembled {
+        m: m_all,
+        k,
+        c,
+        free: dofs,
+    } = assembled_matrices(rotor, speed_rad_s, coefficients);
     let n = dofs.len();
     let fail = |why: String| RotorError::LinearAlgebra {
         what: "damped modes",
         why,
     };
-    let m = Mat::<f64>::from_fn(n, n, |i, j| rotor.mass[(dofs[i], dofs[j])]);
+    let m = Mat::<f64>::from_fn(n, n, |i, j| m_all[(dofs[i], dofs[j])]);
     let llt = m
         .llt(Side::Lower)
         .map_err(|_| fail("the mass matrix is not positive definite".into()))?;
@@ -468,7 +487,10 @@ impl BearingSolvers {
                             speed_rad_s,
                         )
                         .map_err(fail)?;
-                        (eq.coefficients, eq.eccentricity_ratio)
+                        (
+                            f.with_added_mass(eq.coefficients, eq.position_m, &eq.film),
+                            eq.eccentricity_ratio,
+                        )
                     }
                 }
                 (BearingModel::Linear(c), _) => (*c, 0.0),

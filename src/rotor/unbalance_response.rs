@@ -180,12 +180,16 @@ fn harmonic_solution_for(
     coefs: &[crate::film::FilmCoefficients],
     unbalance: &[super::Unbalance],
 ) -> Result<Vec<c64>, RotorError> {
-    let (k, c, dofs) = assembled_matrices(rotor, omega, coefs);
+    let sys = assembled_matrices(rotor, omega, coefs);
+    let dofs = &sys.free;
     let n = dofs.len();
     let w2 = omega * omega;
     let a = Mat::<c64>::from_fn(n, n, |i, j| {
         let (di, dj) = (dofs[i], dofs[j]);
-        c64::new(k[(di, dj)] - w2 * rotor.mass[(di, dj)], omega * c[(di, dj)])
+        c64::new(
+            sys.k[(di, dj)] - w2 * sys.m[(di, dj)],
+            omega * sys.c[(di, dj)],
+        )
     });
     let mut f_full = vec![c64::new(0.0, 0.0); rotor.n_dof()];
     for u in unbalance {

@@ -44,7 +44,7 @@ impl Twin {
         }
         let n = full_of.len();
         let sub = |a: &Mat<f64>| Mat::<f64>::from_fn(n, n, |i, j| a[(full_of[i], full_of[j])]);
-        let m = sub(&rotor.mass);
+        let mut m = sub(&rotor.mass);
         let mut k = sub(&rotor.stiffness);
         let mut c = sub(&rotor.damping);
         let g = sub(&rotor.gyroscopic);
@@ -55,6 +55,8 @@ impl Twin {
                 let p = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
                 add_relative_block(&mut k, j, p, &coef.stiffness_n_per_m);
                 add_relative_block(&mut c, j, p, &coef.damping_n_s_per_m);
+                // weightless: gravity is M g of the rotor's own mass (below)
+                add_relative_block(&mut m, j, p, &coef.added_mass_kg);
             }
         }
         let gravity_full = rotor.gravity_force();
@@ -89,6 +91,7 @@ impl Twin {
                     }),
                     linear_reference: None,
                     previous_raw: None,
+                    inertia: f.inertia,
                     last: LinkEvaluation::default(),
                 });
             }
@@ -117,13 +120,20 @@ impl Twin {
                     link.linear_reference = Some(LinearReference {
                         position_m: eq.position_m,
                         force_n: eq.film.force_n,
-                        coefficients: eq.coefficients,
+                        coefficients: link.with_added_mass(
+                            eq.coefficients,
+                            eq.position_m,
+                            &eq.film,
+                        ),
                     });
                     link.last = LinkEvaluation {
                         force_n: eq.film.force_n,
                         stiffness: eq.coefficients.stiffness_n_per_m,
                         damping: eq.coefficients.damping_n_s_per_m,
                         film_stiffness: eq.coefficients.stiffness_n_per_m,
+                        added_mass_kg: link
+                            .linear_reference
+                            .map_or([[0.0; 2]; 2], |r| r.coefficients.added_mass_kg),
                         film: eq.film,
                         contact: false,
                         rub_power_w: 0.0,

@@ -1,7 +1,7 @@
 //! The time step: Newmark predictor, condensed Newton iteration on the bearing DOFs, update.
 
 use super::{Twin, HELD};
-use crate::dynamics::bearing_link::LinearReference;
+use crate::dynamics::bearing_link::{LinearReference, LinkEvaluation};
 use crate::dynamics::linear::solve_small;
 use crate::dynamics::{Coupling, StepInput, StepOutput, TwinError};
 use crate::film::{equilibrium_under_load, FilmCoefficients};
@@ -86,10 +86,11 @@ impl Twin {
                 let load = [-r.force_n[0], -r.force_n[1]];
                 let mu = l.viscosity();
                 if let Ok(eq) = equilibrium_under_load(&mut l.film, mu, load, speed) {
+                    let coefficients = l.with_added_mass(eq.coefficients, eq.position_m, &eq.film);
                     l.linear_reference = Some(LinearReference {
                         position_m: eq.position_m,
                         force_n: eq.film.force_n,
-                        coefficients: eq.coefficients,
+                        coefficients,
                     });
                 }
             }
@@ -98,220 +99,293 @@ impl Twin {
 
     /// One Newmark step with factor `level` (h / 2^level) to `speed` (rad/s). Ok(iterations);
     /// Err(None) if Newton did not converge (retry smaller); Err(Some) for a hard failure.
-    // Long (≈230 lines): predictor, condensed Newton loop and corrector share the step's
-    // scratch state, kept in one function so the hot path allocates nothing; splitting it into
-    // predictor / iteration / corrector methods on that scratch is open in issue 10.
+    /// Allocates nothing: predictor, iteration and corrector work on the twin's scratch.
     fn advance(
         &mut self,
         level: usize,
         speed: f64,
         accel: f64,
     ) -> Result<usize, Option<TwinError>> {
-        let h = self.factors[level].h;
-        let factored_speed = self.factors[level].speed_rad_s;
-        let (a0, a1, a2) = (4.0 / (h * h), 4.0 / h, 2.0 / h);
-        let n = self.state.q.len();
-        let nb = self.b_dofs.len();
-        let angle = self.state.angle_rad + 0.5 * h * (self.state.speed_rad_s + speed);
-        let time = self.state.time_s + h;
+        let nm = Newmark::of(self.factors[level].h);
+        let angle = self.state.angle_rad + 0.5 * nm.h * (self.state.speed_rad_s + speed);
+        let time = self.state.time_s + nm.h;
+        self.linear_response(level, nm, angle, speed, accel);
+        let (iterations, fallback) = self.iterate_bearings(level, nm, speed, time)?;
+        self.correct(level, nm, time, angle, speed)?;
+        self.fallbacks += usize::from(fallback);
+        if let Coupling::Prehistory { .. } = self.config.coupling {
+            for (l, r) in self.links.iter_mut().zip(&self.raw) {
+                l.previous_raw = *r;
+            }
+        }
+        Ok(iterations)
+    }
 
-        // r = F_ext + M(a0 q + a1 q̇ + q̈) + (C + Ω_f G)(a2 q + q̇) − (Ω − Ω_f) G q̇
+    /// The linear part's response to everything but the bearing forces, a = K_eff⁻¹ r with
+    /// r = F_ext + M(a0 q + a1 q̇ + q̈) + (C + Ω_f G)(a2 q + q̇) − (Ω − Ω_f) G q̇, on the
+    /// condensed DOFs (`a_b`), and the predictor q* = q + h q̇ + h²/2 q̈ there (`qb`).
+    fn linear_response(&mut self, level: usize, nm: Newmark, angle: f64, speed: f64, accel: f64) {
+        let n = self.state.q.len();
+        let factored_speed = self.factors[level].speed_rad_s;
         for i in 0..n {
             self.rhs[i] = self.gravity[i] + self.external[i];
         }
         self.add_unbalance(angle, speed, accel);
-        let f = &self.factors[level];
         let s = &self.state;
         for i in 0..n {
-            self.tmp[i] = a0 * s.q[i] + a1 * s.qd[i] + s.qdd[i];
+            self.tmp[i] = nm.a0 * s.q[i] + nm.a1 * s.qd[i] + s.qdd[i];
         }
         self.m_rows.add_product(1.0, &self.tmp, &mut self.rhs);
         for i in 0..n {
-            self.tmp[i] = a2 * s.q[i] + s.qd[i];
+            self.tmp[i] = nm.a2 * s.q[i] + s.qd[i];
         }
         self.c_rows.add_product(1.0, &self.tmp, &mut self.rhs);
         self.g_rows
             .add_product(factored_speed, &self.tmp, &mut self.rhs);
         self.g_rows
             .add_product(-(speed - factored_speed), &s.qd, &mut self.rhs);
-        f.solve(&self.rhs, &mut self.q_lin);
+        self.factors[level].solve(&self.rhs, &mut self.q_lin);
         for (r, &d) in self.b_dofs.iter().enumerate() {
             self.a_b[r] = self.q_lin[d];
-            // predictor: q* = q + h q̇ + h²/2 q̈
-            self.qb[r] = s.q[d] + h * s.qd[d] + 0.5 * h * h * s.qdd[d];
         }
+        self.predict(nm);
+    }
 
+    /// The predictor q* = q + h q̇ + h²/2 q̈ on the condensed DOFs.
+    fn predict(&mut self, nm: Newmark) {
+        let s = &self.state;
+        for (r, &d) in self.b_dofs.iter().enumerate() {
+            self.qb[r] = s.q[d] + nm.h * s.qd[d] + 0.5 * nm.h * nm.h * s.qdd[d];
+        }
+    }
+
+    /// The condensed iteration on the bearing DOFs: Newton on g = q_B − a − S f_B(q_B); with
+    /// prehistory, first with its relaxed coefficients and, if that does not converge, again
+    /// from the predictor with Newton (a fallback). Ok((iterations, fallback)).
+    fn iterate_bearings(
+        &mut self,
+        level: usize,
+        nm: Newmark,
+        speed: f64,
+        time: f64,
+    ) -> Result<(usize, bool), Option<TwinError>> {
         let max_iterations = match self.config.coupling {
             Coupling::Nonlinear | Coupling::Prehistory { .. } => self.config.max_newton_iterations,
             Coupling::Linear => 1,
         };
-        // prehistory iterates with its relaxed coefficients; if that does not converge, the
-        // step falls back to Newton (fresh coefficients each iteration) and says so
         let prehistory = matches!(self.config.coupling, Coupling::Prehistory { .. });
-        let mut fallback = false;
-        let mut iterations = 0;
-        let mut total_iterations = 0;
-        let mut converged = false;
+        let (mut fallback, mut iterations, mut total) = (false, 0, 0);
         while iterations < max_iterations || (prehistory && !fallback) {
             if iterations == max_iterations {
-                // restart from the predictor with Newton
                 fallback = true;
-                total_iterations += iterations;
+                total += iterations;
                 iterations = 0;
-                for (r, &d) in self.b_dofs.iter().enumerate() {
-                    let s = &self.state;
-                    self.qb[r] = s.q[d] + h * s.qd[d] + 0.5 * h * h * s.qdd[d];
-                }
+                self.predict(nm);
             }
             iterations += 1;
-            // bearing forces and their derivatives at the current iterate
-            self.f_b.fill(0.0);
-            self.d_b.fill(0.0);
-            for (li, link) in self.links.iter_mut().enumerate() {
-                let o = link.b_offset;
-                let rel = |v: &dyn Fn(usize) -> f64| -> [f64; 2] {
-                    match link.pedestal {
-                        Some(_) => [v(o) - v(o + 2), v(o + 1) - v(o + 3)],
-                        None => [v(o), v(o + 1)],
-                    }
-                };
-                let qb = &self.qb;
-                let b_dofs = &self.b_dofs;
-                let state = &self.state;
-                let d = rel(&|r| qb[r]);
-                let v = rel(&|r| a2 * (qb[r] - state.q[b_dofs[r]]) - state.qd[b_dofs[r]]);
-                // prehistory: the film coefficients are computed once a step (first iteration),
-                // relaxed by seed eq. 8 and kept as the iteration matrix; the force is the
-                // Reynolds force at every iteration
-                let fresh = !prehistory || iterations == 1 || fallback;
-                let mut ev = match self.config.coupling {
-                    Coupling::Linear => link.evaluate_linear(d, v),
-                    _ => link
-                        .evaluate(d, v, speed, &self.config.contact, fresh)
-                        .map_err(|cause| {
-                            Some(TwinError::Film {
-                                bearing: link.name.clone(),
-                                time_s: time,
-                                cause,
-                            })
-                        })?,
-                };
-                if let (Coupling::Prehistory { delta }, false) = (self.config.coupling, fallback) {
-                    if fresh {
-                        // c(k+1) = δ c(k) + (1 − δ) c(k−1) on the film coefficients
-                        let raw = FilmCoefficients {
-                            stiffness_n_per_m: ev.film_stiffness,
-                            damping_n_s_per_m: ev.damping,
-                        };
-                        self.raw[li] = Some(raw);
-                        let mut relaxed = raw;
-                        if let Some(prev) = link.previous_raw {
-                            for i in 0..2 {
-                                for j in 0..2 {
-                                    relaxed.stiffness_n_per_m[i][j] = delta
-                                        * raw.stiffness_n_per_m[i][j]
-                                        + (1.0 - delta) * prev.stiffness_n_per_m[i][j];
-                                    relaxed.damping_n_s_per_m[i][j] = delta
-                                        * raw.damping_n_s_per_m[i][j]
-                                        + (1.0 - delta) * prev.damping_n_s_per_m[i][j];
-                                }
-                            }
-                        }
-                        self.relaxed[li] = relaxed;
-                    }
-                    // the wall's stiffness (contact) is not a film coefficient: never relaxed
-                    let r = self.relaxed[li];
-                    for i in 0..2 {
-                        for j in 0..2 {
-                            let wall = ev.stiffness[i][j] - ev.film_stiffness[i][j];
-                            ev.stiffness[i][j] = wall + r.stiffness_n_per_m[i][j];
-                            ev.damping[i][j] = r.damping_n_s_per_m[i][j];
-                        }
-                    }
-                }
-                // f_B: +F on the journal, −F on the pedestal; D = Tᵀ (K + a2 C) T
-                let w = link.width();
-                for i in 0..2 {
-                    self.f_b[o + i] += ev.force_n[i];
-                    if w == 4 {
-                        self.f_b[o + 2 + i] -= ev.force_n[i];
-                    }
-                    for j in 0..2 {
-                        let kd = ev.stiffness[i][j] + a2 * ev.damping[i][j];
-                        self.d_b[(o + i) * nb + o + j] += kd;
-                        if w == 4 {
-                            self.d_b[(o + i) * nb + o + 2 + j] -= kd;
-                            self.d_b[(o + 2 + i) * nb + o + j] -= kd;
-                            self.d_b[(o + 2 + i) * nb + o + 2 + j] += kd;
-                        }
-                    }
-                }
-            }
-            // residual g = q_B − a − S f_B; Jacobian J = I + S D
-            let sm = &self.factors[level].s;
-            for i in 0..nb {
-                let mut g = self.qb[i] - self.a_b[i];
-                for k in 0..nb {
-                    g -= sm[i * nb + k] * self.f_b[k];
-                }
-                self.delta[i] = -g;
-                for j in 0..nb {
-                    let mut v = if i == j { 1.0 } else { 0.0 };
-                    for k in 0..nb {
-                        v += sm[i * nb + k] * self.d_b[k * nb + j];
-                    }
-                    self.jac[i * nb + j] = v;
-                }
-            }
-            if !solve_small(&self.jac, &mut self.delta, nb) {
-                return Err(None);
-            }
-            // limit a Newton move to a fifth of the clearance
-            let mut largest = 0.0_f64;
-            for link in &self.links {
-                let o = link.b_offset;
-                let step = self.delta[o].hypot(self.delta[o + 1]) / link.clearance_m;
-                largest = largest.max(step);
-            }
-            let scale = if largest > 0.2 { 0.2 / largest } else { 1.0 };
-            for i in 0..nb {
-                self.delta[i] *= scale;
-                self.qb[i] += self.delta[i];
-            }
-            // the bearing force consistent with the new iterate: f_B − D Δ
-            for i in 0..nb {
-                for j in 0..nb {
-                    self.f_b[i] -= self.d_b[i * nb + j] * self.delta[j];
-                }
-            }
-            // Newton converges quadratically: after a correction Δ the error left is of order
-            // |Δ|²/c, so a correction below √tol leaves less than tol and needs no further film
-            // solve (the force used is the linearised one at the new iterate, f_B − D Δ)
-            let accept = if self.config.coupling == Coupling::Nonlinear
-                && !self.links.iter().any(|l| l.last.contact)
-            {
-                self.config.newton_tolerance.sqrt()
-            } else {
-                self.config.newton_tolerance
-            };
-            if largest * scale < accept && scale == 1.0 {
-                converged = true;
-                break;
+            // prehistory: the film coefficients are computed once a step (first iteration),
+            // relaxed by seed eq. 8 and kept as the iteration matrix; the force is the Reynolds
+            // force at every iteration
+            let fresh = !prehistory || iterations == 1 || fallback;
+            let relax = prehistory && !fallback;
+            self.bearing_forces(nm, speed, time, fresh, relax)?;
+            if self.newton_move(level)? {
+                return Ok((iterations + total, fallback));
             }
         }
-        if self.config.coupling != Coupling::Linear && !converged {
+        if self.config.coupling == Coupling::Linear {
+            Ok((iterations + total, fallback))
+        } else {
+            Err(None)
+        }
+    }
+
+    /// The bearing forces f_B and their derivatives D at the current iterate `qb`: +F on the
+    /// journal, −F on the pedestal, D = Tᵀ (K + a2 C + a0 M) T.
+    fn bearing_forces(
+        &mut self,
+        nm: Newmark,
+        speed: f64,
+        time: f64,
+        fresh: bool,
+        relax: bool,
+    ) -> Result<(), Option<TwinError>> {
+        let nb = self.b_dofs.len();
+        self.f_b.fill(0.0);
+        self.d_b.fill(0.0);
+        for li in 0..self.links.len() {
+            let ev = self.link_force(li, nm, speed, time, fresh, relax)?;
+            let (o, w) = (self.links[li].b_offset, self.links[li].width());
+            for i in 0..2 {
+                self.f_b[o + i] += ev.force_n[i];
+                if w == 4 {
+                    self.f_b[o + 2 + i] -= ev.force_n[i];
+                }
+                for j in 0..2 {
+                    let kd = ev.stiffness[i][j]
+                        + nm.a2 * ev.damping[i][j]
+                        + nm.a0 * ev.added_mass_kg[i][j];
+                    self.d_b[(o + i) * nb + o + j] += kd;
+                    if w == 4 {
+                        self.d_b[(o + i) * nb + o + 2 + j] -= kd;
+                        self.d_b[(o + 2 + i) * nb + o + j] -= kd;
+                        self.d_b[(o + 2 + i) * nb + o + 2 + j] += kd;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Bearing `li`'s force and derivatives at the iterate: the film (or its linearisation),
+    /// the prehistory relaxation of its coefficients when `relax`, and the film's fluid
+    /// inertia −m ä with the Newmark acceleration ä = a0 (d − d_n) − a1 ḋ_n − d̈_n.
+    fn link_force(
+        &mut self,
+        li: usize,
+        nm: Newmark,
+        speed: f64,
+        time: f64,
+        fresh: bool,
+        relax: bool,
+    ) -> Result<LinkEvaluation, Option<TwinError>> {
+        let link = &mut self.links[li];
+        let (o, pedestal) = (link.b_offset, link.pedestal.is_some());
+        let rel = |v: &dyn Fn(usize) -> f64| -> [f64; 2] {
+            if pedestal {
+                [v(o) - v(o + 2), v(o + 1) - v(o + 3)]
+            } else {
+                [v(o), v(o + 1)]
+            }
+        };
+        let (qb, b_dofs, s) = (&self.qb, &self.b_dofs, &self.state);
+        let d = rel(&|r| qb[r]);
+        let v = rel(&|r| nm.a2 * (qb[r] - s.q[b_dofs[r]]) - s.qd[b_dofs[r]]);
+        let mut ev = match self.config.coupling {
+            Coupling::Linear => link.evaluate_linear(d, v),
+            _ => link
+                .evaluate(d, v, speed, &self.config.contact, fresh)
+                .map_err(|cause| {
+                    Some(TwinError::Film {
+                        bearing: link.name.clone(),
+                        time_s: time,
+                        cause,
+                    })
+                })?,
+        };
+        let m = ev.added_mass_kg;
+        if m != [[0.0; 2]; 2] {
+            let acc = rel(&|r| {
+                let d = b_dofs[r];
+                nm.a0 * (qb[r] - s.q[d]) - nm.a1 * s.qd[d] - s.qdd[d]
+            });
+            for i in 0..2 {
+                ev.force_n[i] -= m[i][0] * acc[0] + m[i][1] * acc[1];
+            }
+        }
+        if relax {
+            self.relax_prehistory(li, &mut ev, fresh);
+        }
+        Ok(ev)
+    }
+
+    /// Seed eq. 8 on bearing `li`'s film coefficients, c(k+1) = δ c(k) + (1 − δ) c(k−1), computed
+    /// on a `fresh` evaluation and kept as the iteration matrix; the wall's stiffness (contact)
+    /// is not a film coefficient and is never relaxed.
+    fn relax_prehistory(&mut self, li: usize, ev: &mut LinkEvaluation, fresh: bool) {
+        let Coupling::Prehistory { delta } = self.config.coupling else {
+            return;
+        };
+        if fresh {
+            let raw = FilmCoefficients {
+                stiffness_n_per_m: ev.film_stiffness,
+                damping_n_s_per_m: ev.damping,
+                ..FilmCoefficients::default()
+            };
+            self.raw[li] = Some(raw);
+            self.relaxed[li] = match self.links[li].previous_raw {
+                Some(prev) => raw.scaled(delta).plus(&prev.scaled(1.0 - delta)),
+                None => raw,
+            };
+        }
+        let r = self.relaxed[li];
+        for i in 0..2 {
+            for j in 0..2 {
+                let wall = ev.stiffness[i][j] - ev.film_stiffness[i][j];
+                ev.stiffness[i][j] = wall + r.stiffness_n_per_m[i][j];
+                ev.damping[i][j] = r.damping_n_s_per_m[i][j];
+            }
+        }
+    }
+
+    /// One Newton move Δ = −J⁻¹ g, g = q_B − a − S f_B, J = I + S D, limited to a fifth of the
+    /// clearance, and f_B carried to the new iterate as f_B − D Δ. Ok(true) when converged.
+    fn newton_move(&mut self, level: usize) -> Result<bool, Option<TwinError>> {
+        let nb = self.b_dofs.len();
+        let sm = &self.factors[level].s;
+        for i in 0..nb {
+            let mut g = self.qb[i] - self.a_b[i];
+            for k in 0..nb {
+                g -= sm[i * nb + k] * self.f_b[k];
+            }
+            self.delta[i] = -g;
+            for j in 0..nb {
+                let mut v = if i == j { 1.0 } else { 0.0 };
+                for k in 0..nb {
+                    v += sm[i * nb + k] * self.d_b[k * nb + j];
+                }
+                self.jac[i * nb + j] = v;
+            }
+        }
+        if !solve_small(&self.jac, &mut self.delta, nb) {
             return Err(None);
         }
+        let mut largest = 0.0_f64;
+        for link in &self.links {
+            let o = link.b_offset;
+            largest = largest.max(self.delta[o].hypot(self.delta[o + 1]) / link.clearance_m);
+        }
+        let scale = if largest > 0.2 { 0.2 / largest } else { 1.0 };
+        for i in 0..nb {
+            self.delta[i] *= scale;
+            self.qb[i] += self.delta[i];
+        }
+        for i in 0..nb {
+            for j in 0..nb {
+                self.f_b[i] -= self.d_b[i * nb + j] * self.delta[j];
+            }
+        }
+        // Newton converges quadratically: after a correction Δ the error left is of order
+        // |Δ|²/c, so a correction below √tol leaves less than tol and needs no further film
+        // solve (the force used is the linearised one at the new iterate, f_B − D Δ)
+        let accept = if self.config.coupling == Coupling::Nonlinear
+            && !self.links.iter().any(|l| l.last.contact)
+        {
+            self.config.newton_tolerance.sqrt()
+        } else {
+            self.config.newton_tolerance
+        };
+        Ok(largest * scale < accept && scale == 1.0)
+    }
 
-        // full state: q = K_eff⁻¹ r + Z f_B
+    /// The full state at the end of the step, q = K_eff⁻¹ r + Z f_B, and its velocity and
+    /// acceleration (Newmark); Err(None) (retry smaller) if any is not finite.
+    fn correct(
+        &mut self,
+        level: usize,
+        nm: Newmark,
+        time: f64,
+        angle: f64,
+        speed: f64,
+    ) -> Result<(), Option<TwinError>> {
         let f = &self.factors[level];
         let next = &mut self.next;
         next.q.copy_from_slice(&self.q_lin);
         f.add_bearing_response(&self.f_b, &mut next.q);
         let s = &self.state;
-        for i in 0..n {
-            next.qdd[i] = a0 * (next.q[i] - s.q[i]) - a1 * s.qd[i] - s.qdd[i];
-            next.qd[i] = s.qd[i] + 0.5 * h * (s.qdd[i] + next.qdd[i]);
+        for i in 0..s.q.len() {
+            next.qdd[i] = nm.a0 * (next.q[i] - s.q[i]) - nm.a1 * s.qd[i] - s.qdd[i];
+            next.qd[i] = s.qd[i] + 0.5 * nm.h * (s.qdd[i] + next.qdd[i]);
         }
         if !next
             .q
@@ -326,13 +400,7 @@ impl Twin {
         next.angle_rad = angle;
         next.speed_rad_s = speed;
         std::mem::swap(&mut self.state, &mut self.next);
-        if let Coupling::Prehistory { .. } = self.config.coupling {
-            for (l, r) in self.links.iter_mut().zip(&self.raw) {
-                l.previous_raw = *r;
-            }
-        }
-        self.fallbacks += usize::from(fallback);
-        Ok(iterations + total_iterations)
+        Ok(())
     }
 
     fn add_unbalance(&mut self, angle: f64, speed: f64, accel: f64) {
@@ -345,6 +413,26 @@ impl Twin {
             if ry != HELD {
                 self.rhs[ry] += fy;
             }
+        }
+    }
+}
+
+/// The average-acceleration Newmark constants of a step h: a0 = 4/h², a1 = 4/h, a2 = 2/h.
+#[derive(Debug, Clone, Copy)]
+struct Newmark {
+    h: f64,
+    a0: f64,
+    a1: f64,
+    a2: f64,
+}
+
+impl Newmark {
+    fn of(h: f64) -> Self {
+        Self {
+            h,
+            a0: 4.0 / (h * h),
+            a1: 4.0 / h,
+            a2: 2.0 / h,
         }
     }
 }

@@ -75,6 +75,7 @@ impl FilmModel for TabulatedFilm {
             FilmCoefficients {
                 stiffness_n_per_m: k,
                 damping_n_s_per_m: d,
+                ..FilmCoefficients::default()
             },
         ))
     }

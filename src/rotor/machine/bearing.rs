@@ -5,7 +5,9 @@
 
 use super::rules::Rules;
 use super::LubricantSpec;
-use crate::film::{BearingGeometry, FilmCoefficients, FilmGrid, Lubricant, WaltherLaw};
+use crate::film::{
+    BearingGeometry, FilmCoefficients, FilmGrid, FluidInertia, Lubricant, WaltherLaw,
+};
 use crate::rotor::ConfigError;
 use serde::{Deserialize, Serialize};
 
@@ -72,6 +74,14 @@ pub struct RawBearingSpec {
     /// Linear bearings: `[[cxx, cxy], [cyx, cyy]]` (N·s/m); zero if absent.
     #[serde(default)]
     damping_n_s_per_m: Option<[[f64; 2]; 2]>,
+    /// Linear bearings: added mass `[[mxx, mxy], [myx, myy]]` (kg), weightless (a film's fluid
+    /// inertia, as bearing codes give it beside K and C); zero if absent.
+    #[serde(default)]
+    added_mass_kg: Option<[[f64; 2]; 2]>,
+    /// Film bearings: `none` (default, the seed's model) or `temporal`, the film's temporal
+    /// fluid inertia as added-mass coefficients ([`crate::film::FilmInertia`]).
+    #[serde(default)]
+    fluid_inertia: FluidInertia,
     /// Flexible support under the bearing (the seed's C_mn, D_mn); rigid if absent.
     #[serde(default)]
     support: Option<SupportSpec>,
@@ -116,6 +126,8 @@ pub struct FilmSpec {
     pub viscosity_law: Option<WaltherLaw>,
     /// Finite-volume grid over the half bearing.
     pub grid: FilmGrid,
+    /// Whether the film carries its fluid inertia (added mass).
+    pub fluid_inertia: FluidInertia,
 }
 
 /// A pedestal: a mass on a spring–damper to the ground, carrying the bearing.
@@ -154,6 +166,7 @@ impl RawBearingSpec {
     /// cannot use.
     pub(super) fn parse(self, i: usize, rules: &Rules) -> Result<BearingSpec, ConfigError> {
         let field = |name: &str| format!("bearings[{i}].{name}");
+        self.refuse_fields_of_other_models(i, rules)?;
         let model = match self.model {
             BearingModelName::Finite => BearingModelSpec::Finite(self.film(i, rules)?),
             BearingModelName::Short => {
@@ -189,6 +202,29 @@ impl RawBearingSpec {
             model,
             support: self.support,
         })
+    }
+
+    /// The inertia fields of the other kind of bearing: refused, not ignored.
+    fn refuse_fields_of_other_models(&self, i: usize, rules: &Rules) -> Result<(), ConfigError> {
+        let film = matches!(
+            self.model,
+            BearingModelName::Finite | BearingModelName::Short
+        );
+        if film && self.added_mass_kg.is_some() {
+            return Err(rules.error(
+                format!("bearings[{i}].added_mass_kg"),
+                "(given)",
+                "is for linear bearings; a film bearing's comes from `fluid_inertia: temporal`",
+            ));
+        }
+        if !film && self.fluid_inertia != FluidInertia::None {
+            return Err(rules.error(
+                format!("bearings[{i}].fluid_inertia"),
+                "temporal",
+                "is for film bearings; give a linear bearing its `added_mass_kg`",
+            ));
+        }
+        Ok(())
     }
 
     /// The film data of entry `i`.
@@ -238,6 +274,7 @@ impl RawBearingSpec {
             lubricant,
             viscosity_law,
             grid,
+            fluid_inertia: self.fluid_inertia,
         })
     }
 
@@ -292,9 +329,21 @@ impl RawBearingSpec {
                 ));
             }
         }
+        let m = self.added_mass_kg.unwrap_or_default();
+        rules.finite_matrix(field("added_mass_kg"), &m)?;
+        for d in 0..2 {
+            if m[d][d] < 0.0 {
+                return Err(rules.error(
+                    format!("bearings[{i}].added_mass_kg[{d}][{d}]"),
+                    m[d][d],
+                    "a direct added mass must be zero or more",
+                ));
+            }
+        }
         Ok(FilmCoefficients {
             stiffness_n_per_m: k,
             damping_n_s_per_m: c,
+            added_mass_kg: m,
         })
     }
 }
