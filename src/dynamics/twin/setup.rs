@@ -14,10 +14,8 @@ use faer::Mat;
 impl Twin {
     /// Builds the twin of `rotor`, at rest in its static equilibrium on the films at
     /// `speed_rad_s` (rad/s): rigid-support bearing loads, each film's equilibrium under its load,
-    /// the shaft deflected statically and moved rigidly onto the journal positions.
-    // Long (≈220 lines): DOF reduction, film links, static equilibrium and the step factors are
-    // built in order from one set of locals; splitting them into setup stages that pass a
-    // partly built twin is open in issue 10.
+    /// the shaft deflected statically and moved rigidly onto the journal positions, then put on
+    /// the synchronous orbit of the system linearised there.
     pub fn new(rotor: &Rotor, config: TwinConfig, speed_rad_s: f64) -> Result<Self, TwinError> {
         validate_config(&config)?;
         if !(speed_rad_s.is_finite() && speed_rad_s > 0.0) {
@@ -27,179 +25,29 @@ impl Twin {
                 rule: "must be finite and greater than zero",
             });
         }
-        let n_full = rotor.n_dof();
-        let held: Vec<usize> = rotor
-            .bearings
-            .iter()
-            .filter(|b| matches!(b.model, BearingModel::Rigid))
-            .flat_map(|b| b.journal_dofs)
-            .collect();
-        let mut reduced_of = vec![HELD; n_full];
-        let mut full_of = Vec::new();
-        for d in 0..n_full {
-            if !held.contains(&d) {
-                reduced_of[d] = full_of.len();
-                full_of.push(d);
-            }
-        }
-        let n = full_of.len();
-        let sub = |a: &Mat<f64>| Mat::<f64>::from_fn(n, n, |i, j| a[(full_of[i], full_of[j])]);
-        let mut m = sub(&rotor.mass);
-        let mut k = sub(&rotor.stiffness);
-        let mut c = sub(&rotor.damping);
-        let g = sub(&rotor.gyroscopic);
-        // constant-coefficient bearings join the linear part
-        for b in &rotor.bearings {
-            if let BearingModel::Linear(coef) = &b.model {
-                let j = b.journal_dofs.map(|d| reduced_of[d]);
-                let p = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
-                add_relative_block(&mut k, j, p, &coef.stiffness_n_per_m);
-                add_relative_block(&mut c, j, p, &coef.damping_n_s_per_m);
-                // weightless: gravity is M g of the rotor's own mass (below)
-                add_relative_block(&mut m, j, p, &coef.added_mass_kg);
-            }
-        }
-        let gravity_full = rotor.gravity_force();
-        let gravity: Vec<f64> = full_of.iter().map(|&d| gravity_full[d]).collect();
-
-        // film bearings and the condensed DOFs
-        let mut links = Vec::new();
-        let mut b_dofs = Vec::new();
-        for b in &rotor.bearings {
-            if let BearingModel::Film(f) = &b.model {
-                let journal = b.journal_dofs.map(|d| reduced_of[d]);
-                let pedestal = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
-                let b_offset = b_dofs.len();
-                b_dofs.extend(journal);
-                if let Some(p) = pedestal {
-                    b_dofs.extend(p);
-                }
-                links.push(BearingLink {
-                    name: b.name.clone(),
-                    journal,
-                    pedestal,
-                    b_offset,
-                    clearance_m: f.geometry.radial_clearance_m,
-                    radius_m: f.geometry.radius_m(),
-                    viscosity_pa_s: f.lubricant.viscosity_pa_s,
-                    // the linear coupling evaluates films only to re-linearise: direct
-                    film: f.scaled(match (config.film, config.coupling) {
-                        (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.reference_solver(),
-                        (FilmEvaluation::Table, _) => f
-                            .reference_tabulated_solver()
-                            .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", b.name)))?,
-                    }),
-                    linear_reference: None,
-                    previous_raw: None,
-                    inertia: f.inertia,
-                    last: LinkEvaluation::default(),
-                });
-            }
-        }
-        let nb = b_dofs.len();
-
-        // static equilibrium at the starting speed
-        let statics = static_solution(rotor).map_err(|e| TwinError::Setup(e.to_string()))?;
-        let mut q_full = statics.displacement.clone();
-        q_full.resize(n_full, 0.0);
-        let mut journal_abs: Vec<(f64, [f64; 2])> = Vec::new();
-        let mut link_index = 0;
-        for (b, load) in rotor.bearings.iter().zip(&statics.bearing_loads_n) {
-            let z = rotor.node_z_m[b.node];
-            let d = match &b.model {
-                BearingModel::Film(_) => {
-                    let link = &mut links[link_index];
-                    link_index += 1;
-                    let mu = link.viscosity();
-                    let eq = equilibrium_under_load(&mut link.film, mu, *load, speed_rad_s)
-                        .map_err(|cause| TwinError::Film {
-                            bearing: link.name.clone(),
-                            time_s: 0.0,
-                            cause,
-                        })?;
-                    link.linear_reference = Some(LinearReference {
-                        position_m: eq.position_m,
-                        force_n: eq.film.force_n,
-                        coefficients: link.with_added_mass(
-                            eq.coefficients,
-                            eq.position_m,
-                            &eq.film,
-                        ),
-                    });
-                    link.last = LinkEvaluation {
-                        force_n: eq.film.force_n,
-                        stiffness: eq.coefficients.stiffness_n_per_m,
-                        damping: eq.coefficients.damping_n_s_per_m,
-                        film_stiffness: eq.coefficients.stiffness_n_per_m,
-                        added_mass_kg: link
-                            .linear_reference
-                            .map_or([[0.0; 2]; 2], |r| r.coefficients.added_mass_kg),
-                        film: eq.film,
-                        contact: false,
-                        rub_power_w: 0.0,
-                    };
-                    eq.position_m
-                }
-                BearingModel::Linear(coef) => solve2(&coef.stiffness_n_per_m, *load),
-                BearingModel::Rigid => [0.0, 0.0],
-            };
-            // pedestal: its spring carries the journal's load and its own weight
-            let mut p_abs = [0.0, 0.0];
-            if let (Some(p), Some(spec_k)) =
-                (b.pedestal_dofs, pedestal_stiffness(rotor, b.pedestal_dofs))
-            {
-                let mp = rotor.mass[(p[0], p[0])];
-                let f = [
-                    load[0] + mp * rotor.gravity_m_s2[0],
-                    load[1] + mp * rotor.gravity_m_s2[1],
-                ];
-                p_abs = solve2(&spec_k, f);
-                q_full[p[0]] = p_abs[0];
-                q_full[p[1]] = p_abs[1];
-            }
-            if !matches!(b.model, BearingModel::Rigid) {
-                journal_abs.push((z, [p_abs[0] + d[0], p_abs[1] + d[1]]));
-            }
-        }
-        // move the statically deflected shaft rigidly onto the journal positions (exact for two
-        // bearings; a least-squares fit for more)
-        let fit = rigid_fit(&journal_abs);
-        for (node, &z) in rotor.node_z_m.iter().enumerate() {
-            for plane in 0..2 {
-                let (a, slope) = fit[plane];
-                q_full[4 * node + plane] += a + slope * z;
-            }
-            q_full[4 * node + 2] += -fit[1].1; // θx = −dy/dz
-            q_full[4 * node + 3] += fit[0].1; // θy = dx/dz
-        }
-        let mut q: Vec<f64> = full_of.iter().map(|&d| q_full[d]).collect();
+        let sys = ReducedSystem::of(rotor);
+        let (mut links, b_dofs) = film_links(rotor, &sys.reduced_of, &config)?;
+        let q_full = static_start(rotor, &mut links, speed_rad_s)?;
+        let mut q: Vec<f64> = sys.full_of.iter().map(|&d| q_full[d]).collect();
         // start on the synchronous orbit of the linearised system, so that only the nonlinear
         // part of the response has to settle
         let (response, velocity, acceleration) =
-            synchronous_response(rotor, &reduced_of, &m, &c, &g, &k, &links, speed_rad_s);
-        for i in 0..n {
-            q[i] += response[i];
+            synchronous_response(rotor, &sys, &links, speed_rad_s);
+        for (qi, r) in q.iter_mut().zip(&response) {
+            *qi += r;
         }
-
         let mut factors = Vec::new();
         for level in 0..3 {
             let h = config.time_step_s / f64::from(1u32 << level);
             factors.push(
-                StepFactor::new(&m, &c, &g, &k, h, speed_rad_s, &b_dofs).ok_or_else(|| {
-                    TwinError::Setup("the effective stiffness K + 2C/h + 4M/h² is singular".into())
-                })?,
+                StepFactor::new(&sys.m, &sys.c, &sys.g, &sys.k, h, speed_rad_s, &b_dofs)
+                    .ok_or_else(|| {
+                        TwinError::Setup(
+                            "the effective stiffness K + 2C/h + 4M/h² is singular".into(),
+                        )
+                    })?,
             );
         }
-        let probes = rotor
-            .probes
-            .iter()
-            .map(|p| {
-                (
-                    [reduced_of[4 * p.node], reduced_of[4 * p.node + 1]],
-                    p.angles_rad,
-                )
-            })
-            .collect();
         let state = State {
             time_s: 0.0,
             angle_rad: 0.0,
@@ -208,22 +56,52 @@ impl Twin {
             qd: velocity,
             qdd: acceleration,
         };
+        let parts = Parts {
+            sys,
+            links,
+            b_dofs,
+            factors,
+            state,
+        };
+        let mut twin = Self::assemble(rotor, config, parts);
+        twin.fill_output(0, 1);
+        Ok(twin)
+    }
+
+    /// The twin of `rotor` from its built parts, with its scratch allocated once.
+    fn assemble(rotor: &Rotor, config: TwinConfig, parts: Parts) -> Self {
+        let Parts {
+            sys,
+            links,
+            b_dofs,
+            factors,
+            state,
+        } = parts;
+        let (n, nb) = (sys.full_of.len(), b_dofs.len());
+        let probes = rotor
+            .probes
+            .iter()
+            .map(|p| {
+                let r = &sys.reduced_of;
+                ([r[4 * p.node], r[4 * p.node + 1]], p.angles_rad)
+            })
+            .collect();
         let output = StepOutput {
             bearings: vec![BearingState::default(); links.len()],
             probes: vec![ProbeState::default(); rotor.probes.len()],
             ..StepOutput::default()
         };
-        let mut twin = Self {
+        Self {
             config,
-            m_rows: SparseRows::from_dense(&m),
-            c_rows: SparseRows::from_dense(&c),
-            g_rows: SparseRows::from_dense(&g),
-            m,
-            c,
-            g,
-            k,
-            reduced_of,
-            gravity,
+            m_rows: SparseRows::from_dense(&sys.m),
+            c_rows: SparseRows::from_dense(&sys.c),
+            g_rows: SparseRows::from_dense(&sys.g),
+            m: sys.m,
+            c: sys.c,
+            g: sys.g,
+            k: sys.k,
+            reduced_of: sys.reduced_of,
+            gravity: sys.gravity,
             unbalance: rotor.unbalance.clone(),
             external: vec![0.0; n],
             raw: vec![None; links.len()],
@@ -247,43 +125,232 @@ impl Twin {
             jac: vec![0.0; nb * nb],
             delta: vec![0.0; nb],
             output,
+        }
+    }
+}
+
+/// What [`Twin::new`] builds before the twin itself.
+struct Parts {
+    sys: ReducedSystem,
+    links: Vec<BearingLink>,
+    b_dofs: Vec<usize>,
+    factors: Vec<StepFactor>,
+    state: State,
+}
+
+/// The linear part on the DOFs left free by the rigid bearings: M, K, C, G with the
+/// constant-coefficient bearings in them, and gravity.
+struct ReducedSystem {
+    /// Reduced index of each global DOF ([`HELD`] for a rigid bearing's journal).
+    reduced_of: Vec<usize>,
+    /// Global DOF of each reduced one.
+    full_of: Vec<usize>,
+    m: Mat<f64>,
+    k: Mat<f64>,
+    c: Mat<f64>,
+    g: Mat<f64>,
+    /// M g of the rotor's own mass (N): the bearings' added mass is weightless.
+    gravity: Vec<f64>,
+}
+
+impl ReducedSystem {
+    fn of(rotor: &Rotor) -> Self {
+        let n_full = rotor.n_dof();
+        let held: Vec<usize> = rotor
+            .bearings
+            .iter()
+            .filter(|b| matches!(b.model, BearingModel::Rigid))
+            .flat_map(|b| b.journal_dofs)
+            .collect();
+        let mut reduced_of = vec![HELD; n_full];
+        let mut full_of = Vec::new();
+        for d in 0..n_full {
+            if !held.contains(&d) {
+                reduced_of[d] = full_of.len();
+                full_of.push(d);
+            }
+        }
+        let n = full_of.len();
+        let sub = |a: &Mat<f64>| Mat::<f64>::from_fn(n, n, |i, j| a[(full_of[i], full_of[j])]);
+        let (mut m, mut k, mut c) = (sub(&rotor.mass), sub(&rotor.stiffness), sub(&rotor.damping));
+        // constant-coefficient bearings join the linear part
+        for b in &rotor.bearings {
+            if let BearingModel::Linear(coef) = &b.model {
+                let j = b.journal_dofs.map(|d| reduced_of[d]);
+                let p = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
+                add_relative_block(&mut k, j, p, &coef.stiffness_n_per_m);
+                add_relative_block(&mut c, j, p, &coef.damping_n_s_per_m);
+                add_relative_block(&mut m, j, p, &coef.added_mass_kg);
+            }
+        }
+        let gravity_full = rotor.gravity_force();
+        Self {
+            gravity: full_of.iter().map(|&d| gravity_full[d]).collect(),
+            g: sub(&rotor.gyroscopic),
+            reduced_of,
+            full_of,
+            m,
+            k,
+            c,
+        }
+    }
+}
+
+/// The film bearings as the step sees them, and the condensed DOFs (each bearing's journal,
+/// then its pedestal if flexible).
+fn film_links(
+    rotor: &Rotor,
+    reduced_of: &[usize],
+    config: &TwinConfig,
+) -> Result<(Vec<BearingLink>, Vec<usize>), TwinError> {
+    let mut links = Vec::new();
+    let mut b_dofs = Vec::new();
+    for b in &rotor.bearings {
+        let BearingModel::Film(f) = &b.model else {
+            continue;
         };
-        twin.fill_output(0, 1);
-        Ok(twin)
+        let journal = b.journal_dofs.map(|d| reduced_of[d]);
+        let pedestal = b.pedestal_dofs.map(|p| p.map(|d| reduced_of[d]));
+        let b_offset = b_dofs.len();
+        b_dofs.extend(journal);
+        if let Some(p) = pedestal {
+            b_dofs.extend(p);
+        }
+        // the linear coupling evaluates films only to re-linearise: direct
+        let film = match (config.film, config.coupling) {
+            (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.reference_solver(),
+            (FilmEvaluation::Table, _) => f
+                .reference_tabulated_solver()
+                .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", b.name)))?,
+        };
+        links.push(BearingLink {
+            name: b.name.clone(),
+            journal,
+            pedestal,
+            b_offset,
+            clearance_m: f.geometry.radial_clearance_m,
+            radius_m: f.geometry.radius_m(),
+            viscosity_pa_s: f.lubricant.viscosity_pa_s,
+            film: f.scaled(film),
+            linear_reference: None,
+            previous_raw: None,
+            inertia: f.inertia,
+            last: LinkEvaluation::default(),
+        });
+    }
+    Ok((links, b_dofs))
+}
+
+/// The global displacement of the static start at `speed_rad_s`: each film's equilibrium under
+/// its rigid-support load (set as the link's linear reference), pedestals under their loads,
+/// the statically deflected shaft moved rigidly onto the journals (exact for two bearings; a
+/// least-squares fit for more).
+fn static_start(
+    rotor: &Rotor,
+    links: &mut [BearingLink],
+    speed_rad_s: f64,
+) -> Result<Vec<f64>, TwinError> {
+    let statics = static_solution(rotor).map_err(|e| TwinError::Setup(e.to_string()))?;
+    let mut q_full = statics.displacement.clone();
+    q_full.resize(rotor.n_dof(), 0.0);
+    let mut journal_abs: Vec<(f64, [f64; 2])> = Vec::new();
+    let mut films = links.iter_mut();
+    for (b, load) in rotor.bearings.iter().zip(&statics.bearing_loads_n) {
+        let d = match &b.model {
+            BearingModel::Film(_) => match films.next() {
+                Some(link) => link.start_at_equilibrium(*load, speed_rad_s)?,
+                None => [0.0, 0.0],
+            },
+            BearingModel::Linear(coef) => solve2(&coef.stiffness_n_per_m, *load),
+            BearingModel::Rigid => [0.0, 0.0],
+        };
+        // pedestal: its spring carries the journal's load and its own weight
+        let mut p_abs = [0.0, 0.0];
+        if let (Some(p), Some(spec_k)) =
+            (b.pedestal_dofs, pedestal_stiffness(rotor, b.pedestal_dofs))
+        {
+            let mp = rotor.mass[(p[0], p[0])];
+            let f = [
+                load[0] + mp * rotor.gravity_m_s2[0],
+                load[1] + mp * rotor.gravity_m_s2[1],
+            ];
+            p_abs = solve2(&spec_k, f);
+            q_full[p[0]] = p_abs[0];
+            q_full[p[1]] = p_abs[1];
+        }
+        if !matches!(b.model, BearingModel::Rigid) {
+            journal_abs.push((rotor.node_z_m[b.node], [p_abs[0] + d[0], p_abs[1] + d[1]]));
+        }
+    }
+    let fit = rigid_fit(&journal_abs);
+    for (node, &z) in rotor.node_z_m.iter().enumerate() {
+        for plane in 0..2 {
+            let (a, slope) = fit[plane];
+            q_full[4 * node + plane] += a + slope * z;
+        }
+        q_full[4 * node + 2] += -fit[1].1; // θx = −dy/dz
+        q_full[4 * node + 3] += fit[0].1; // θy = dx/dz
+    }
+    Ok(q_full)
+}
+
+impl BearingLink {
+    /// Puts the film at its equilibrium under `load` (N) at `speed_rad_s`: the linear
+    /// reference (with the added mass, if the film carries its inertia) and the last
+    /// evaluation. Returns the journal's position relative to the bearing (m).
+    fn start_at_equilibrium(
+        &mut self,
+        load: [f64; 2],
+        speed_rad_s: f64,
+    ) -> Result<[f64; 2], TwinError> {
+        let mu = self.viscosity();
+        let eq =
+            equilibrium_under_load(&mut self.film, mu, load, speed_rad_s).map_err(|cause| {
+                TwinError::Film {
+                    bearing: self.name.clone(),
+                    time_s: 0.0,
+                    cause,
+                }
+            })?;
+        let coefficients = self.with_added_mass(eq.coefficients, eq.position_m, &eq.film);
+        self.linear_reference = Some(LinearReference {
+            position_m: eq.position_m,
+            force_n: eq.film.force_n,
+            coefficients,
+        });
+        self.last = LinkEvaluation {
+            force_n: eq.film.force_n,
+            stiffness: eq.coefficients.stiffness_n_per_m,
+            damping: eq.coefficients.damping_n_s_per_m,
+            film_stiffness: eq.coefficients.stiffness_n_per_m,
+            added_mass_kg: coefficients.added_mass_kg,
+            film: eq.film,
+            contact: false,
+            rub_power_w: 0.0,
+        };
+        Ok(eq.position_m)
     }
 }
 
 /// The steady 1X unbalance response of the system linearised about the static equilibrium
 /// (film coefficients there): (K_t − Ω²M + iΩ C_t) Q = F_u, solved in real form. Returns
 /// displacement, velocity and acceleration at rotor angle 0 (reduced DOFs). Zeros if singular.
-#[allow(clippy::too_many_arguments)]
 fn synchronous_response(
     rotor: &Rotor,
-    reduced_of: &[usize],
-    m: &Mat<f64>,
-    c: &Mat<f64>,
-    g: &Mat<f64>,
-    k: &Mat<f64>,
+    sys: &ReducedSystem,
     links: &[BearingLink],
     speed: f64,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let n = m.nrows();
-    let mut kt = k.clone();
+    let (m0, c, g, k, reduced_of) = (&sys.m, &sys.c, &sys.g, &sys.k, &sys.reduced_of);
+    let n = m0.nrows();
+    let (mut kt, mut m) = (k.clone(), m0.clone());
     let mut ct = Mat::<f64>::from_fn(n, n, |i, j| c[(i, j)] + speed * g[(i, j)]);
     for l in links {
         if let Some(r) = l.linear_reference {
-            add_relative_block(
-                &mut kt,
-                l.journal,
-                l.pedestal,
-                &r.coefficients.stiffness_n_per_m,
-            );
-            add_relative_block(
-                &mut ct,
-                l.journal,
-                l.pedestal,
-                &r.coefficients.damping_n_s_per_m,
-            );
+            let coef = &r.coefficients;
+            add_relative_block(&mut kt, l.journal, l.pedestal, &coef.stiffness_n_per_m);
+            add_relative_block(&mut ct, l.journal, l.pedestal, &coef.damping_n_s_per_m);
+            add_relative_block(&mut m, l.journal, l.pedestal, &coef.added_mass_kg);
         }
     }
     // [A_r −A_i; A_i A_r], A_r = K_t − Ω²M, A_i = Ω C_t
