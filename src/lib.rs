@@ -21,6 +21,7 @@ pub mod ros;
 pub mod rotor;
 pub mod session;
 pub mod signals;
+pub mod sweep;
 pub mod topics;
 pub mod transient;
 pub mod units;

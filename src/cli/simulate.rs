@@ -4,9 +4,7 @@ use crate::dynamics::Coupling;
 use crate::film::FilmGrid;
 use crate::monitor::RotorState;
 use crate::rotor::{MachineDescription, Rotor};
-use crate::transient::{
-    run_driven, run_transient, Drive, Kick, SpeedHistory, TransientResult, TransientSpec,
-};
+use crate::transient::{run_driven, Drive, Kick, SpeedHistory, TransientResult, TransientSpec};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -584,27 +582,15 @@ pub struct SweepArgs {
 }
 
 #[derive(Debug, Serialize)]
-struct SweepPoint {
-    speed_rpm: f64,
-    state: RotorState,
-    growth_per_rev: f64,
-    max_eccentricity_ratio: f64,
-    subsync_ratio: f64,
-    bearings: Vec<[f64; 3]>,
-}
-
-#[derive(Debug, Serialize)]
 struct SweepReport {
     machine: String,
     model: ModelArg,
     onset_speed_rpm: Option<f64>,
-    points: Vec<SweepPoint>,
+    points: Vec<crate::sweep::SweepPoint>,
     csv: String,
     svg: String,
 }
 
-// Long (≈170 lines): the sweep's logic still lives in the CLI; moving it into the library
-// beside `transient` (the CLI then parses and prints only) is open in issue 10.
 /// What a sweep can check before computing any speed (issue 15, item 20): every speed within
 /// the twin's limit for this machine, and an output directory that can be made.
 fn check_sweep_first(args: &SweepArgs, rotor: &Rotor) -> anyhow::Result<()> {
@@ -621,10 +607,8 @@ fn check_sweep_first(args: &SweepArgs, rotor: &Rotor) -> anyhow::Result<()> {
         .with_context(|| format!("--out: creating {}", args.out.display()))
 }
 
-/// Runs `rotor-twin sweep`: one transient per speed, the table, CSV and onset.
-// Long (≈170 lines): the per-speed loop, its progress and the table printing; moving the sweep
-// into the library (the CLI only parsing and printing) is open in issue 10.
-pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
+/// The sweep's speeds (rpm), checked: finite, positive, ascending, at most 500.
+fn sweep_speeds(args: &SweepArgs) -> anyhow::Result<Vec<f64>> {
     for (name, v) in [
         ("--from-rpm", args.from_rpm),
         ("--to-rpm", args.to_rpm),
@@ -647,114 +631,42 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
         "invalid --step-rpm {}: more than 500 speeds",
         args.step_rpm
     );
-    let (desc, rotor) = args.options.machine()?;
-    let speeds: Vec<f64> = (0..count)
+    Ok((0..count)
         .map(|k| (args.from_rpm + k as f64 * args.step_rpm).min(args.to_rpm))
-        .collect();
+        .collect())
+}
+
+/// Runs `rotor-twin sweep` ([`crate::sweep`]): writes sweep.csv and sweep.svg, prints the table
+/// and the onset.
+pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
+    let speeds = sweep_speeds(args)?;
+    let (desc, rotor) = args.options.machine()?;
     check_sweep_first(args, &rotor)?;
     let specs = speeds
         .iter()
         .map(|&s| args.options.spec(s, &rotor))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(count);
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<std::sync::Mutex<Option<anyhow::Result<TransientResult>>>> =
-        (0..count).map(|_| std::sync::Mutex::new(None)).collect();
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-                if k >= count {
-                    break;
-                }
-                let r = run_transient(&rotor, &specs[k]).map_err(anyhow::Error::from);
-                *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
-                let d = done.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
-                let bar = "#".repeat(30 * d / count);
-                eprint!("\rsweep [{bar:<30}] {d}/{count} speeds");
-            });
-        }
+    let sweep = crate::sweep::run_sweep(&rotor, &specs, |d, count| {
+        let bar = "#".repeat(30 * d / count);
+        eprint!("\rsweep [{bar:<30}] {d}/{count} speeds");
     });
     eprintln!();
-    let mut points = Vec::new();
-    let mut series: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
-    for (k, slot) in results.into_iter().enumerate() {
-        let r = slot
-            .into_inner()
-            .unwrap_or_else(|e| e.into_inner())
-            .unwrap_or_else(|| Err(anyhow::anyhow!("not run")))
-            .with_context(|| format!("transient at {:.0} rpm", speeds[k]))?;
-        if series.is_empty() {
-            series = r
-                .bearing_names
-                .iter()
-                .map(|n| (n.clone(), Vec::new(), Vec::new()))
-                .collect();
-        }
-        let rep = &r.report;
-        for (s, b) in series.iter_mut().zip(&rep.bearings) {
-            s.1.push(0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m));
-            s.2.push(b.subsync_amplitude_m);
-        }
-        points.push(SweepPoint {
-            speed_rpm: speeds[k],
-            state: rep.state,
-            growth_per_rev: r.growth_per_rev(),
-            max_eccentricity_ratio: rep
-                .bearings
-                .iter()
-                .map(|b| b.max_eccentricity_ratio)
-                .fold(0.0, f64::max),
-            subsync_ratio: rep
-                .bearings
-                .iter()
-                .map(|b| b.subsync_ratio)
-                .fold(0.0, f64::max),
-            bearings: rep
-                .bearings
-                .iter()
-                .map(|b| {
-                    [
-                        0.5 * b.orbit_pp_x_m.max(b.orbit_pp_y_m),
-                        b.subsync_amplitude_m,
-                        b.max_pressure_pa,
-                    ]
-                })
-                .collect(),
-        });
-    }
-    // onset: the first speed whose non-synchronous motion grows, or that is classified unstable
-    let onset_speed_rpm = points
-        .iter()
-        .find(|p| p.state != RotorState::Stable || p.growth_per_rev > 0.0)
-        .map(|p| p.speed_rpm);
+    let sweep = sweep?;
     let csv_path = args.out.join("sweep.csv");
     let svg_path = args.out.join("sweep.svg");
-    let mut csv =
-        String::from("speed_rpm,state,growth_per_rev,max_eccentricity_ratio,subsync_ratio");
-    for (name, _, _) in &series {
-        csv.push_str(&format!(
-            ",{name}_amplitude_m,{name}_subsync_amplitude_m,{name}_max_pressure_pa"
-        ));
-    }
-    csv.push('\n');
-    for p in &points {
-        csv.push_str(
-            &format!(
-                "{},{:?},{},{},{}",
-                p.speed_rpm, p.state, p.growth_per_rev, p.max_eccentricity_ratio, p.subsync_ratio
+    std::fs::write(&csv_path, sweep.csv())
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    let series: Vec<(String, Vec<f64>, Vec<f64>)> = sweep
+        .series
+        .iter()
+        .map(|s| {
+            (
+                s.name.clone(),
+                s.amplitude_m.clone(),
+                s.subsync_amplitude_m.clone(),
             )
-            .to_lowercase(),
-        );
-        for b in &p.bearings {
-            csv.push_str(&format!(",{},{},{}", b[0], b[1], b[2]));
-        }
-        csv.push('\n');
-    }
-    std::fs::write(&csv_path, csv).with_context(|| format!("writing {}", csv_path.display()))?;
+        })
+        .collect();
     crate::plot::sweep_svg(
         &svg_path,
         &format!("amplitude–speed characteristic: {}", desc.name),
@@ -764,33 +676,38 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let report = SweepReport {
         machine: desc.name,
         model: args.options.model,
-        onset_speed_rpm,
-        points,
+        onset_speed_rpm: sweep.onset_speed_rpm(),
+        points: sweep.points,
         csv: csv_path.display().to_string(),
         svg: svg_path.display().to_string(),
     };
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        println!(
-            "rotor-twin sweep: {} ({:?} coupling)",
-            report.machine, report.model
-        );
-        for p in &report.points {
-            println!(
-                "  {:>8.0} rpm  {:<8}  growth {:+.4}/rev  max ε {:.3}  sub-sync {:.3}X",
-                p.speed_rpm,
-                format!("{:?}", p.state),
-                p.growth_per_rev,
-                p.max_eccentricity_ratio,
-                p.subsync_ratio
-            );
-        }
-        match report.onset_speed_rpm {
-            Some(s) => println!("  onset of instability: {s:.0} rpm"),
-            None => println!("  stable over the range"),
-        }
-        println!("  wrote {} and {}", report.csv, report.svg);
+    print_sweep(&report, args.json)
+}
+
+/// The sweep's table (or its JSON).
+fn print_sweep(report: &SweepReport, json: bool) -> anyhow::Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+        return Ok(());
     }
+    println!(
+        "rotor-twin sweep: {} ({:?} coupling)",
+        report.machine, report.model
+    );
+    for p in &report.points {
+        println!(
+            "  {:>8.0} rpm  {:<8}  growth {:+.4}/rev  max ε {:.3}  sub-sync {:.3}X",
+            p.speed_rpm,
+            format!("{:?}", p.state),
+            p.growth_per_rev,
+            p.max_eccentricity_ratio,
+            p.subsync_ratio
+        );
+    }
+    match report.onset_speed_rpm {
+        Some(s) => println!("  onset of instability: {s:.0} rpm"),
+        None => println!("  stable over the range"),
+    }
+    println!("  wrote {} and {}", report.csv, report.svg);
     Ok(())
 }
