@@ -19,6 +19,9 @@ enum Workload {
     Orc9000,
     /// One film solve of the seed's bearing (9,000 rpm, 275 N) on a 60 × 10 half-grid.
     Film,
+    /// ORC-9000's renewal of the step factor after a speed change (three substep levels), by
+    /// the band LU and by faer's dense LU.
+    Factor,
 }
 
 /// Measure the cost of the hot paths.
@@ -31,6 +34,10 @@ pub struct BenchArgs {
     /// in the whip (the hardest case: large orbits, contact near the wall).
     #[arg(long)]
     whip: bool,
+    /// ORC-9000: ramp the speed at this rate (rpm/s) from 9,000 rpm while measuring, so that
+    /// the step's factor is renewed every 0.2 % of speed (the worst step shows its cost).
+    #[arg(long)]
+    ramp_rpm_s: Option<f64>,
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
@@ -64,15 +71,20 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let figures = match args.workload {
         Workload::Film => film_cases(args)?,
         Workload::Orc9000 => return orc_9000(args),
+        Workload::Factor => factor_cases(args)?,
     };
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&figures)?);
     } else {
-        outln!(
-            "film solve, seed bearing (D 60 mm, L 30 mm, c 40 µm, 9000 rpm, 275 N), grid {}x{}:",
-            args.grid.n_theta,
-            args.grid.n_z
-        );
+        if args.workload == Workload::Factor {
+            outln!("ORC-9000 step factor renewal (K_eff of 124 DOFs, three substep levels):");
+        } else {
+            outln!(
+                "film solve, seed bearing (D 60 mm, L 30 mm, c 40 µm, 9000 rpm, 275 N), grid {}x{}:",
+                args.grid.n_theta,
+                args.grid.n_z
+            );
+        }
         for f in &figures {
             outln!(
                 "  {:<44} median {:>8.2} µs   p99 {:>8.2} µs   ({} samples, {:.2} active-set passes)",
@@ -92,6 +104,8 @@ struct TwinFigures {
     time_step_us: f64,
     median_step_us: f64,
     p99_step_us: f64,
+    /// The slowest step (µs): with `--ramp-rpm-s`, a factor's renewal (and any preemption).
+    max_step_us: f64,
     mean_step_us: f64,
     real_time_factor: f64,
     newton_iterations_per_step: f64,
@@ -110,10 +124,16 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128)
     };
     let mut twin = Twin::new(&rotor, config, omega)?;
-    let input = StepInput {
+    let mut input = StepInput {
         speed_rad_s: omega,
         accel_rad_s2: 0.0,
     };
+    let ramp = rpm_to_rad_s(args.ramp_rpm_s.unwrap_or(0.0));
+    anyhow::ensure!(
+        ramp.is_finite() && (0.0..=rpm_to_rad_s(10_000.0)).contains(&ramp),
+        "--ramp-rpm-s {:?} must lie between 0 and 10,000 rpm/s",
+        args.ramp_rpm_s
+    );
     if args.whip {
         eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
         for _ in 0..500 * 128 {
@@ -124,7 +144,14 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let mut times = Vec::with_capacity(1 << 20);
     let mut iterations = 0;
     let start = Instant::now();
+    let t0 = twin.time_s();
     while start.elapsed() < budget && times.len() < (1 << 20) {
+        if ramp > 0.0 {
+            // at most 1.5× the start speed: the ramp stays below the twin's limit
+            let t = twin.time_s() - t0 + config.time_step_s;
+            input.speed_rad_s = (omega + ramp * t).min(1.5 * omega);
+            input.accel_rad_s2 = ramp;
+        }
         let t = Instant::now();
         let out = twin.step(&input)?;
         times.push(t.elapsed().as_secs_f64() * 1e6);
@@ -137,15 +164,16 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let h_us = config.time_step_s * 1e6;
     let fig = TwinFigures {
         workload: "ORC-9000",
-        phase: if args.whip {
-            "developed oil whip"
-        } else {
-            "from the synchronous orbit (first seconds)"
+        phase: match (args.whip, ramp > 0.0) {
+            (_, true) => "speed ramp from 9,000 rpm",
+            (true, false) => "developed oil whip",
+            (false, false) => "from the synchronous orbit (first seconds)",
         },
         steps: n,
         time_step_us: h_us,
         median_step_us: pick(0.5),
         p99_step_us: pick(0.99),
+        max_step_us: pick(1.0),
         mean_step_us: total_us / n as f64,
         real_time_factor: h_us * n as f64 / total_us,
         newton_iterations_per_step: iterations as f64 / n as f64,
@@ -155,8 +183,8 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     } else {
         outln!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
         outln!(
-            "  {} steps: median {:.1} µs, p99 {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
-            fig.steps, fig.median_step_us, fig.p99_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step
+            "  {} steps: median {:.1} µs, p99 {:.1} µs, max {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
+            fig.steps, fig.median_step_us, fig.p99_step_us, fig.max_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step
         );
     }
     Ok(())
@@ -259,4 +287,38 @@ fn measure(
         p99_us: pick(0.99),
         mean_active_set_passes: passes as f64 / times.len() as f64,
     })
+}
+
+/// The factor renewal of ORC-9000 at speeds alternating by 1 %, band LU then dense LU.
+fn factor_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
+    use crate::dynamics::{Coupling, Twin, TwinConfig};
+    use crate::rotor::{MachineDescription, Rotor};
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let omega = rpm_to_rad_s(9000.0);
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128);
+    let mut twin = Twin::new(&rotor, config, omega)?;
+    let budget = Duration::from_secs_f64(args.seconds);
+    let time = |twin: &mut Twin, case| {
+        let mut times = Vec::new();
+        let start = Instant::now();
+        while start.elapsed() < budget && times.len() < 100_000 {
+            let speed = omega * if times.len() % 2 == 0 { 1.01 } else { 1.0 };
+            let t = Instant::now();
+            twin.renew_factors(speed);
+            times.push(t.elapsed().as_secs_f64() * 1e6);
+        }
+        times.sort_by(f64::total_cmp);
+        let pick = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+        CaseFigures {
+            case,
+            samples: times.len(),
+            median_us: pick(0.5),
+            p99_us: pick(0.99),
+            mean_active_set_passes: 0.0,
+        }
+    };
+    let band = time(&mut twin, "band LU without pivoting, inverse from it");
+    twin.use_dense_factors();
+    let dense = time(&mut twin, "faer's dense LU with pivoting and inverse");
+    Ok(vec![band, dense])
 }

@@ -13,6 +13,7 @@
 //!   same tolerance as `Nonlinear`; a step whose relaxed iteration does not converge falls back to
 //!   Newton and is counted (`prehistory_fallbacks`).
 
+mod band_lu;
 mod bearing_link;
 mod linear;
 pub use linear::MAX_CONDENSED_DOFS;

@@ -69,12 +69,26 @@ impl Twin {
         if (speed - f.speed_rad_s).abs()
             > self.config.speed_refactor_tolerance * f.speed_rad_s.max(1.0)
         {
-            for f in &mut self.factors {
-                f.refactor(&self.m, &self.c, &self.g, &self.k, speed, &self.b_dofs);
-            }
+            self.renew_factors(speed);
             if self.config.coupling == Coupling::Linear {
                 self.relinearise_films(speed);
             }
+        }
+    }
+
+    /// Factors the step's K_eff again at `speed` (rad/s), every substep level (what a speed
+    /// change beyond the tolerance costs; `rotor-twin bench factor` times it).
+    pub(crate) fn renew_factors(&mut self, speed: f64) {
+        for f in &mut self.factors {
+            f.refactor(&self.m, &self.c, &self.g, &self.k, speed, &self.b_dofs);
+        }
+    }
+
+    /// Drops the band factorisation of every level for good: faer's dense LU from now on (for
+    /// the bench's comparison of the two).
+    pub(crate) fn use_dense_factors(&mut self) {
+        for f in &mut self.factors {
+            f.drop_band();
         }
     }
 
