@@ -31,6 +31,7 @@ macro_rules! outln {
 
 mod bag;
 mod bearing;
+mod bearing_speeds;
 mod bench;
 mod modes;
 mod node;

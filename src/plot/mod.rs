@@ -1,11 +1,13 @@
 //! Plots written as SVG files (plotters' SVG backend).
 
+mod bearing;
 mod campbell;
 mod legend;
 mod replay;
 mod response;
 mod transient;
 
+pub use bearing::{bearing_coefficients_svg, centerline_svg, BearingCurves};
 pub use campbell::campbell_svg;
 pub use replay::{
     amplitude_speed_svg, orbit_comparison_svg, spectrum_comparison_svg, waterfall_svg,
