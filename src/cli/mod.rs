@@ -33,6 +33,7 @@ mod bag;
 mod bearing;
 mod bearing_speeds;
 mod bench;
+mod mode_shapes;
 mod modes;
 mod node;
 mod replay;

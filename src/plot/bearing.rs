@@ -210,6 +210,16 @@ pub fn centerline_svg(path: &Path, b: &BearingCurves) -> anyhow::Result<()> {
             marked.push(i);
         }
     }
+    // the last speed is always marked (in place of a mark too close to it)
+    if let Some(&last) = marked.last() {
+        let end = pts.len() - 1;
+        if last != end {
+            if (pts[last].0 - pts[end].0).hypot(pts[last].1 - pts[end].1) <= 0.06 * c && last > 0 {
+                marked.pop();
+            }
+            marked.push(end);
+        }
+    }
     chart.draw_series(marked.into_iter().map(|i| {
         EmptyElement::at(pts[i])
             + Circle::new((0, 0), 3, blue.filled())
