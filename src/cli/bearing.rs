@@ -1,5 +1,6 @@
 //! `rotor-twin bearing`: static analysis of one journal bearing.
 
+use super::bearing_speeds::{self, SpeedRange, SweptBearing};
 use crate::film::{
     equilibrium_at_eccentricity, equilibrium_under_load, BearingGeometry, Equilibrium, FilmGrid,
     FilmModel, FiniteFilm, Lubricant, ShortFilm,
@@ -8,6 +9,7 @@ use crate::units::rpm_to_rad_s;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
+use std::path::PathBuf;
 
 /// The frame every bearing result is given in.
 pub const FRAME: &str = "x along the static load, y perpendicular to it, 90 deg ahead of x in the \
@@ -78,6 +80,27 @@ pub struct BearingArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Speeds FROM:TO:STEP (rpm): the equilibrium, ε, attitude and eight coefficients at each,
+    /// at a constant load, one line a speed (instead of --speed-rpm).
+    #[arg(long, value_parser = SpeedRange::parse, conflicts_with_all = ["speed_rpm", "eccentricity_ratio"])]
+    speeds: Option<SpeedRange>,
+    /// Machine description (YAML): the bearing (--bearing) and its static load on rigid supports
+    /// are taken from it (with --speeds).
+    #[arg(long, requires = "speeds", conflicts_with_all = [
+        "diameter_m", "length_m", "clearance_m", "viscosity_pa_s", "density_kg_m3", "load_n",
+        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model",
+    ])]
+    config: Option<PathBuf>,
+    /// The machine file's bearing, by name; default its first film bearing.
+    #[arg(long, requires = "config")]
+    bearing: Option<String>,
+    /// Write the eight coefficients, ε and attitude against speed to this SVG (with --speeds).
+    #[arg(long, requires = "speeds")]
+    plot: Option<PathBuf>,
+    /// Write the shaft centerline (journal position in the clearance circle against speed,
+    /// machine frame, 1:1) to this SVG (with --speeds).
+    #[arg(long, requires = "speeds")]
+    centerline_plot: Option<PathBuf>,
 }
 
 /// The `--json` report (field names carry their units).
@@ -110,6 +133,9 @@ struct BearingReport {
 }
 
 pub(crate) fn run(args: &BearingArgs) -> anyhow::Result<()> {
+    if let Some(speeds) = &args.speeds {
+        return run_speeds(args, &speeds.0);
+    }
     let report = analyse(args)?;
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -119,7 +145,50 @@ pub(crate) fn run(args: &BearingArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
+/// `--speeds`: the sweep of the flags' bearing or the machine file's, its table or JSON, plots.
+fn run_speeds(args: &BearingArgs, speeds: &[f64]) -> anyhow::Result<()> {
+    let mut bearing = match &args.config {
+        Some(path) => bearing_speeds::from_machine(path, args.bearing.as_deref())?,
+        None => {
+            let (film, lubricant) = film_from_flags(args)?;
+            let w = args.load_n.unwrap_or(275.0);
+            anyhow::ensure!(
+                w.is_finite() && w > 0.0,
+                "invalid --load-n {w}: the static load (N) must be a finite number greater than zero"
+            );
+            SweptBearing {
+                name: "bearing (flags)".into(),
+                machine: String::new(),
+                model: args.model,
+                grid: match args.model {
+                    ModelKind::Finite => format!("{}x{}", args.grid.n_theta, args.grid.n_z),
+                    ModelKind::Short => "closed form".into(),
+                },
+                film,
+                viscosity_pa_s: lubricant.viscosity_pa_s,
+                load_n: [w, 0.0],
+            }
+        }
+    };
+    let report = bearing_speeds::sweep(&mut bearing, speeds)?;
+    if let Some(path) = &args.plot {
+        crate::plot::bearing_coefficients_svg(path, &bearing_speeds::curves(&report))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.centerline_plot {
+        crate::plot::centerline_svg(path, &bearing_speeds::curves(&report))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        bearing_speeds::print_table(&report)?;
+    }
+    Ok(())
+}
+
+/// The film solver and lubricant of the flags' bearing.
+fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lubricant)> {
     let geometry = match args.grooves {
         Grooves::None => BearingGeometry::plain(args.diameter_m, args.length_m, args.clearance_m),
         Grooves::TwoAxial => BearingGeometry::two_axial_grooves(
@@ -135,10 +204,15 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
     if args.model == ModelKind::Short && args.grooves != Grooves::None {
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
-    let mut model: Box<dyn FilmModel> = match args.model {
+    let model: Box<dyn FilmModel> = match args.model {
         ModelKind::Finite => Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?),
         ModelKind::Short => Box::new(ShortFilm::new(geometry, lubricant)?),
     };
+    Ok((model, lubricant))
+}
+
+fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
+    let (mut model, lubricant) = film_from_flags(args)?;
     let omega = rpm_to_rad_s(args.speed_rpm);
     let eq: Equilibrium = match args.eccentricity_ratio {
         Some(e) => equilibrium_at_eccentricity(model.as_mut(), args.viscosity_pa_s, e, omega),

@@ -31,7 +31,9 @@ macro_rules! outln {
 
 mod bag;
 mod bearing;
+mod bearing_speeds;
 mod bench;
+mod mode_shapes;
 mod modes;
 mod node;
 mod replay;

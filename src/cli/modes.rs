@@ -39,6 +39,16 @@ pub struct ModesArgs {
     /// whatever the machine file's `fluid_inertia` says.
     #[arg(long)]
     fluid_inertia: bool,
+    /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the
+    /// lowest --modes modes (at most 6 drawn).
+    #[arg(long)]
+    shapes_rpm: Option<f64>,
+    /// Write the mode shapes at --shapes-rpm to this SVG file.
+    #[arg(long, requires = "shapes_rpm")]
+    shapes_plot: Option<PathBuf>,
+    /// Write a drawing of the rotor model (shaft, discs, bearings, probes; to scale) to this SVG.
+    #[arg(long)]
+    rotor_plot: Option<PathBuf>,
 }
 
 /// Frequencies set apart as modes of a massless shaft's own mass (Hz).
@@ -72,6 +82,9 @@ struct ModesReport {
     whirl_ratio_at_threshold: Option<f64>,
     threshold_frequency_hz: Option<f64>,
     campbell: Vec<CampbellPoint>,
+    /// The damped mode shapes at `--shapes-rpm` (absent without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mode_shapes: Option<super::mode_shapes::ModeShapes>,
 }
 
 /// The speeds of the Campbell diagram and threshold search, checked: (speeds, from, to, step)
@@ -124,6 +137,12 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let threshold =
         stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
     let criticals = critical_speeds(&points);
+    let shapes = args
+        .shapes_rpm
+        .map(|rpm| super::mode_shapes::mode_shapes(&rotor, &statics, rpm, args.modes))
+        .transpose()
+        .context("mode shapes")?;
+    write_shape_plots(args, &rotor, shapes.as_ref())?;
     let report = ModesReport {
         machine: desc.name.clone(),
         rotor_mass_kg: rotor.rotor_mass_kg(),
@@ -153,6 +172,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         whirl_ratio_at_threshold: threshold.map(|t| t.whirl_ratio),
         threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
         campbell: points,
+        mode_shapes: shapes,
     };
     if let Some(path) = &args.plot {
         crate::plot::campbell_svg(
@@ -172,11 +192,77 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The `--shapes-plot` and `--rotor-plot` drawings.
+fn write_shape_plots(
+    args: &ModesArgs,
+    rotor: &Rotor,
+    shapes: Option<&super::mode_shapes::ModeShapes>,
+) -> anyhow::Result<()> {
+    if let (Some(path), Some(s)) = (&args.shapes_plot, shapes) {
+        let mut panels = super::mode_shapes::panels(s);
+        panels.truncate(6);
+        crate::plot::mode_shapes_svg(
+            path,
+            &format!(
+                "Damped mode shapes at {:.0} rpm: {}",
+                s.speed_rpm, rotor.name
+            ),
+            &panels,
+            &super::mode_shapes::stations(rotor),
+        )
+        .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.rotor_plot {
+        crate::plot::rotor_svg(path, &super::mode_shapes::rotor_drawing(rotor))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
+
 fn print_tables(r: &ModesReport) {
     print_statics(r);
     print_frequencies(r);
     print_campbell(r);
     print_criticals(r);
+    if let Some(s) = &r.mode_shapes {
+        print_shapes(s);
+    }
+}
+
+/// Each mode at the chosen speed: frequency, sense, the largest orbit and the nodes (zero
+/// crossings) of its deflected line.
+fn print_shapes(s: &super::mode_shapes::ModeShapes) {
+    println!("  damped mode shapes at {:.0} rpm:", s.speed_rpm);
+    for (i, m) in s.modes.iter().enumerate() {
+        let largest = m
+            .nodes
+            .iter()
+            .max_by(|a, b| a.semi_major.total_cmp(&b.semi_major));
+        let crossings: Vec<String> = m
+            .nodes
+            .windows(2)
+            .filter(|w| w[0].deflection * w[1].deflection < 0.0)
+            .map(|w| {
+                let t = w[0].deflection / (w[0].deflection - w[1].deflection);
+                format!("{:.3}", w[0].z_m + t * (w[1].z_m - w[0].z_m))
+            })
+            .collect();
+        println!(
+            "    mode {}: {:8.2} Hz {:?}, log dec {:.3}; largest orbit at node {} (z {:.3} m); nodes of \
+             the line at z (m): {}",
+            i + 1,
+            m.frequency_hz,
+            m.direction,
+            super::mode_shapes::shown_log_dec(m.log_dec),
+            largest.map_or(0, |n| n.node),
+            largest.map_or(0.0, |n| n.z_m),
+            if crossings.is_empty() {
+                "none".to_string()
+            } else {
+                crossings.join(", ")
+            }
+        );
+    }
 }
 
 /// Mass, size and the static loads and deflection.

@@ -1,16 +1,22 @@
 //! Plots written as SVG files (plotters' SVG backend).
 
+mod bearing;
 mod campbell;
 mod legend;
+mod mode_shapes;
 mod replay;
 mod response;
+mod rotor;
 mod transient;
 
+pub use bearing::{bearing_coefficients_svg, centerline_svg, BearingCurves};
 pub use campbell::campbell_svg;
+pub use mode_shapes::{mode_shapes_svg, ShapeNode, ShapePanel, ShapeStation};
 pub use replay::{
     amplitude_speed_svg, orbit_comparison_svg, spectrum_comparison_svg, waterfall_svg,
 };
 pub use response::{bode_svg, polar_svg, ResponseCurve};
+pub use rotor::{rotor_svg, BearingGlyph, DiscGlyph, RotorDrawing, SectionGlyph};
 pub use transient::{orbit_svg, pressure_map_svg, spectrum_svg, sweep_svg};
 
 use plotters::coord::Shift;

@@ -23,6 +23,7 @@ pub use machine::{
     RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec, UnbalanceSpec, ViscosityTemperatureSpec,
     DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
 };
+pub(crate) use modal::BearingSolvers;
 pub use modal::{
     campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
     natural_frequencies, stability_threshold, undamped_frequencies_hz, BearingCoefficientSet,
