@@ -188,14 +188,16 @@ fn check_compression(files: Vec<PathBuf>) -> Result<Vec<PathBuf>, BagError> {
     Ok(files)
 }
 
-/// The bytes of `file`, which must be a regular file (not a device or a pipe).
-pub(super) fn read_regular(file: &Path) -> Result<Vec<u8>, BagError> {
+/// `file` opened for reading; it must be a regular file (not a device or a pipe).
+pub(super) fn open_regular(file: &Path) -> Result<super::Source, BagError> {
     let io = |cause| BagError::Io {
         path: file.to_path_buf(),
         cause,
     };
-    if !std::fs::metadata(file).map_err(io)?.is_file() {
+    let f = std::fs::File::open(file).map_err(io)?;
+    let meta = f.metadata().map_err(io)?;
+    if !meta.is_file() {
         return Err(not_regular(file));
     }
-    std::fs::read(file).map_err(io)
+    Ok(super::Source::File(std::sync::Arc::new(f), meta.len()))
 }
