@@ -163,3 +163,20 @@ fn the_limits_of_the_command_line_are_checked() {
     assert_eq!(s.max_bytes, Some(1 << 20));
     assert_eq!(s.max_duration_ns, Some(60_000_000_000));
 }
+
+/// Without metadata.yaml the directory's files are read in the order of their number, as
+/// rosbag2 names them (DIR_2 before DIR_10), and still every message once.
+#[test]
+fn a_split_recording_without_metadata_reads_its_files_by_number() {
+    let dir = scratch("nometa");
+    let split = SplitLimits {
+        max_bytes: None,
+        max_duration_ns: Some(1_000 * MS),
+    };
+    let files = record(&dir, 12_000, split);
+    assert_eq!(files.len(), 12);
+    std::fs::remove_file(dir.join("metadata.yaml")).unwrap();
+    let bag = Bag::read(&dir).unwrap();
+    assert_eq!(bag.files, files);
+    assert_eq!(bag.message_count(), 12_000);
+}
