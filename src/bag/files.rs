@@ -206,6 +206,10 @@ pub(super) fn open_regular(file: &Path) -> Result<super::Source, BagError> {
         path: file.to_path_buf(),
         cause,
     };
+    // checked before opening too: opening a FIFO would wait for a writer
+    if !std::fs::metadata(file).map_err(io)?.is_file() {
+        return Err(not_regular(file));
+    }
     let f = std::fs::File::open(file).map_err(io)?;
     let meta = f.metadata().map_err(io)?;
     if !meta.is_file() {
