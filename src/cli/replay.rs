@@ -280,6 +280,10 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         return run_calibrated(args, &bag, &rotor, &options, &out_dir);
     }
     let (report, comparisons) = replay_with_progress(&bag, &rotor, &options)?;
+    // chunks that could not be read back during the replay (the file changed under it)
+    for n in report.notes.iter().skip(bag.notes.len()) {
+        eprintln!("warning: {}: {n}", args.bag.display());
+    }
     let json = serde_json::to_string_pretty(&report)?;
     std::fs::write(out_dir.join("report.json"), &json)?;
     for c in comparisons.iter().filter(|c| c.samples > 0) {
