@@ -64,9 +64,9 @@ fn delivered(bytes: &[u8], what: &str) -> (usize, Bag) {
     bag.read_file(Path::new("flipped.mcap"), bytes)
         .unwrap_or_else(|e| panic!("{what}: refused: {e}"));
     let mut seen = HashSet::new();
-    for m in &bag.messages {
+    for m in bag.messages() {
         assert_eq!(bag.topics[m.topic].name, "/t", "{what}");
-        let v = from_cdr::<Float64>(bag.payload(m))
+        let v = from_cdr::<Float64>(m.payload())
             .unwrap_or_else(|e| panic!("{what}: undecodable payload delivered: {e}"))
             .data;
         assert!(
@@ -82,7 +82,7 @@ fn delivered(bytes: &[u8], what: &str) -> (usize, Bag) {
         );
         assert!(seen.insert(i), "{what}: message {i} delivered twice");
     }
-    (bag.messages.len(), bag)
+    (bag.message_count(), bag)
 }
 
 #[test]

@@ -120,9 +120,9 @@ fn a_full_disk_stops_the_recording_loudly_and_what_was_written_is_recovered() {
     let bag = work.join("bag");
     let read = Bag::read(&bag).unwrap();
     assert!(
-        read.messages.len() > 1000,
+        read.message_count() > 1000,
         "{} messages readable",
-        read.messages.len()
+        read.message_count()
     );
     let rec = work.join("recovered");
     let (ok, _, err) = run_cli(&[
@@ -140,5 +140,5 @@ fn a_full_disk_stops_the_recording_loudly_and_what_was_written_is_recovered() {
         .values()
         .map(|v| v.as_u64().unwrap())
         .sum();
-    assert_eq!(total as usize, read.messages.len(), "{counts}");
+    assert_eq!(total as usize, read.message_count(), "{counts}");
 }

@@ -172,12 +172,10 @@ fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
     assert!(ok, "{err}");
     let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
     let published = bag
-        .messages
-        .iter()
+        .messages()
         .find(|m| bag.topics[m.topic].name == rotor_twin::topics::UNBALANCE)
         .map(|m| {
-            rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(bag.payload(m))
-                .unwrap()
+            rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(m.payload()).unwrap()
         })
         .expect("the bag publishes its unbalance");
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());

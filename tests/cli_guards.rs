@@ -409,3 +409,67 @@ fn replay_and_calibrate_reuse_their_output_directory() {
     assert!(names.contains(&"notes.txt".into()), "{names:?}");
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// A bag of `speeds_rpm` as /rotor_twin/speed, 10 ms apart (an empty list: the topic without a
+/// message).
+fn speed_bag(name: &str, speeds_rpm: &[f64]) -> PathBuf {
+    use rotor_twin::messages::{Header, RotorSpeed, Time};
+    let dir = scratch(name);
+    let mut rec = rotor_twin::record::Recorder::create(&dir).unwrap();
+    let h = rec
+        .add_topic::<RotorSpeed>(
+            rotor_twin::topics::SPEED,
+            rotor_twin::topics::INPUT_RECORDED,
+        )
+        .unwrap();
+    for (i, rpm) in speeds_rpm.iter().enumerate() {
+        let ns = 1_700_000_000_000_000_000 + i as u64 * 10_000_000;
+        let m = RotorSpeed {
+            header: Header {
+                stamp: Time::from_nanos(ns as i64),
+                frame_id: String::new(),
+            },
+            speed: rpm * std::f64::consts::PI / 30.0,
+            acceleration: 0.0,
+        };
+        rec.write(h, &m, ns, ns).unwrap();
+    }
+    rec.finish().unwrap()
+}
+
+/// A replay in which the twin never starts (an empty bag; speeds all below the minimum speed,
+/// 1,000 rpm; speeds all refused) is an error that says why (issue 15, item 21: it exited 0
+/// with no note); the report is still written.
+#[test]
+fn a_replay_that_never_starts_the_twin_fails_and_says_why() {
+    let cases: [(&str, Vec<f64>, &[&str]); 3] = [
+        ("empty", vec![], &["no message to replay"]),
+        (
+            "slow",
+            vec![500.0; 100],
+            &["of its 100 message(s)", "1000 rpm"],
+        ),
+        (
+            "refused",
+            vec![f64::NAN; 20],
+            &["20 refused on /rotor_twin/speed"],
+        ),
+    ];
+    for (name, speeds, expect) in cases {
+        let bag = speed_bag(&format!("never-{name}"), &speeds);
+        let out = scratch(&format!("never-{name}-out"));
+        let (ok, _, err) = run_cli(&[
+            "replay",
+            bag.to_str().unwrap(),
+            "--no-bag",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok, "{name}: exit 0");
+        assert!(err.contains("the twin never started"), "{name}: {err}");
+        for e in expect {
+            assert!(err.contains(e), "{name}: '{e}' not in {err}");
+        }
+        assert!(out.join("report.json").is_file(), "{name}");
+    }
+}

@@ -171,7 +171,7 @@ fn replay_route(inputs: &[(i64, Msg)], dir: &std::path::Path) -> Vec<(u8, i64, V
     replay(&bag, &rotor(), &options, &mut |_| {}).unwrap();
     let out = Bag::read(&out_dir).unwrap();
     let mut keys = Vec::new();
-    for m in &out.messages {
+    for m in out.messages() {
         let topic = &out.topics[m.topic].name;
         let kind = match topic.as_str() {
             "/rotor_twin/journal_state" => 0,
@@ -182,7 +182,7 @@ fn replay_route(inputs: &[(i64, Msg)], dir: &std::path::Path) -> Vec<(u8, i64, V
             "/rotor_twin/stability_margin" => 5,
             _ => continue,
         };
-        keys.push((kind, m.log_time_ns as i64, out.payload(m).to_vec()));
+        keys.push((kind, m.log_time_ns as i64, m.payload().to_vec()));
     }
     keys.sort();
     keys

@@ -168,8 +168,20 @@ fn directory_mcaps(path: &Path, dir: &Path) -> std::io::Result<Vec<PathBuf>> {
                     .is_ok_and(|r| r.starts_with(dir) && r.is_file())
         })
         .collect();
-    found.sort();
+    // rosbag2's order: DIR_2.mcap before DIR_10.mcap (a split recording's files by number)
+    found.sort_by_key(|p| split_number(p));
     Ok(found)
+}
+
+/// A file name as (stem before its number, number, name): `bag_10.mcap` → ("bag_", 10, …).
+fn split_number(p: &Path) -> (String, u64, String) {
+    let name = p
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let stem = name.split('.').next().unwrap_or("");
+    let digits = stem.len() - stem.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    let (head, number) = stem.split_at(stem.len() - digits);
+    (head.to_string(), number.parse().unwrap_or(0), name.clone())
 }
 
 fn check_compression(files: Vec<PathBuf>) -> Result<Vec<PathBuf>, BagError> {
@@ -188,14 +200,20 @@ fn check_compression(files: Vec<PathBuf>) -> Result<Vec<PathBuf>, BagError> {
     Ok(files)
 }
 
-/// The bytes of `file`, which must be a regular file (not a device or a pipe).
-pub(super) fn read_regular(file: &Path) -> Result<Vec<u8>, BagError> {
+/// `file` opened for reading; it must be a regular file (not a device or a pipe).
+pub(super) fn open_regular(file: &Path) -> Result<super::Source, BagError> {
     let io = |cause| BagError::Io {
         path: file.to_path_buf(),
         cause,
     };
+    // checked before opening too: opening a FIFO would wait for a writer
     if !std::fs::metadata(file).map_err(io)?.is_file() {
         return Err(not_regular(file));
     }
-    std::fs::read(file).map_err(io)
+    let f = std::fs::File::open(file).map_err(io)?;
+    let meta = f.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(file));
+    }
+    Ok(super::Source::File(std::sync::Arc::new(f), meta.len()))
 }

@@ -11,6 +11,14 @@ pub struct NodeArgs {
     /// Record every input and output into this new bag directory (rosbag2 MCAP).
     #[arg(long)]
     record: Option<PathBuf>,
+    /// Largest file of the recording (bytes) before it goes on in the next, DIR_1.mcap, …
+    /// (rosbag2's --max-bag-size); 0: no limit. Default 268435456 (256 MiB).
+    #[arg(long)]
+    record_max_bag_size: Option<u64>,
+    /// Longest span of receive times in one file of the recording (s; rosbag2's
+    /// --max-bag-duration); 0 (the default): no limit.
+    #[arg(long)]
+    record_max_bag_duration: Option<f64>,
     /// ROS arguments: -p name:=value, --params-file F.yaml, -r from:=to.
     #[arg(long = "ros-args", num_args = 0.., allow_hyphen_values = true)]
     ros_args: Vec<String>,
@@ -35,11 +43,22 @@ fn setup(mut args: NodeArgs) -> anyhow::Result<crate::ros::NodeSetup> {
         );
         args.config = args.config.or(tail.config);
         args.record = args.record.or(tail.record);
+        args.record_max_bag_size = args.record_max_bag_size.or(tail.record_max_bag_size);
+        args.record_max_bag_duration = args
+            .record_max_bag_duration
+            .or(tail.record_max_bag_duration);
         args.ros_args.extend(tail.ros_args);
     }
+    let record_split = crate::record::SplitLimits::from_options(
+        args.record_max_bag_size
+            .unwrap_or(crate::record::DEFAULT_MAX_BAGFILE_BYTES),
+        args.record_max_bag_duration.unwrap_or(0.0),
+    )
+    .map_err(anyhow::Error::msg)?;
     Ok(crate::ros::NodeSetup {
         config: args.config,
         record: args.record,
+        record_split,
         ros_args: args.ros_args,
     })
 }
@@ -71,6 +90,25 @@ mod tests {
         let s = setup(top.node).unwrap();
         assert_eq!(s.record, Some(PathBuf::from("run1")));
         assert_eq!(s.ros_args, ["-p", "model:=linear"]);
+        assert_eq!(s.record_split, crate::record::SplitLimits::default());
+    }
+
+    #[test]
+    fn the_recording_split_options_are_taken_and_checked() {
+        let parse = |args: &[&str]| {
+            let all = ["node"].iter().chain(args).copied();
+            setup(Top::try_parse_from(all).unwrap().node)
+        };
+        let s = parse(&["--ros-args", "--", "--record-max-bag-duration", "60"]).unwrap();
+        assert_eq!(s.record_split.max_duration_ns, Some(60_000_000_000));
+        assert_eq!(
+            s.record_split.max_bytes,
+            Some(crate::record::DEFAULT_MAX_BAGFILE_BYTES)
+        );
+        let s = parse(&["--record-max-bag-size", "0"]).unwrap();
+        assert_eq!(s.record_split.max_bytes, None);
+        let e = parse(&["--record-max-bag-size", "10"]).unwrap_err();
+        assert!(e.to_string().contains("--record-max-bag-size 10"), "{e}");
     }
 }
 

@@ -280,10 +280,20 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
         return run_calibrated(args, &bag, &rotor, &options, &out_dir);
     }
     let (report, comparisons) = replay_with_progress(&bag, &rotor, &options)?;
+    // chunks that could not be read back during the replay (the file changed under it)
+    for n in report.notes.iter().skip(bag.notes.len()) {
+        eprintln!("warning: {}: {n}", args.bag.display());
+    }
     let json = serde_json::to_string_pretty(&report)?;
     std::fs::write(out_dir.join("report.json"), &json)?;
     for c in comparisons.iter().filter(|c| c.samples > 0) {
         write_station_plots(&out_dir, c)?;
+    }
+    if let Some(why) = never_started(&report, &options) {
+        anyhow::bail!(
+            "the twin never started: {why}; nothing was modelled (report.json in {})",
+            out_dir.display()
+        );
     }
     // a closed standard output (e.g. piped into `head`) is not an error of the replay
     if args.json {
@@ -295,6 +305,41 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
             out_dir.display()
         ))
     }
+}
+
+/// Why the twin never started in the replay that gave `report`, if it did not: a replay that
+/// modelled nothing is an error (exit 1), as a `ros2 bag` user scripting it would want to know,
+/// not an empty success.
+fn never_started(report: &crate::replay::ReplayReport, options: &ReplayOptions) -> Option<String> {
+    if report.states.iter().any(|s| s.state == "start") {
+        return None;
+    }
+    if report.messages_in == 0 {
+        return Some("the bag has no message to replay".into());
+    }
+    let refused: Vec<String> = report
+        .rejected
+        .iter()
+        .map(|r| {
+            format!(
+                "{} refused on {} (last: {})",
+                r.count, r.topic, r.last_reason
+            )
+        })
+        .collect();
+    Some(format!(
+        "of its {} message(s) replayed{}, none was a speed at or above the minimum speed {:.0} rpm that the twin accepted{}",
+        report.messages_in,
+        options
+            .duration_s
+            .map_or(String::new(), |d| format!(" (the first {d} s, --duration)")),
+        crate::units::rad_s_to_rpm(options.min_speed_rad_s),
+        if refused.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", refused.join("; "))
+        }
+    ))
 }
 
 /// `replay_STEM` in the working directory, for bag `bag`.

@@ -9,8 +9,14 @@
 //! and say so; what was flushed before stays readable.
 
 mod recover;
+mod split;
 
 pub use recover::{recover, resolved_path, RecoverError, Recovered};
+pub use split::{SplitLimits, DEFAULT_MAX_BAGFILE_BYTES, MIN_MAX_BAGFILE_BYTES};
+
+use split::{FileEntry, McapWriter, SizedFile};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 use crate::messages::RosMessage;
 use serde::Serialize;
@@ -76,6 +82,9 @@ impl TopicQos {
 struct TopicEntry {
     name: String,
     type_name: String,
+    /// schema encoding and text (to define the topic again in each new file)
+    encoding: String,
+    schema: Vec<u8>,
     /// RIHS01 type hash ('' where the schema could not be hashed).
     type_hash: String,
     qos: TopicQos,
@@ -126,22 +135,65 @@ impl From<mcap::McapError> for RecordError {
     }
 }
 
-/// Writes one bag directory.
+/// Writes one bag directory: `<name>_0.mcap`, and `<name>_1.mcap`, … when a file reaches the
+/// recording's [`SplitLimits`].
 pub struct Recorder {
     dir: PathBuf,
-    file_name: String,
-    writer: mcap::Writer<BufWriter<File>>,
+    /// the directory's name, the files' stem
+    stem: String,
+    split: SplitLimits,
+    writer: McapWriter,
+    /// how large the current file has grown (bytes)
+    size: Arc<AtomicU64>,
+    /// every file so far, the current one last
+    files: Vec<FileEntry>,
     topics: Vec<TopicEntry>,
     sequence: u32,
-    first_ns: Option<u64>,
-    last_ns: u64,
     last_flush: Instant,
     custom_data: BTreeMap<String, String>,
 }
 
+/// Opens `path` for the MCAP writer, in the rosbag2 conventions.
+fn open_writer(path: &Path) -> Result<(McapWriter, Arc<AtomicU64>), RecordError> {
+    let file = File::create(path).map_err(|cause| RecordError::Io {
+        path: path.to_path_buf(),
+        cause,
+    })?;
+    let (file, size) = SizedFile::new(file);
+    let writer = mcap::WriteOptions::new()
+        .profile("ros2")
+        .library("rotor-twin")
+        // chunks of 64 KiB: a file cut off (a crash, a full disk) loses at most that much
+        .chunk_size(Some(64 * 1024))
+        .create(BufWriter::new(file))
+        .map_err(|e| write_failed(path, e))?;
+    Ok((writer, size))
+}
+
+/// A writer error with its causes in one message (the I/O error, e.g. "No space left on
+/// device", is the MCAP error's source).
+fn write_failed(path: &Path, e: mcap::McapError) -> RecordError {
+    let mut why = e.to_string();
+    let mut cause = std::error::Error::source(&e);
+    while let Some(c) = cause {
+        why = format!("{why}: {c}");
+        cause = c.source();
+    }
+    RecordError::Write {
+        path: path.to_path_buf(),
+        why,
+    }
+}
+
 impl Recorder {
-    /// Creates bag directory `dir` (which must not exist yet, as with `ros2 bag record -o`).
+    /// Creates bag directory `dir` (which must not exist yet, as with `ros2 bag record -o`),
+    /// split into files of [`DEFAULT_MAX_BAGFILE_BYTES`].
     pub fn create(dir: &Path) -> Result<Self, RecordError> {
+        Self::create_split(dir, SplitLimits::default())
+    }
+
+    /// Creates bag directory `dir`, going on in a new file whenever one reaches `split`.
+    pub fn create_split(dir: &Path, split: SplitLimits) -> Result<Self, RecordError> {
         let io = |cause| RecordError::Io {
             path: dir.to_path_buf(),
             cause,
@@ -157,29 +209,16 @@ impl Recorder {
             .file_name()
             .map_or("rotor_twin".into(), |s| s.to_string_lossy().into_owned());
         let file_name = format!("{stem}_0.mcap");
-        let path = dir.join(&file_name);
-        let file = File::create(&path).map_err(|cause| RecordError::Io {
-            path: path.clone(),
-            cause,
-        })?;
-        let writer = mcap::WriteOptions::new()
-            .profile("ros2")
-            .library("rotor-twin")
-            // chunks of 64 KiB: a file cut off (a crash, a full disk) loses at most that much
-            .chunk_size(Some(64 * 1024))
-            .create(BufWriter::new(file))
-            .map_err(|e| RecordError::Write {
-                path: path.clone(),
-                why: e.to_string(),
-            })?;
+        let (writer, size) = open_writer(&dir.join(&file_name))?;
         let rec = Self {
             dir: dir.to_path_buf(),
-            file_name,
+            stem,
+            split,
             writer,
+            size,
+            files: vec![FileEntry::new(file_name)],
             topics: Vec::new(),
             sequence: 0,
-            first_ns: None,
-            last_ns: 0,
             last_flush: Instant::now(),
             custom_data: BTreeMap::new(),
         };
@@ -189,22 +228,35 @@ impl Recorder {
 
     /// The .mcap file being written.
     pub fn file(&self) -> PathBuf {
-        self.dir.join(&self.file_name)
+        let current = self.files.last().map_or("", |f| f.name.as_str());
+        self.dir.join(current)
     }
 
-    /// A writer error with its causes in one message (the I/O error, e.g. "No space left on
-    /// device", is the MCAP error's source).
+    /// Every .mcap file of the recording so far, the one being written last.
+    pub fn files(&self) -> Vec<PathBuf> {
+        self.files.iter().map(|f| self.dir.join(&f.name)).collect()
+    }
+
     fn failed(&self, e: mcap::McapError) -> RecordError {
-        let mut why = e.to_string();
-        let mut cause = std::error::Error::source(&e);
-        while let Some(c) = cause {
-            why = format!("{why}: {c}");
-            cause = c.source();
+        write_failed(&self.file(), e)
+    }
+
+    /// Finishes the current file (its summary written) and goes on in the next one, with every
+    /// topic defined again; metadata.yaml then lists it.
+    fn roll_over(&mut self) -> Result<(), RecordError> {
+        let name = format!("{}_{}.mcap", self.stem, self.files.len());
+        let (mut writer, size) = open_writer(&self.dir.join(&name))?;
+        for t in &mut self.topics {
+            t.channel = define_topic(&mut writer, t)?;
         }
-        RecordError::Write {
-            path: self.file(),
-            why,
-        }
+        let done = self.file();
+        let mut old = std::mem::replace(&mut self.writer, writer);
+        self.size = size;
+        self.files.push(FileEntry::new(name));
+        old.finish().map_err(|e| write_failed(&done, e))?;
+        std::io::Write::flush(&mut old.into_inner())
+            .map_err(|e| write_failed(&done, mcap::McapError::Io(e)))?;
+        self.write_metadata()
     }
 
     /// Writes metadata.yaml as the recording stands (atomically: a kill while writing leaves
@@ -270,20 +322,18 @@ impl Recorder {
         if let Some(i) = self.topics.iter().position(|t| t.name == name) {
             return Ok(i);
         }
-        let schema = self.writer.add_schema(type_name, encoding, schema)?;
-        let metadata = BTreeMap::from([
-            ("offered_qos_profiles".to_string(), qos.rosbag2_yaml()),
-            ("topic_type_hash".to_string(), type_hash.clone()),
-        ]);
-        let channel = self.writer.add_channel(schema, name, "cdr", &metadata)?;
-        self.topics.push(TopicEntry {
+        let mut entry = TopicEntry {
             name: name.into(),
             type_name: type_name.into(),
+            encoding: encoding.into(),
+            schema: schema.to_vec(),
             type_hash,
             qos,
-            channel,
+            channel: 0,
             count: 0,
-        });
+        };
+        entry.channel = define_topic(&mut self.writer, &entry)?;
+        self.topics.push(entry);
         Ok(self.topics.len() - 1)
     }
 
@@ -322,12 +372,15 @@ impl Recorder {
         log_time_ns: u64,
         publish_time_ns: u64,
     ) -> Result<(), RecordError> {
-        let entry = self
-            .topics
-            .get_mut(topic)
-            .ok_or_else(|| RecordError::UnknownTopic(format!("#{topic}")))?;
+        if topic >= self.topics.len() {
+            return Err(RecordError::UnknownTopic(format!("#{topic}")));
+        }
+        let current = self.files.last().and_then(|f| f.first_ns);
+        if (self.split).full(self.size.load(Ordering::Relaxed), current, log_time_ns) {
+            self.roll_over()?;
+        }
         self.sequence = self.sequence.wrapping_add(1);
-        let channel = entry.channel;
+        let channel = self.topics[topic].channel;
         self.writer
             .write_to_known_channel(
                 &mcap::records::MessageHeader {
@@ -340,8 +393,9 @@ impl Recorder {
             )
             .map_err(|e| self.failed(e))?;
         self.topics[topic].count += 1;
-        self.first_ns = Some(self.first_ns.map_or(log_time_ns, |f| f.min(log_time_ns)));
-        self.last_ns = self.last_ns.max(log_time_ns);
+        if let Some(f) = self.files.last_mut() {
+            f.note(log_time_ns);
+        }
         Ok(())
     }
 
@@ -384,8 +438,14 @@ impl Recorder {
     }
 
     fn metadata_yaml(&self) -> String {
-        let start = self.first_ns.unwrap_or(0);
-        let duration = self.last_ns.saturating_sub(start);
+        let start = self
+            .files
+            .iter()
+            .filter_map(|f| f.first_ns)
+            .min()
+            .unwrap_or(0);
+        let last = self.files.iter().map(|f| f.last_ns).max().unwrap_or(0);
+        let duration = last.saturating_sub(start);
         let total: u64 = self.topics.iter().map(|t| t.count).sum();
         let mut topics = String::new();
         for t in &self.topics {
@@ -403,21 +463,51 @@ impl Recorder {
                 if t.type_hash.is_empty() { "''" } else { &t.type_hash }
             ));
         }
+        let paths: String = self
+            .files
+            .iter()
+            .map(|f| format!("  - {}\n", f.name))
+            .collect();
+        let files: String = self
+            .files
+            .iter()
+            .map(|f| {
+                let first = f.first_ns.unwrap_or(start);
+                format!(
+                    "  - path: {}\n    starting_time:\n      nanoseconds_since_epoch: {first}\n    duration:\n      nanoseconds: {}\n    message_count: {}\n",
+                    f.name,
+                    f.last_ns.saturating_sub(first),
+                    f.count
+                )
+            })
+            .collect();
         format!(
-            "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n  - {file}\n  files:\n  - path: {file}\n    starting_time:\n      nanoseconds_since_epoch: {start}\n    duration:\n      nanoseconds: {duration}\n    message_count: {total}\n  custom_data: {custom}\n  ros_distro: jazzy\n",
-            file = self.file_name,
-            custom = if self.custom_data.is_empty() {
-                "{}".to_string()
-            } else {
-                // JSON strings are valid YAML scalars (quotes and escapes included)
-                let quote = |v: &String| serde_json::to_string(v).unwrap_or_default();
-                let items: String = self
-                    .custom_data
-                    .iter()
-                    .map(|(k, v)| format!("\n    {}: {}", quote(k), quote(v)))
-                    .collect();
-                items
-            }
+            "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: mcap\n  duration:\n    nanoseconds: {duration}\n  starting_time:\n    nanoseconds_since_epoch: {start}\n  message_count: {total}\n  topics_with_message_count:\n{topics}  compression_format: ''\n  compression_mode: ''\n  relative_file_paths:\n{paths}  files:\n{files}  custom_data: {custom}\n  ros_distro: jazzy\n",
+            custom = self.custom_data_yaml()
         )
     }
+
+    /// metadata.yaml's `custom_data`.
+    fn custom_data_yaml(&self) -> String {
+        if self.custom_data.is_empty() {
+            return "{}".to_string();
+        }
+        // JSON strings are valid YAML scalars (quotes and escapes included)
+        let quote = |v: &String| serde_json::to_string(v).unwrap_or_default();
+        self.custom_data
+            .iter()
+            .map(|(k, v)| format!("\n    {}: {}", quote(k), quote(v)))
+            .collect()
+    }
+}
+
+/// Defines topic `t` (its schema and channel, with the metadata rosbag2 Jazzy writes:
+/// `offered_qos_profiles` and `topic_type_hash`) in `writer`; returns its channel id.
+fn define_topic(writer: &mut McapWriter, t: &TopicEntry) -> Result<u16, RecordError> {
+    let schema = writer.add_schema(&t.type_name, &t.encoding, &t.schema)?;
+    let metadata = BTreeMap::from([
+        ("offered_qos_profiles".to_string(), t.qos.rosbag2_yaml()),
+        ("topic_type_hash".to_string(), t.type_hash.clone()),
+    ]);
+    Ok(writer.add_channel(schema, &t.name, "cdr", &metadata)?)
 }

@@ -71,11 +71,13 @@ pub fn recover(input: &Path, out: &Path) -> Result<Recovered, RecoverError> {
         let h = rec.add_topic_raw(&t.name, &t.type_name, &t.schema_encoding, &t.schema, qos)?;
         handles.push(Some(h));
     }
-    for m in bag.messages.iter().chain(&bag.excluded) {
+    let (mut kept, mut excluded) = (bag.messages(), bag.excluded_messages());
+    for m in kept.by_ref().chain(excluded.by_ref()) {
         if let Some(h) = handles[m.topic] {
-            rec.write_cdr(h, bag.payload(m), m.log_time_ns, m.publish_time_ns)?;
+            rec.write_cdr(h, m.payload(), m.log_time_ns, m.publish_time_ns)?;
         }
     }
+    notes.extend(kept.problems().iter().chain(excluded.problems()).cloned());
     rec.set_custom_data("recovered_from", &input.display().to_string());
     let counts = rec.counts();
     let dir = rec.finish()?;

@@ -57,11 +57,11 @@ pub fn angle_samples(
             .find(|(f, _)| f == n)
             .map_or(n.as_str(), |(_, t)| t.as_str())
     };
-    let t0 = bag.messages.first().map_or(0, |m| m.log_time_ns);
+    let t0 = bag.time_span_ns().map_or(0, |(a, _)| a);
     let mut out = vec![Vec::new(); rotor.probes.len()];
     // (time s, angle rad, speed rad/s, accel rad/s²) at the last speed message
     let mut last: Option<(f64, f64, f64, f64)> = None;
-    for m in &bag.messages {
+    for m in bag.messages() {
         let t = m.log_time_ns.saturating_sub(t0) as f64 * 1e-9;
         let topic = name(m.topic);
         let type_name = bag.topics[m.topic].type_name.as_str();
@@ -72,7 +72,7 @@ pub fn angle_samples(
             })
         };
         if topic == crate::topics::SPEED && type_name == messages::RotorSpeed::TYPE_NAME {
-            let Ok(s) = from_cdr::<messages::RotorSpeed>(bag.payload(m)) else {
+            let Ok(s) = from_cdr::<messages::RotorSpeed>(m.payload()) else {
                 continue;
             };
             if !(s.speed.is_finite() && s.acceleration.is_finite()) {
@@ -89,7 +89,7 @@ pub fn angle_samples(
             && type_name == messages::ProbeDisplacement::TYPE_NAME
             && (window_s[0]..=window_s[1]).contains(&t)
         {
-            let Ok(p) = from_cdr::<messages::ProbeDisplacement>(bag.payload(m)) else {
+            let Ok(p) = from_cdr::<messages::ProbeDisplacement>(m.payload()) else {
                 continue;
             };
             let (Some(k), Some((angle, w))) = (

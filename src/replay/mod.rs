@@ -216,11 +216,12 @@ pub fn replay(
         forecasting: forecast::Forecasting::for_options(rotor, options, t0 as i64)?,
     };
     let mut last_progress = std::time::Instant::now();
-    for m in &bag.messages {
+    let mut messages = bag.messages();
+    for m in messages.by_ref() {
         if m.log_time_ns > t_end {
             break;
         }
-        run.message(bag, m, roles[m.topic], options.speed_unit);
+        run.message(bag, &m, roles[m.topic], options.speed_unit);
         run.forecast();
         // the report and the output bag
         for o in run.emitted.drain(..) {
@@ -230,7 +231,7 @@ pub fn replay(
             }
         }
         if let Some(out) = out.as_mut() {
-            out.write_input(bag, m)?;
+            out.write_input(&m)?;
         }
         if let Some(rate) = options.rate {
             let due = m.log_time_ns.saturating_sub(t0) as f64 * 1e-9 / rate;
@@ -245,6 +246,7 @@ pub fn replay(
         }
     }
     progress(1.0);
+    run.report.notes.extend(messages.problems().iter().cloned());
     let Replaying {
         mut report,
         comparisons,
@@ -265,7 +267,8 @@ fn driver_for(bag: &Bag, rotor: &Rotor, options: &ReplayOptions, roles: &[Role])
     let mut driver = Driver::new(rotor.clone(), options.driver_settings(rotor));
     driver.set_threshold(crate::session::linear_threshold(rotor));
     let keyphasor_role = |r: &Role| matches!(r, Role::Keyphasor | Role::KeyphasorHeader);
-    if bag.messages.iter().any(|m| keyphasor_role(&roles[m.topic])) {
+    let has_messages = |t: usize| bag.topic_message_count(t) > 0;
+    if (0..roles.len()).any(|t| keyphasor_role(&roles[t]) && has_messages(t)) {
         driver.expect_keyphasor();
     }
     driver
@@ -298,7 +301,7 @@ impl Replaying {
         self.report.messages_in += 1;
         let topic = &bag.topics[m.topic].name;
         let emitted = &mut self.emitted;
-        let fed = match decode(role, bag.payload(m), unit) {
+        let fed = match decode(role, m.payload(), unit) {
             Ok(None) => {
                 self.driver
                     .advance_to(t_ns, usize::MAX, &mut |o| emitted.push(o));
@@ -611,10 +614,10 @@ impl OutputBag {
         })
     }
 
-    fn write_input(&mut self, bag: &Bag, m: &BagMessage) -> Result<(), ReplayError> {
+    fn write_input(&mut self, m: &BagMessage) -> Result<(), ReplayError> {
         if let Some(h) = self.inputs[m.topic] {
             self.rec
-                .write_cdr(h, bag.payload(m), m.log_time_ns, m.publish_time_ns)?;
+                .write_cdr(h, m.payload(), m.log_time_ns, m.publish_time_ns)?;
         }
         Ok(())
     }

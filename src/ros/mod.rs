@@ -56,6 +56,8 @@ pub struct NodeSetup {
     pub config: Option<PathBuf>,
     /// Bag directory to record into.
     pub record: Option<PathBuf>,
+    /// When the recording goes on in a new file (`--record-max-bag-size`, `…-duration`).
+    pub record_split: crate::record::SplitLimits,
     /// Arguments after `--ros-args`.
     pub ros_args: Vec<String>,
 }
@@ -346,6 +348,7 @@ fn start_recorder(
     let (tx, rx) = mpsc::sync_channel::<ToRecord>(65_536);
     let thread = recording::spawn(
         dir,
+        setup.record_split,
         params.speed_type == SpeedType::Float64,
         &params.probe_point_topics,
         rx,

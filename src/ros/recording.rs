@@ -31,17 +31,18 @@ pub(super) enum ToRecord {
     ProbeSignal(messages::ProbeSignal, i64),
 }
 
-/// Starts recording to bag directory `dir` what arrives on `rx` (the speed as std_msgs/Float64
+/// Starts recording to bag directory `dir` (a new file whenever one reaches `split`) what arrives on `rx` (the speed as std_msgs/Float64
 /// if `speed_float64`; the PointStamped probe topics `points` as `(station, topic)`), until `stop`
 /// is set and a quiet moment follows or the senders are gone.
 pub(super) fn spawn(
     dir: &Path,
+    split: crate::record::SplitLimits,
     speed_float64: bool,
     points: &[(String, String)],
     rx: mpsc::Receiver<ToRecord>,
     stop: Arc<AtomicBool>,
 ) -> anyhow::Result<JoinHandle<anyhow::Result<PathBuf>>> {
-    let mut rec = Recorder::create(dir)?;
+    let mut rec = Recorder::create_split(dir, split)?;
     let input = qos::INPUT_RECORDED;
     let h_speed = if speed_float64 {
         rec.add_topic::<messages::Float64>(SPEED, input)?

@@ -85,7 +85,12 @@ pub fn natural_frequencies(
     let s = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
     let eig = s
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| fail(format!("{e:?}")))?;
+        .map_err(|e| {
+            fail(format!(
+                "the symmetric eigenvalue solver failed ({e:?}) on the {n} × {n} mass and stiffness matrices of the free shaft (machine {})",
+                rotor.name
+            ))
+        })?;
     // φ = L⁻ᵀ u, the mode shape (its kinetic energy in the shaft elements tells a massless
     // shaft's own modes)
     let mut phi = eig.U().to_owned();
@@ -318,6 +323,51 @@ pub(crate) fn assembled_matrices(
 /// Eigenvalues λ (Im λ > 0, ascending) of the state-space form ż = A z,
 /// A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]], and the displacement half of each eigenvector on the
 /// global DOFs (held DOFs zero).
+/// What to say when the eigenvalue solver of the damped modes fails (`what`: the solver's
+/// own word, e.g. NoConvergence): the speed, and the bearing coefficient that is not a finite
+/// number or, failing that, the largest one (issue 15, item 21: "NoConvergence" named nothing).
+fn eigen_failure(
+    what: &str,
+    rotor: &Rotor,
+    speed_rad_s: f64,
+    coefficients: &[FilmCoefficients],
+) -> String {
+    const NAMES: [[&str; 2]; 2] = [["xx", "xy"], ["yx", "yy"]];
+    let mut entries = Vec::new();
+    for (b, c) in rotor.bearings.iter().zip(coefficients) {
+        for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let n = NAMES[i][j];
+            entries.push((
+                b.name.as_str(),
+                format!("k_{n}"),
+                c.stiffness_n_per_m[i][j],
+                "N/m",
+            ));
+            entries.push((
+                b.name.as_str(),
+                format!("c_{n}"),
+                c.damping_n_s_per_m[i][j],
+                "N·s/m",
+            ));
+        }
+    }
+    let bad = entries.iter().find(|e| !e.2.is_finite());
+    let largest = entries
+        .iter()
+        .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()));
+    let cause = match (bad, largest) {
+        (Some((b, f, v, u)), _) => format!("bearing {b}: {f} = {v} {u} is not a finite number"),
+        (None, Some((b, f, v, u))) => format!(
+            "every bearing coefficient is finite; the largest is bearing {b}'s {f} = {v:.3e} {u}"
+        ),
+        (None, None) => "the machine has no film bearing".into(),
+    };
+    format!(
+        "the eigenvalue solver failed ({what}) at {:.1} rpm (speed_rad_s = {speed_rad_s}): {cause}",
+        crate::units::rad_s_to_rpm(speed_rad_s)
+    )
+}
+
 fn state_eigen(
     rotor: &Rotor,
     speed_rad_s: f64,
@@ -350,7 +400,14 @@ fn state_eigen(
         (false, false) => -mc[(i - n, j - n)],
     });
     let (a, scale) = balance(a);
-    let eig = a.eigen().map_err(|e| fail(format!("{e:?}")))?;
+    let eig = a.eigen().map_err(|e| {
+        fail(eigen_failure(
+            &format!("{e:?}"),
+            rotor,
+            speed_rad_s,
+            coefficients,
+        ))
+    })?;
     let values = eig.S().column_vector();
     // eigenvectors of the balanced matrix D⁻¹AD are D⁻¹ times those of A
     let u = eig.U();
@@ -685,4 +742,47 @@ pub struct CriticalSpeed {
     pub track: usize,
     /// The mode's log decrement there (interpolated).
     pub log_dec: f64,
+}
+
+#[cfg(test)]
+mod eigen_failure_tests {
+    use super::*;
+
+    /// The damped modes with a NaN film coefficient: an error, or at least no panic; the error
+    /// text names the bearing and the coefficient (issue 15, item 21).
+    #[test]
+    fn an_eigen_failure_names_the_bearing_and_the_coefficient() {
+        let rotor = Rotor::from_description(&crate::rotor::MachineDescription::builtin_default());
+        let mut coefficients = vec![
+            FilmCoefficients {
+                stiffness_n_per_m: [[1e8, 2e7], [-3e7, 9e7]],
+                damping_n_s_per_m: [[1e5, 0.0], [0.0, 1e5]],
+            };
+            rotor.bearings.len()
+        ];
+        coefficients[0].stiffness_n_per_m[0][0] = 2e8;
+        let ok = eigen_failure("NoConvergence", &rotor, 900.0, &coefficients);
+        let first = &rotor.bearings[0].name;
+        assert!(
+            ok.contains("NoConvergence") && ok.contains("8594.4 rpm"),
+            "{ok}"
+        );
+        assert!(
+            ok.contains(&format!("bearing {first}'s k_xx = 2.000e8 N/m")),
+            "{ok}"
+        );
+        let last = rotor.bearings.len() - 1;
+        coefficients[last].damping_n_s_per_m[1][0] = f64::NAN;
+        let bad = eigen_failure("NoConvergence", &rotor, 900.0, &coefficients);
+        let name = &rotor.bearings[last].name;
+        assert!(
+            bad.contains(&format!(
+                "bearing {name}: c_yx = NaN N·s/m is not a finite number"
+            )),
+            "{bad}"
+        );
+        if let Err(e) = damped_modes(&rotor, 900.0, &coefficients) {
+            assert!(e.to_string().contains("c_yx = NaN"), "{e}");
+        }
+    }
 }

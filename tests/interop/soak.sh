@@ -6,7 +6,7 @@
 # NaN, every 1000th stamped 1 h ahead, a malformed sample on each input every 2 s; the node records
 # everything to a bag.
 # Usage (as root): bash tests/interop/soak.sh [--minutes N] [--model nonlinear|linear] [--out DIR]
-#                  [--no-record] [--bin PATH]
+#                  [--no-record] [--bin PATH] [--record-max-bag-size BYTES]
 # Prints the RSS samples' summary; DIR/rss.csv has them all (seconds, kB), DIR/peer.json the peer's
 # counts. Flat means: the RSS at the end is within 5 % of the RSS after 6 minutes of warm-up
 # (1 minute if the run is shorter than 10), and the least-squares slope over the second half of
@@ -15,10 +15,11 @@
 # and the point probe at 100 Hz, 5 s for the probes at 4 kHz); from then on they hold at most that
 # (measured without recording: 90.2 MiB at 360 s, 90.3 MiB at 602 s).
 # --bin PATH: the rotor-twin binary to run (default target/release/rotor-twin; a copy lets you
-# rebuild while a soak runs).
+# rebuild while a soak runs). --record-max-bag-size BYTES: the node's file size limit of the
+# recording (its default, 256 MiB, if absent; 0: one file).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
-minutes=30; model=nonlinear; out=""; record=1; bin="$root/target/release/rotor-twin"
+minutes=30; model=nonlinear; out=""; record=1; bin="$root/target/release/rotor-twin"; max_size=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --minutes) minutes="$2"; shift 2 ;;
@@ -26,6 +27,7 @@ while [ $# -gt 0 ]; do
     --out) out="$2"; shift 2 ;;
     --no-record) record=0; shift ;;
     --bin) bin="$2"; shift 2 ;;
+    --record-max-bag-size) max_size="$2"; shift 2 ;;
     *) echo "soak.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -36,11 +38,13 @@ if [ -z "${ROTOR_TWIN_SOAK_INSIDE:-}" ]; then
   [ -x "$bin" ] || (cd "$root" && cargo build --release)
   # every DDS participant in a private network namespace with loopback only
   exec env ROTOR_TWIN_SOAK_INSIDE=1 SOAK_PY="$py" SOAK_BIN="$bin" unshare -n \
-    bash "$0" --minutes "$minutes" --model "$model" --out "$out" $([ "$record" = 1 ] || echo --no-record)
+    bash "$0" --minutes "$minutes" --model "$model" --out "$out" $([ "$record" = 1 ] || echo --no-record) \
+    $([ -z "$max_size" ] || echo --record-max-bag-size "$max_size")
 fi
 ip link set lo up
 seconds=$(python3 -c "print(int(float('$minutes') * 60))")
 rec_args=(); [ "$record" = 1 ] && { rm -rf "$out/bag"; rec_args=(--record "$out/bag"); }
+[ "$record" = 1 ] && [ -n "$max_size" ] && rec_args+=(--record-max-bag-size "$max_size")
 "$SOAK_BIN" node "${rec_args[@]}" --ros-args -p model:="$model" \
   -p probe_point_topics:=probe_pulley_end=/plant/probe_b > "$out/node.out" 2> "$out/node.err" &
 node=$!
