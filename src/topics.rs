@@ -18,6 +18,9 @@ pub const KEYPHASOR: &str = "/rotor_twin/keyphasor";
 /// Raw proximity-probe readings in (rotor_twin_msgs/ProbeSignal; std_msgs/Float64 topics per
 /// probe by the `probe_signal_topics` mapping): best effort, [`SENSOR_READER`].
 pub const PROBE_SIGNAL: &str = "/rotor_twin/probe_signal";
+/// The 1X vectors and phase lags per probe axis, per block of revolutions
+/// (rotor_twin_msgs/OneXVectors), out: [`STATE`].
+pub const ONE_X: &str = "/rotor_twin/one_x";
 // --- end plant signals ---
 /// Predicted minus measured at a probe station, out.
 pub const RESIDUAL: &str = "/rotor_twin/residual";

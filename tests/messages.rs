@@ -46,6 +46,7 @@ fn rust_types_mirror_the_msg_files() {
     check::<Keyphasor>();
     check::<ProbeSignal>();
     check::<Forecast>();
+    check::<OneXVectors>();
     check::<Float64>();
     check::<PointStamped>();
     check::<Clock>();
@@ -71,6 +72,7 @@ fn every_msg_file_is_mirrored_listed_and_documented() {
         Keyphasor::TYPE_NAME,
         ProbeSignal::TYPE_NAME,
         Forecast::TYPE_NAME,
+        OneXVectors::TYPE_NAME,
     ];
     for entry in std::fs::read_dir(dir.join("msg")).unwrap() {
         let path = entry.unwrap().path();

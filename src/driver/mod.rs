@@ -8,6 +8,7 @@
 
 mod clock;
 pub mod inputs;
+pub mod one_x;
 mod plant_signals;
 pub mod settings;
 
@@ -16,6 +17,7 @@ pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,
 };
+pub use one_x::{OneXBlock, OneXBlocks};
 pub use plant_signals::SignalState;
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 
@@ -79,6 +81,13 @@ pub struct DriverCounts {
     pub step_failures: u64,
     /// Steps taken.
     pub steps: u64,
+    /// Probe samples (pairs, or raw readings paired) that were valid but not compared: no
+    /// twin ran at their time (before the first speed, below the minimum speed, after a
+    /// failed step).
+    pub probes_not_compared: u64,
+    /// Raw probe readings never paired with their station's other probe (the next reading of
+    /// the same probe came first: the other probe's reading was lost or stamped too far off).
+    pub readings_unpaired: u64,
 }
 
 /// The twin of one machine, driven by timed inputs.
@@ -238,8 +247,10 @@ impl Driver {
                 stamp_ns,
             } => self.take_probe_signal(now_ns, &probe, value, stamp_ns, emit),
         };
-        if let Fed::Refused(why) = &fed {
-            self.note_refused(now_ns, why, emit);
+        match &fed {
+            Fed::Refused(why) => self.note_refused(now_ns, why, emit),
+            Fed::Unused => self.counts.probes_not_compared += 1,
+            _ => {}
         }
         self.emit_margin(now_ns, emit);
         fed

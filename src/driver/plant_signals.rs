@@ -293,6 +293,9 @@ impl Driver {
         if self.signals.stations.len() < self.rotor.probes.len() {
             self.signals.stations = vec![RawStation::default(); self.rotor.probes.len()];
         }
+        if self.signals.stations[station].last[axis].is_some() {
+            self.counts.readings_unpaired += 1;
+        }
         self.signals.stations[station].last[axis] = Some((t, d));
         self.pair_station(now_ns, station, axis, emit)
     }
@@ -361,6 +364,14 @@ impl Driver {
             xy = self.remove_ac_mean(station, t0, xy);
         }
         self.compare_probe(now_ns, &StationRef::Index(station), xy, t0, emit)
+    }
+
+    /// The probe axis angles (rad) of every probe station, in axis order: the machine file's
+    /// raw probes where it lists them, else x and y.
+    pub fn probe_axes(&self) -> Vec<[f64; 2]> {
+        (0..self.rotor.probes.len())
+            .map(|k| self.station_axes(k))
+            .collect()
     }
 
     /// The two axis angles (rad) of a raw-probe station, in axis order.

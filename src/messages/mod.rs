@@ -349,6 +349,37 @@ ros_message!(
         value: f64 = "float64",
     }
 );
+
+ros_message!(
+    /// The 1X vectors of one probe station over a block of whole revolutions, per probe axis,
+    /// measured and predicted; phase lags from the keyphasor (API 670), empty when null.
+    OneXVectors, "OneXVectors.msg" {
+        /// Time of the block's last sample; frame: the station.
+        header: Header = "std_msgs/Header",
+        /// Probe station name.
+        station: String = "string",
+        /// Mean speed (rad/s).
+        speed: f64 = "float64",
+        /// Whole revolutions in the block.
+        revolutions: u32 = "uint32",
+        /// Probe samples in the block.
+        samples: u32 = "uint32",
+        /// Probe axis angles (rad).
+        axis_angles: Vec<f64> = "float64[]",
+        /// Measured 1X amplitudes (m).
+        measured_amplitudes: Vec<f64> = "float64[]",
+        /// Measured 1X phase lags (deg); empty when null.
+        measured_phase_lags_deg: Vec<f64> = "float64[]",
+        /// Predicted 1X amplitudes (m).
+        predicted_amplitudes: Vec<f64> = "float64[]",
+        /// Predicted 1X phase lags (deg); empty when null.
+        predicted_phase_lags_deg: Vec<f64> = "float64[]",
+        /// Predicted − measured phase lags (deg); empty when null.
+        phase_lag_errors_deg: Vec<f64> = "float64[]",
+        /// Why the phase lags are empty ('' when keyphasor-referenced).
+        phase_null_reason: String = "string",
+    }
+);
 // --- end plant signals ---
 
 // --- forecast (issue 14) ---

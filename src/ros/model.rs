@@ -4,7 +4,7 @@
 //! falls behind it says so.
 
 use super::params::NodeParams;
-use crate::driver::{Driver, DriverSettings, Input};
+use crate::driver::{Driver, DriverSettings, Fed, Input, OneXBlocks};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
@@ -14,6 +14,17 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// What the model thread hands to the publishing thread: the twin's messages (those of the
+/// driver, shared with the replay) and the node's own (issue 12: the live 1X vectors and the
+/// calibration estimates).
+#[derive(Debug, Clone)]
+pub enum Published {
+    /// A message of the twin.
+    Twin(Outgoing),
+    /// The 1X vectors of one station over a block.
+    OneX(OneXVectors),
+}
 
 /// Inputs waiting for the model thread beyond this many are dropped, oldest first, and counted.
 pub const INBOX_CAPACITY: usize = 65_536;
@@ -55,9 +66,38 @@ pub struct NodeCounters {
     pub publish_failed: AtomicU64,
     /// The recording stopped before the node (e.g. a full disk): what follows is not recorded.
     pub recording_failed: AtomicBool,
+    /// Input samples lost before the node read them, per input topic (gaps in each writer's
+    /// sequence numbers, [`super::loss`]): (topic, count).
+    pub lost_inputs: Mutex<Vec<(String, u64)>>,
+    /// `lost_inputs` in all at the last diagnostics.
+    pub lost_reported: AtomicU64,
 }
 
 impl NodeCounters {
+    /// Registers an input topic for the loss counts; returns its index.
+    pub fn add_topic(&self, topic: &str) -> usize {
+        let mut t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        t.push((topic.to_string(), 0));
+        t.len() - 1
+    }
+
+    /// Counts `n` input samples of topic `index` lost before the node read them.
+    pub fn lost(&self, index: usize, n: u64) {
+        if n == 0 {
+            return;
+        }
+        let mut t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = t.get_mut(index) {
+            e.1 += n;
+        }
+    }
+
+    /// Input samples lost before the node read them, all topics.
+    pub fn lost_total(&self) -> u64 {
+        let t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        t.iter().map(|e| e.1).sum()
+    }
+
     /// Hands `item` to the recorder; a full queue loses it, counted.
     pub fn record<T>(&self, rec: &std::sync::mpsc::SyncSender<T>, item: T) {
         if rec.try_send(item).is_err() {
@@ -174,6 +214,10 @@ pub struct ModelLoop {
     counts_before: crate::driver::DriverCounts,
     /// the forecast thread's link, when `forecast_period_s` > 0 (issue 14)
     forecast: Option<super::forecast::ForecastLink>,
+    /// the live 1X blocks per probe station (issue 12)
+    one_x: OneXBlocks,
+    /// the node's own messages of this wake, sent after the twin's
+    pending: Vec<Published>,
 }
 
 impl ModelLoop {
@@ -195,8 +239,11 @@ impl ModelLoop {
                 *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
             });
         }
+        let driver = Driver::new(rotor.clone(), driver_settings(&params, &rotor));
         Self {
-            driver: Driver::new(rotor.clone(), driver_settings(&params, &rotor)),
+            one_x: OneXBlocks::new(driver.probe_axes()),
+            pending: Vec::with_capacity(64),
+            driver,
             params,
             live,
             seen_version: 0,
@@ -215,20 +262,32 @@ impl ModelLoop {
 
     /// Runs until `stop` is set. Messages go to `out`; when `out` is full a message is dropped
     /// and counted (the model never waits for the bus).
-    pub fn run(mut self, out: SyncSender<Outgoing>, stop: Arc<AtomicBool>) {
+    pub fn run(mut self, out: SyncSender<Published>, stop: Arc<AtomicBool>) {
         self.start_forecast(&out);
         let mut dropped = 0u64;
         while !stop.load(Ordering::Relaxed) {
             let mut emit = |m: Outgoing| {
-                if out.try_send(m).is_err() {
+                if out.try_send(Published::Twin(m)).is_err() {
                     dropped += 1;
                 }
             };
-            if !self.wake(&mut emit) {
+            let busy = self.wake(&mut emit);
+            for m in self.pending.drain(..) {
+                if out.try_send(m).is_err() {
+                    dropped += 1;
+                }
+            }
+            if !busy {
                 std::thread::sleep(Duration::from_millis(1));
             }
             self.dropped_out = dropped;
         }
+    }
+
+    /// The node's own messages of the last wakes (the live 1X vectors, the calibration), for a
+    /// caller that drives [`ModelLoop::wake`] itself (tests).
+    pub fn take_published(&mut self) -> Vec<Published> {
+        std::mem::take(&mut self.pending)
     }
 
     /// One wake: parameter changes, the queued inputs, the steps now due, the reports. False
@@ -251,7 +310,7 @@ impl ModelLoop {
     }
 
     /// Starts the forecast thread when `forecast_period_s` > 0; its messages go to `out`.
-    fn start_forecast(&mut self, out: &SyncSender<Outgoing>) {
+    fn start_forecast(&mut self, out: &SyncSender<Published>) {
         let p = &self.params;
         if p.forecast_period_s <= 0.0 {
             return;
@@ -323,12 +382,31 @@ impl ModelLoop {
             self.timing.steps += steps as u64;
             match input {
                 Ok(input) => {
-                    self.driver.feed(t, input, emit);
+                    let fed = self.driver.feed(t, input, emit);
+                    self.after_feed(&fed);
                 }
                 Err(why) => self.driver.refuse(t, &why, emit),
             }
         }
         any
+    }
+
+    /// What the node makes of a fed input beyond the driver's messages: a compared probe sample
+    /// goes into its station's 1X block, and a finished block is published.
+    fn after_feed(&mut self, fed: &Fed) {
+        let Fed::Compared(c) = fed else {
+            return;
+        };
+        let Some(block) = self.one_x.add(c) else {
+            return;
+        };
+        let name = self
+            .driver
+            .rotor()
+            .probes
+            .get(block.station)
+            .map_or("", |p| p.name.as_str());
+        self.pending.push(Published::OneX(block.to_message(name)));
     }
 
     /// Steps up to `now`, one at a time to time each, at most [`MAX_STEPS_PER_WAKE`].
@@ -530,10 +608,15 @@ impl ModelLoop {
             kv("refused_inputs", counts.refused.to_string()),
             kv("dropped_inputs", dropped_in.to_string()),
         ];
+        let (values, lost_now) = self.loss_values(values);
         let timeout = self.driver.settings().input_timeout_s;
         let (level, message) = match age {
             None => (DiagnosticStatus::STALE, "no speed received yet".into()),
             Some(a) if a > timeout => (DiagnosticStatus::STALE, format!("no speed for {a:.2} s")),
+            Some(_) if lost_now > 0 => (
+                DiagnosticStatus::WARN,
+                format!("{lost_now} input sample(s) lost before the node in the last second"),
+            ),
             Some(_) if refused > 0 => (
                 DiagnosticStatus::WARN,
                 format!("{refused} input(s) refused in the last second"),
@@ -541,6 +624,44 @@ impl ModelLoop {
             Some(_) => (DiagnosticStatus::OK, "speed fresh".into()),
         };
         self.status("inputs", level, message, values)
+    }
+
+    /// Every count of input samples lost or not used, where it happened (issue 15, item 8):
+    /// lost before the node (`lost_samples`, in all and per topic: sequence gaps), queued
+    /// beyond the inbox (`dropped_inputs`, already in `values`), valid probes not compared
+    /// (no twin at their time), raw readings never paired, 1X blocks given up; and the losses
+    /// since the last diagnostics.
+    fn loss_values(&self, mut values: Vec<KeyValue>) -> (Vec<KeyValue>, u64) {
+        let counts = self.driver.counts();
+        let total = self.counters.lost_total();
+        let before = self
+            .counters
+            .lost_reported
+            .swap(total, std::sync::atomic::Ordering::Relaxed);
+        values.push(kv("lost_samples", total.to_string()));
+        for (topic, n) in self
+            .counters
+            .lost_inputs
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .filter(|e| e.1 > 0)
+        {
+            values.push(kv(&format!("lost_samples {topic}"), n.to_string()));
+        }
+        values.push(kv(
+            "probes_not_compared",
+            counts.probes_not_compared.to_string(),
+        ));
+        values.push(kv(
+            "raw_readings_unpaired",
+            counts.readings_unpaired.to_string(),
+        ));
+        values.push(kv(
+            "one_x_blocks_overflowed",
+            self.one_x.overflowed.to_string(),
+        ));
+        (values, total.saturating_sub(before))
     }
 }
 

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The node against signal_peer.py (a plant's keyphasor as std_msgs/Header and raw probes as
+# std_msgs/Float64, best effort, selected by node parameters), recording. Call under `unshare -n`.
+# Args: ROTOR_TWIN_BIN PYTHON OUT_DIR CONFIG SECONDS RPM STOP_KEYPHASOR_AFTER_S LOSS_PER_MILLE
+# LOSS_PER_MILLE > 0: the peer's Cyclone DDS drops that share of the datagrams it sends.
+set -u
+bin="$1"; py="$2"; out="$3"; cfg="$4"; seconds="$5"; rpm="$6"; stop_kp="$7"; loss="$8"
+here="$(cd "$(dirname "$0")" && pwd)"
+ip link set lo up
+rm -rf "$out/bag"
+"$bin" node --config "$cfg" --record "$out/bag" --ros-args -p model:=linear \
+  -p keyphasor_type:=header -r rotor_twin/keyphasor:=/plant/keyphasor \
+  -p probe_signal_topics:=probe_outboard_x=/plant/probe_outboard_x,probe_outboard_y=/plant/probe_outboard_y \
+  > "$out/node.out" 2> "$out/node.err" &
+node=$!
+sleep 1
+if [ "$loss" != "0" ]; then
+  export CYCLONEDDS_URI="<CycloneDDS><Domain><Internal><Test><XmitLossiness>$loss</XmitLossiness></Test></Internal></Domain></CycloneDDS>"
+fi
+timeout 120 "$py" "$here/signal_peer.py" "$seconds" "$rpm" --stop-keyphasor-after "$stop_kp" \
+  > "$out/peer.json" 2> "$out/peer.err"
+unset CYCLONEDDS_URI
+sleep 1.2  # one more diagnostics after the last sample
+kill -INT "$node"
+wait "$node"
+echo "node exit $?" >> "$out/node.err"
+# the node's last input diagnostics as recorded, and the messages recorded per topic
+"$py" - "$out/bag" > "$out/recorded.json" <<'PY'
+import json, sys
+from pathlib import Path
+from rosbags.highlevel import AnyReader
+diag, counts = {}, {}
+with AnyReader([Path(sys.argv[1])]) as r:
+    for c in r.connections:
+        counts[c.topic] = counts.get(c.topic, 0) + c.msgcount
+    conns = [c for c in r.connections if c.topic == "/diagnostics"]
+    for c, t, raw in r.messages(connections=conns):
+        for st in r.deserialize(raw, c.msgtype).status:
+            if st.name.endswith(": inputs"):
+                diag = {kv.key: kv.value for kv in st.values}
+print(json.dumps({"diagnostics": diag, "counts": counts}))
+PY
