@@ -47,6 +47,7 @@ fn rust_types_mirror_the_msg_files() {
     check::<ProbeSignal>();
     check::<Forecast>();
     check::<OneXVectors>();
+    check::<CalibrationEstimate>();
     check::<Float64>();
     check::<PointStamped>();
     check::<Clock>();
@@ -73,6 +74,7 @@ fn every_msg_file_is_mirrored_listed_and_documented() {
         ProbeSignal::TYPE_NAME,
         Forecast::TYPE_NAME,
         OneXVectors::TYPE_NAME,
+        CalibrationEstimate::TYPE_NAME,
     ];
     for entry in std::fs::read_dir(dir.join("msg")).unwrap() {
         let path = entry.unwrap().path();

@@ -23,8 +23,8 @@ fn machine(out: &Path) -> PathBuf {
 }
 
 /// Runs tests/interop/signal_scenario.sh (SECONDS RPM STOP_KEYPHASOR_AFTER LOSS_PER_MILLE) and
-/// returns (peer.json, recorded.json).
-fn scenario(name: &str, args: [&str; 4]) -> (Value, Value) {
+/// returns (peer.json, recorded.json, the node's log).
+fn scenario(name: &str, args: [&str; 4]) -> (Value, Value, String) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let setup = Command::new("bash")
         .arg(root.join("tests/interop/setup-venv.sh"))
@@ -55,7 +55,8 @@ fn scenario(name: &str, args: [&str; 4]) -> (Value, Value) {
             )
         })
     };
-    let got = (read("peer.json"), read("recorded.json"));
+    let log = std::fs::read_to_string(out.join("node.err")).unwrap_or_default();
+    let got = (read("peer.json"), read("recorded.json"), log);
     std::fs::remove_dir_all(&out).ok();
     got
 }
@@ -80,7 +81,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// warns "keyphasor stopped"; the amplitudes go on.
 #[test]
 fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
-    let (peer, rec) = scenario("signals", ["6", "1500", "4", "0"]);
+    let (peer, rec, log) = scenario("signals", ["6", "1500", "4", "0"]);
     let blocks = peer["one_x"].as_array().unwrap();
     let stop = peer["keyphasor_stopped_at_s"].as_f64().unwrap();
     let (mut gaps, mut amps, mut null) = ([Vec::new(), Vec::new()], Vec::new(), 0);
@@ -136,6 +137,22 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
         blocks.len() as u64
     );
     assert_eq!(rec["diagnostics"]["lost_samples"], "0");
+    // the live calibration (calibration_period_s:=2, calibration_apply:=true): the unbalance
+    // from the keyphasor-referenced 1X vectors, published, recorded and applied (logged); no
+    // viscosity from AC-coupled probes, with the reason
+    let cal = &rec["calibration"];
+    println!("calibration: {cal}");
+    assert_eq!(cal["unbalance_valid"], true, "{cal}");
+    assert_eq!(cal["applied"], true, "{cal}");
+    assert_eq!(cal["viscosity_valid"], false, "{cal}");
+    assert!(
+        cal["viscosity_reason"]
+            .as_str()
+            .unwrap()
+            .contains("mean position"),
+        "{cal}"
+    );
+    assert!(log.contains("calibration applied to the twin"), "{log}");
 }
 
 /// The peer's Cyclone DDS drops 5 % of the datagrams it sends (its XmitLossiness test option): a
@@ -145,7 +162,7 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
 /// Before, such losses were invisible (`dropped_messages 0`).
 #[test]
 fn every_sample_lost_on_a_best_effort_link_is_counted() {
-    let (peer, rec) = scenario("signal-loss", ["6", "1500", "100", "50"]);
+    let (peer, rec, _) = scenario("signal-loss", ["6", "1500", "100", "50"]);
     let d = &rec["diagnostics"];
     println!("{d}");
     let mut lost_all = 0;

@@ -6,12 +6,14 @@
 //! (bad, stale or missing input; model failures) and the stability margin. It knows no bus, file
 //! or clock: the same inputs at the same times give the same outputs, whoever feeds them.
 
+pub mod calibration;
 mod clock;
 pub mod inputs;
 pub mod one_x;
 mod plant_signals;
 pub mod settings;
 
+pub use calibration::{Applied, LiveCalibration, LiveEstimate, MeasuredSet};
 pub use clock::{ClockSample, SimClock, CLOCK_CONFIRM, CLOCK_JUMP_S};
 pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
@@ -115,6 +117,11 @@ pub struct Driver {
     oil_temperature_k: Option<f64>,
     /// keyphasor lock and raw-probe state (issue 12)
     signals: SignalState,
+    /// the live calibration in force, if applied (issue 12)
+    calibration: Option<Applied>,
+    /// the viscosity scale of the last accepted oil temperature (kept while a calibrated
+    /// viscosity is in force)
+    oil_scale: Option<f64>,
 }
 
 impl Driver {
@@ -140,6 +147,8 @@ impl Driver {
             counts: DriverCounts::default(),
             oil_temperature_k: None,
             signals: SignalState::default(),
+            calibration: None,
+            oil_scale: None,
         }
     }
 
@@ -358,9 +367,14 @@ impl Driver {
                 return Fed::Taken;
             }
         };
-        for (plane, u) in self.unbalance.iter().enumerate() {
-            if let Some((me, phase)) = *u {
-                // checked when received: the plane exists and the values are finite
+        let calibrated = self
+            .calibration
+            .as_ref()
+            .is_some_and(|c| c.unbalance.is_some());
+        for plane in 0..self.unbalance.len() {
+            if self.unbalance[plane].is_some() || calibrated {
+                let (me, phase) = self.unbalance_in_force(plane);
+                // checked when received or applied: the plane exists and the values are finite
                 let _ = s.twin_mut().set_unbalance(plane, me, phase);
             }
         }
@@ -378,6 +392,16 @@ impl Driver {
             Ok(s) => s,
             Err(why) => return Fed::Refused(why),
         };
+        self.oil_scale = Some(scale);
+        self.oil_temperature_k = Some(t_k);
+        if self
+            .calibration
+            .as_ref()
+            .is_some_and(|c| c.viscosity_scale.is_some())
+        {
+            // a calibrated viscosity is in force; this one comes back with revert_calibration
+            return Fed::Taken;
+        }
         if let Err(e) = self.rotor.set_viscosity_scale(scale) {
             return Fed::Refused(format!("oil temperature: {e}"));
         }
@@ -386,7 +410,6 @@ impl Driver {
                 return Fed::Refused(format!("oil temperature: {e}"));
             }
         }
-        self.oil_temperature_k = Some(t_k);
         Fed::Taken
     }
 

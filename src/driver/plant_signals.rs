@@ -388,7 +388,8 @@ impl Driver {
         a
     }
 
-    fn station_is_ac(&self, station: usize) -> bool {
+    /// True if a probe of raw-probe station `station` is AC-coupled (its mean is the twin's).
+    pub fn station_is_ac(&self, station: usize) -> bool {
         self.rotor.proximity_probes.iter().any(|p| {
             p.station == station && p.coupling == crate::signals::probes::ProbeCoupling::Ac
         })

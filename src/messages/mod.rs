@@ -380,6 +380,63 @@ ros_message!(
         phase_null_reason: String = "string",
     }
 );
+
+ros_message!(
+    /// The live calibration: viscosity from the mean positions, unbalance from the 1X vectors
+    /// (see `msg/msg/CalibrationEstimate.msg`).
+    CalibrationEstimate, "CalibrationEstimate.msg" {
+        /// Time of the estimate.
+        header: Header = "std_msgs/Header",
+        /// 1X vectors used.
+        vectors: u32 = "uint32",
+        /// Mean positions used.
+        positions: u32 = "uint32",
+        /// The viscosity was fitted.
+        viscosity_valid: bool = "bool",
+        /// Why not.
+        viscosity_reason: String = "string",
+        /// µ / µ of the machine file.
+        viscosity_scale: f64 = "float64",
+        /// Its 1σ.
+        viscosity_scale_std: f64 = "float64",
+        /// Effective viscosity (Pa·s).
+        viscosity: f64 = "float64",
+        /// The law gives a temperature.
+        temperature_valid: bool = "bool",
+        /// Oil temperature (K).
+        oil_temperature: f64 = "float64",
+        /// Its 1σ (K).
+        oil_temperature_std: f64 = "float64",
+        /// Offset from the design supply temperature (K).
+        temperature_offset: f64 = "float64",
+        /// Position residual RMS (m).
+        viscosity_residual: f64 = "float64",
+        /// The unbalance was fitted.
+        unbalance_valid: bool = "bool",
+        /// Why not.
+        unbalance_reason: String = "string",
+        /// Node per plane.
+        unbalance_nodes: Vec<u32> = "uint32[]",
+        /// m·e per plane (kg·m).
+        unbalance_magnitudes: Vec<f64> = "float64[]",
+        /// Heavy-spot angle per plane (rad).
+        unbalance_phases: Vec<f64> = "float64[]",
+        /// Correction mass per plane (kg).
+        correction_masses: Vec<f64> = "float64[]",
+        /// Correction angle per plane (rad).
+        correction_angles: Vec<f64> = "float64[]",
+        /// Correction radius (m).
+        correction_radius: f64 = "float64",
+        /// 1X residual RMS (m).
+        unbalance_residual: f64 = "float64",
+        /// Relative 1X residual.
+        unbalance_relative_residual: f64 = "float64",
+        /// Condition number.
+        condition_number: f64 = "float64",
+        /// In force in the running twin.
+        applied: bool = "bool",
+    }
+);
 // --- end plant signals ---
 
 // --- forecast (issue 14) ---

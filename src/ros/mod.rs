@@ -20,6 +20,7 @@
 //! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
 //!   outputs are stamped in simulation time.
 
+mod calibration;
 mod forecast;
 pub mod loss;
 pub mod model;
@@ -489,6 +490,14 @@ fn plant_signal_parameters(params: &NodeParams) -> Vec<(&'static str, ParameterV
             ParameterValue::String(params.keyphasor_type.to_string()),
         ),
         ("probe_signal_topics", ParameterValue::String(signals)),
+        (
+            "calibration_period_s",
+            ParameterValue::Double(params.calibration_period_s),
+        ),
+        (
+            "calibration_apply",
+            ParameterValue::Boolean(params.calibration_apply),
+        ),
     ]
 }
 
@@ -524,6 +533,7 @@ struct Publishers {
     margin: ros2_client::Publisher<messages::StabilityMargin>,
     forecast: ros2_client::Publisher<messages::Forecast>,
     one_x: ros2_client::Publisher<messages::OneXVectors>,
+    calibration: ros2_client::Publisher<messages::CalibrationEstimate>,
 }
 
 fn publisher<M: RosMessage>(
@@ -552,6 +562,7 @@ impl Publishers {
             margin: publisher(node, ros, MARGIN, qos::MARGIN_QOS)?,
             forecast: publisher(node, ros, qos::FORECAST, qos::FORECAST_QOS)?,
             one_x: publisher(node, ros, qos::ONE_X, qos::STATE)?,
+            calibration: publisher(node, ros, qos::CALIBRATION, qos::CALIBRATION_QOS)?,
         })
     }
 
@@ -571,6 +582,9 @@ impl Publishers {
                     let sent = match &item {
                         Published::Twin(o) => self.publish_twin(o),
                         Published::OneX(m) => self.one_x.publish(m.clone()).is_ok(),
+                        Published::Calibration(m) => {
+                            self.calibration.publish((**m).clone()).is_ok()
+                        }
                     };
                     if !sent {
                         counters.publish_failed.fetch_add(1, Ordering::Relaxed);

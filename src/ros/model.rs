@@ -4,7 +4,9 @@
 //! falls behind it says so.
 
 use super::params::NodeParams;
-use crate::driver::{Driver, DriverSettings, Fed, Input, OneXBlocks};
+use crate::driver::{
+    Applied, Driver, DriverSettings, Fed, Input, LiveCalibration, LiveEstimate, OneXBlocks,
+};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
@@ -24,6 +26,8 @@ pub enum Published {
     Twin(Outgoing),
     /// The 1X vectors of one station over a block.
     OneX(OneXVectors),
+    /// The live calibration estimate (boxed: the largest message).
+    Calibration(Box<CalibrationEstimate>),
 }
 
 /// Inputs waiting for the model thread beyond this many are dropped, oldest first, and counted.
@@ -218,6 +222,16 @@ pub struct ModelLoop {
     one_x: OneXBlocks,
     /// the node's own messages of this wake, sent after the twin's
     pending: Vec<Published>,
+    /// the live calibration's measurements, fitting thread and last estimate (issue 12)
+    calibration: LiveCalibration,
+    calibration_worker: Option<super::calibration::CalibrationWorker>,
+    next_calibration_ns: i64,
+    last_estimate: Option<LiveEstimate>,
+    /// `calibration_apply` as last acted upon
+    apply_seen: bool,
+    /// the viscosity scale the threshold was computed at, and whether a computation runs
+    threshold_scale: f64,
+    threshold_busy: Arc<AtomicBool>,
 }
 
 impl ModelLoop {
@@ -232,15 +246,25 @@ impl ModelLoop {
         clock: Arc<NodeClock>,
     ) -> Self {
         let threshold = Arc::new(Mutex::new(None));
-        {
-            let (rotor, threshold) = (rotor.clone(), threshold.clone());
-            std::thread::spawn(move || {
-                let value = crate::session::linear_threshold(&rotor);
-                *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
-            });
-        }
+        let threshold_busy = Arc::new(AtomicBool::new(false));
+        spawn_threshold(&rotor, &threshold, &threshold_busy);
         let driver = Driver::new(rotor.clone(), driver_settings(&params, &rotor));
+        let calibration_worker = (params.calibration_period_s > 0.0)
+            .then(super::calibration::CalibrationWorker::spawn)
+            .and_then(|w| {
+                w.map_err(|e| {
+                    eprintln!("rotor_twin: ERROR: the calibration thread did not start: {e}")
+                })
+                .ok()
+            });
         Self {
+            calibration: LiveCalibration::default(),
+            calibration_worker,
+            next_calibration_ns: i64::MIN,
+            last_estimate: None,
+            apply_seen: false,
+            threshold_scale: rotor.viscosity_scale(),
+            threshold_busy,
             one_x: OneXBlocks::new(driver.probe_axes()),
             pending: Vec::with_capacity(64),
             driver,
@@ -302,6 +326,8 @@ impl ModelLoop {
         };
         let fed = self.feed_inputs(now, emit);
         let steps = self.step_until(now, emit);
+        self.calibrate(now);
+        self.refresh_threshold();
         if let Some(f) = self.forecast.as_mut() {
             f.after_wake(&self.driver);
         }
@@ -407,6 +433,101 @@ impl ModelLoop {
             .get(block.station)
             .map_or("", |p| p.name.as_str());
         self.pending.push(Published::OneX(block.to_message(name)));
+        let dc = !self.driver.station_is_ac(block.station);
+        self.calibration.add(&block, dc);
+    }
+
+    /// The live calibration (issue 12): a change of `calibration_apply` acted upon, a finished
+    /// fit published (and applied while `calibration_apply` is true), the next fit asked for
+    /// every `calibration_period_s`.
+    fn calibrate(&mut self, now: i64) {
+        self.follow_apply(now);
+        let Some(finished) = self.calibration_worker.as_ref().map(|w| w.take()) else {
+            return;
+        };
+        if let Some(e) = finished {
+            if self.params.calibration_apply {
+                self.apply(&e);
+            }
+            let applied = self.driver.calibration().is_some();
+            self.pending
+                .push(Published::Calibration(Box::new(e.to_message(now, applied))));
+            self.last_estimate = Some(e);
+        }
+        if now < self.next_calibration_ns {
+            return;
+        }
+        let measured = self.calibration.measurements();
+        if measured.0.is_empty() && measured.1.len() < 2 {
+            return;
+        }
+        let asked = self
+            .calibration_worker
+            .as_ref()
+            .is_some_and(|w| w.request(self.driver.rotor(), measured));
+        if asked {
+            let period = crate::driver::seconds_to_ns(self.params.calibration_period_s);
+            self.next_calibration_ns = now.saturating_add(period);
+        }
+    }
+
+    /// Applies an estimate's fitted values to the twin, logged.
+    fn apply(&mut self, e: &LiveEstimate) {
+        let (unbalance, viscosity_scale) = e.values();
+        if unbalance.is_none() && viscosity_scale.is_none() {
+            return;
+        }
+        let applied = Applied {
+            unbalance,
+            viscosity_scale,
+        };
+        match self.driver.apply_calibration(applied) {
+            Ok(said) => eprintln!("rotor_twin: calibration applied to the twin: {said}"),
+            Err(why) => eprintln!("rotor_twin: WARN: calibration not applied: {why}"),
+        }
+    }
+
+    /// `calibration_apply` changed: true applies the last estimate, false takes the calibration
+    /// back (the machine file's and the received values in force again); logged, and the
+    /// estimate published again with what is in force.
+    fn follow_apply(&mut self, now: i64) {
+        let want = self.params.calibration_apply;
+        if want == self.apply_seen {
+            return;
+        }
+        self.apply_seen = want;
+        let Some(e) = self.last_estimate.take() else {
+            if !want {
+                let _ = self.driver.revert_calibration();
+            }
+            return;
+        };
+        if want {
+            self.apply(&e);
+        } else {
+            match self.driver.revert_calibration() {
+                Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
+                Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
+            }
+        }
+        let applied = self.driver.calibration().is_some();
+        self.pending
+            .push(Published::Calibration(Box::new(e.to_message(now, applied))));
+        self.last_estimate = Some(e);
+    }
+
+    /// The linear stability threshold recomputed, off the model thread, when the viscosity in
+    /// force has moved by more than [`super::calibration::THRESHOLD_RESCALE`] since it was
+    /// computed (an oil temperature, or a calibration); the old one is published meanwhile.
+    fn refresh_threshold(&mut self) {
+        let s = self.driver.viscosity_scale();
+        let moved = (s / self.threshold_scale - 1.0).abs() > super::calibration::THRESHOLD_RESCALE;
+        if !moved || self.threshold_busy.load(Ordering::Acquire) {
+            return;
+        }
+        self.threshold_scale = s;
+        eprintln!("rotor_twin: viscosity × {s:.4} in force: the stability threshold is recomputed");
+        spawn_threshold(self.driver.rotor(), &self.threshold, &self.threshold_busy);
     }
 
     /// Steps up to `now`, one at a time to time each, at most [`MAX_STEPS_PER_WAKE`].
@@ -663,6 +784,18 @@ impl ModelLoop {
         ));
         (values, total.saturating_sub(before))
     }
+}
+
+/// Computes the linear stability threshold of `rotor` on a helper thread into `slot`
+/// (`busy` while it runs).
+fn spawn_threshold(rotor: &Rotor, slot: &Arc<Mutex<ThresholdSlot>>, busy: &Arc<AtomicBool>) {
+    let (rotor, slot, busy) = (rotor.clone(), slot.clone(), busy.clone());
+    busy.store(true, Ordering::Release);
+    std::thread::spawn(move || {
+        let value = crate::session::linear_threshold(&rotor);
+        *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
+        busy.store(false, Ordering::Release);
+    });
 }
 
 fn kv(key: &str, value: String) -> KeyValue {

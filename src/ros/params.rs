@@ -140,6 +140,12 @@ pub struct NodeParams {
     /// the machine file's `proximity_probes`, `probe=topic,…` (the reading in the probe's unit;
     /// no stamp: the receive time is its time).
     pub probe_signal_topics: Vec<(String, String)>,
+    /// `calibration_period_s`: node-clock time between live calibration fits (s); 0 (the
+    /// default): none. Each fit takes a core for a while (the README's "Calibration").
+    pub calibration_period_s: f64,
+    /// `calibration_apply`: apply each live estimate to the running twin (may change at run
+    /// time; false takes the calibration back).
+    pub calibration_apply: bool,
 }
 
 impl Default for NodeParams {
@@ -167,6 +173,8 @@ impl Default for NodeParams {
             forecast_offsets_rpm: crate::forecast::DEFAULT_OFFSETS_RPM.to_vec(),
             keyphasor_type: KeyphasorType::default(),
             probe_signal_topics: Vec::new(),
+            calibration_period_s: 0.0,
+            calibration_apply: false,
         }
     }
 }
@@ -300,6 +308,18 @@ impl NodeParams {
                     .map_err(|e| format!("parameter keyphasor_type: {e}"))?
             }
             "probe_signal_topics" => self.probe_signal_topics = topic_pairs(name, value)?,
+            "calibration_period_s" => {
+                let p: f64 = value.trim().parse().map_err(|_| {
+                    format!("parameter calibration_period_s: '{value}' is not a number")
+                })?;
+                if !(p == 0.0 || (p.is_finite() && p >= MIN_CALIBRATION_PERIOD_S)) {
+                    return Err(format!(
+                        "parameter calibration_period_s: {p} must be 0 (off) or at least {MIN_CALIBRATION_PERIOD_S} s"
+                    ));
+                }
+                self.calibration_period_s = p;
+            }
+            "calibration_apply" => self.calibration_apply = boolean(name, value)?,
             _ => return Err(format!("unknown parameter '{name}'")),
         }
         Ok(())
@@ -315,6 +335,10 @@ fn boolean(name: &str, value: &str) -> Result<bool, String> {
     }
 }
 
+/// Shortest period of the live calibration (s): 1 s, the diagnostics' rate (a fit takes a
+/// fraction of a second to seconds).
+pub const MIN_CALIBRATION_PERIOD_S: f64 = 1.0;
+
 /// Parameters that may change while the node runs (`ros2 param set`); the others shape the model
 /// or its subscriptions and are set at start only.
 pub const RUNTIME_PARAMETERS: &[&str] = &[
@@ -323,6 +347,7 @@ pub const RUNTIME_PARAMETERS: &[&str] = &[
     "input_timeout_s",
     "min_speed_rpm",
     "warning_amplitude_ratio",
+    "calibration_apply",
 ];
 
 impl NodeParams {
@@ -684,6 +709,13 @@ mod tests {
             .set("probe_signal_topics", "probe_outboard_x=plant/px")
             .unwrap_err()
             .contains("absolute"));
+        p.set("calibration_period_s", "5").unwrap();
+        assert!(p
+            .set("calibration_period_s", "0.2")
+            .unwrap_err()
+            .contains("at least 1"));
+        p.set_at_runtime("calibration_apply", "true").unwrap();
+        assert!(p.calibration_apply);
         // at run time: rates and thresholds yes, the model no
         p.set_at_runtime("state_rate_hz", "50").unwrap();
         assert_eq!(p.state_rate_hz, 50.0);

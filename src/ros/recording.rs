@@ -52,6 +52,7 @@ struct Handles {
     keyphasor: usize,
     signal: usize,
     one_x: usize,
+    calibration: usize,
     points: Vec<usize>,
     values: Vec<usize>,
 }
@@ -99,6 +100,10 @@ impl Handles {
             oil: rec.add_topic::<messages::Temperature>(qos::OIL_TEMPERATURE, input)?,
             signal: rec.add_topic::<messages::ProbeSignal>(qos::PROBE_SIGNAL, input)?,
             one_x: rec.add_topic::<messages::OneXVectors>(qos::ONE_X, qos::STATE)?,
+            calibration: rec.add_topic::<messages::CalibrationEstimate>(
+                qos::CALIBRATION,
+                qos::CALIBRATION_QOS,
+            )?,
         })
     }
 
@@ -117,6 +122,9 @@ impl Handles {
             ToRecord::ProbeSignal(m, ns) => rec.write(self.signal, m, t(ns), t(ns)),
             ToRecord::ProbeValue(i, m, ns) => rec.write(self.values[*i], m, t(ns), t(ns)),
             ToRecord::Out(Published::OneX(m), ns) => rec.write(self.one_x, m, t(ns), t(ns)),
+            ToRecord::Out(Published::Calibration(m), ns) => {
+                rec.write(self.calibration, &**m, t(ns), t(ns))
+            }
             ToRecord::Out(Published::Twin(o), ns) => {
                 let (h, ns) = (self.output(o), t(ns));
                 match o {

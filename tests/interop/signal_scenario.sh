@@ -11,6 +11,7 @@ rm -rf "$out/bag"
 "$bin" node --config "$cfg" --record "$out/bag" --ros-args -p model:=linear \
   -p keyphasor_type:=header -r rotor_twin/keyphasor:=/plant/keyphasor \
   -p probe_signal_topics:=probe_outboard_x=/plant/probe_outboard_x,probe_outboard_y=/plant/probe_outboard_y \
+  -p calibration_period_s:=2.0 -p calibration_apply:=true \
   > "$out/node.out" 2> "$out/node.err" &
 node=$!
 sleep 1
@@ -38,5 +39,15 @@ with AnyReader([Path(sys.argv[1])]) as r:
         for st in r.deserialize(raw, c.msgtype).status:
             if st.name.endswith(": inputs"):
                 diag = {kv.key: kv.value for kv in st.values}
-print(json.dumps({"diagnostics": diag, "counts": counts}))
+calibration = None
+with AnyReader([Path(sys.argv[1])]) as r:
+    conns = [c for c in r.connections if c.topic == "/rotor_twin/calibration"]
+    for c, t, raw in r.messages(connections=conns):
+        m = r.deserialize(raw, c.msgtype)
+        calibration = {"unbalance_valid": m.unbalance_valid, "unbalance_reason": m.unbalance_reason,
+                       "magnitudes": [float(v) for v in m.unbalance_magnitudes],
+                       "phases": [float(v) for v in m.unbalance_phases],
+                       "viscosity_valid": m.viscosity_valid, "viscosity_reason": m.viscosity_reason,
+                       "vectors": m.vectors, "applied": m.applied}
+print(json.dumps({"diagnostics": diag, "counts": counts, "calibration": calibration}))
 PY
