@@ -102,7 +102,7 @@ impl Rig {
                 feed(&mut self.driver, Input::Keyphasor { stamp_ns });
             }
             k += 1;
-            if !measure || k % 2 != 0 {
+            if !measure || !k.is_multiple_of(2) {
                 continue;
             }
             let probes: Vec<[f64; 2]> = o.probes.iter().map(|p| p.displacement_m).collect();
