@@ -144,12 +144,12 @@ impl OneXBlocks {
     }
 
     /// Adds a comparison; returns the block it completes, if it does. A twin that restarted
-    /// (its angle went back) or an angle that jumped by more than half a revolution starts a
-    /// new block.
+    /// (its angle went back by more than half a revolution) or a revolution without a sample
+    /// starts a new block.
     pub fn add(&mut self, c: &ProbeComparison) -> Option<OneXBlock> {
         let g = self.stations.get_mut(c.station)?;
         let last = g.samples.last().map(|s| s.angle_rad);
-        if last.is_some_and(|a| c.angle_rad < a - PI || c.angle_rad > a + PI) {
+        if last.is_some_and(|a| c.angle_rad < a - PI || c.angle_rad > a + TAU) {
             g.samples.clear();
         }
         if g.samples.len() >= ONE_X_BLOCK_CAPACITY {
