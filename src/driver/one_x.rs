@@ -334,5 +334,14 @@ mod tests {
             n, 0,
             "two halves of a block across a restart are not one block"
         );
+        // a revolution and a half without a sample: the block starts again after the gap
+        let mut blocks = OneXBlocks::new(vec![[0.0, FRAC_PI_2]]);
+        let mut got = Vec::new();
+        for k in (0..(4 * 16)).chain((4 * 16 + 24)..(14 * 16)) {
+            let psi = TAU * k as f64 / 16.0;
+            got.extend(blocks.add(&comparison(k, psi, 900.0, lag, PhaseReference::Locked)));
+        }
+        assert_eq!(got.len(), 1, "{got:?}");
+        assert_eq!(got[0].samples, 8 * 16);
     }
 }
