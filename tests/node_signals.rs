@@ -130,6 +130,7 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
     assert!(g0.abs() < 5.0 && g1.abs() < 5.0 && a.abs() < 0.03);
     let stale = peer["warnings"]["stale_input"].to_string();
     assert!(stale.contains("keyphasor stopped"), "{stale}");
+    assert_eq!(rec["diagnostics"]["keyphasor"], "stopped");
     // recorded as received, in their own types
     let c = &rec["counts"];
     assert_eq!(

@@ -728,6 +728,10 @@ impl ModelLoop {
             ),
             kv("refused_inputs", counts.refused.to_string()),
             kv("dropped_inputs", dropped_in.to_string()),
+            kv(
+                "keyphasor",
+                keyphasor_state(self.driver.phase_reference(now)).into(),
+            ),
         ];
         let (values, lost_now) = self.loss_values(values);
         let timeout = self.driver.settings().input_timeout_s;
@@ -783,6 +787,18 @@ impl ModelLoop {
             self.one_x.overflowed.to_string(),
         ));
         (values, total.saturating_sub(before))
+    }
+}
+
+/// The keyphasor's state as `<node>: inputs` reports it: locked, not_locked (events come, the
+/// running twin is not locked yet), stopped (no event for 3 revolutions: phases null), none.
+fn keyphasor_state(r: crate::signals::PhaseReference) -> &'static str {
+    use crate::signals::PhaseReference::*;
+    match r {
+        Locked => "locked",
+        NotLocked => "not_locked",
+        Stopped => "stopped",
+        NoKeyphasor => "none",
     }
 }
 
