@@ -18,6 +18,12 @@ pub const KEYPHASOR: &str = "/rotor_twin/keyphasor";
 /// Raw proximity-probe readings in (rotor_twin_msgs/ProbeSignal; std_msgs/Float64 topics per
 /// probe by the `probe_signal_topics` mapping): best effort, [`SENSOR_READER`].
 pub const PROBE_SIGNAL: &str = "/rotor_twin/probe_signal";
+/// The 1X vectors and phase lags per probe axis, per block of revolutions
+/// (rotor_twin_msgs/OneXVectors), out: [`STATE`].
+pub const ONE_X: &str = "/rotor_twin/one_x";
+/// The live calibration estimate (rotor_twin_msgs/CalibrationEstimate), out: latched, keep last
+/// 1 ([`CALIBRATION_QOS`]).
+pub const CALIBRATION: &str = "/rotor_twin/calibration";
 // --- end plant signals ---
 /// Predicted minus measured at a probe station, out.
 pub const RESIDUAL: &str = "/rotor_twin/residual";
@@ -65,6 +71,9 @@ pub const MARGIN_QOS: TopicQos = TopicQos::latched(1);
 
 /// QoS of the /clock subscription: best effort, keep last 10 (as rclcpp's clock subscription).
 pub const CLOCK_READER: TopicQos = TopicQos::sensor(10);
+
+/// QoS of the calibration estimate: latched, keep last 1 (a late subscriber gets the last).
+pub const CALIBRATION_QOS: TopicQos = TopicQos::latched(1);
 
 /// QoS of the forecast: latched, keep last 1 (a late subscriber gets the last look-ahead).
 pub const FORECAST_QOS: TopicQos = TopicQos::latched(1);

@@ -46,6 +46,8 @@ fn rust_types_mirror_the_msg_files() {
     check::<Keyphasor>();
     check::<ProbeSignal>();
     check::<Forecast>();
+    check::<OneXVectors>();
+    check::<CalibrationEstimate>();
     check::<Float64>();
     check::<PointStamped>();
     check::<Clock>();
@@ -71,6 +73,8 @@ fn every_msg_file_is_mirrored_listed_and_documented() {
         Keyphasor::TYPE_NAME,
         ProbeSignal::TYPE_NAME,
         Forecast::TYPE_NAME,
+        OneXVectors::TYPE_NAME,
+        CalibrationEstimate::TYPE_NAME,
     ];
     for entry in std::fs::read_dir(dir.join("msg")).unwrap() {
         let path = entry.unwrap().path();

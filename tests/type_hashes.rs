@@ -37,6 +37,8 @@ fn recorded_type_hashes_equal_rosbags_hashes() {
         add::<messages::Keyphasor>(&mut rec),
         add::<messages::ProbeSignal>(&mut rec),
         add::<messages::Forecast>(&mut rec),
+        add::<messages::OneXVectors>(&mut rec),
+        add::<messages::CalibrationEstimate>(&mut rec),
         add::<messages::Header>(&mut rec),
         add::<messages::Float64>(&mut rec),
         add::<messages::PointStamped>(&mut rec),

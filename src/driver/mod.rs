@@ -6,16 +6,20 @@
 //! (bad, stale or missing input; model failures) and the stability margin. It knows no bus, file
 //! or clock: the same inputs at the same times give the same outputs, whoever feeds them.
 
+pub mod calibration;
 mod clock;
 pub mod inputs;
+pub mod one_x;
 mod plant_signals;
 pub mod settings;
 
+pub use calibration::{Applied, LiveCalibration, LiveEstimate, MeasuredSet};
 pub use clock::{ClockSample, SimClock, CLOCK_CONFIRM, CLOCK_JUMP_S};
 pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,
 };
+pub use one_x::{OneXBlock, OneXBlocks};
 pub use plant_signals::SignalState;
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 
@@ -79,6 +83,13 @@ pub struct DriverCounts {
     pub step_failures: u64,
     /// Steps taken.
     pub steps: u64,
+    /// Probe samples (pairs, or raw readings paired) that were valid but not compared: no
+    /// twin ran at their time (before the first speed, below the minimum speed, after a
+    /// failed step).
+    pub probes_not_compared: u64,
+    /// Raw probe readings never paired with their station's other probe (the next reading of
+    /// the same probe came first: the other probe's reading was lost or stamped too far off).
+    pub readings_unpaired: u64,
 }
 
 /// The twin of one machine, driven by timed inputs.
@@ -106,6 +117,11 @@ pub struct Driver {
     oil_temperature_k: Option<f64>,
     /// keyphasor lock and raw-probe state (issue 12)
     signals: SignalState,
+    /// the live calibration in force, if applied (issue 12)
+    calibration: Option<Applied>,
+    /// the viscosity scale of the last accepted oil temperature (kept while a calibrated
+    /// viscosity is in force)
+    oil_scale: Option<f64>,
 }
 
 impl Driver {
@@ -131,6 +147,8 @@ impl Driver {
             counts: DriverCounts::default(),
             oil_temperature_k: None,
             signals: SignalState::default(),
+            calibration: None,
+            oil_scale: None,
         }
     }
 
@@ -238,8 +256,10 @@ impl Driver {
                 stamp_ns,
             } => self.take_probe_signal(now_ns, &probe, value, stamp_ns, emit),
         };
-        if let Fed::Refused(why) = &fed {
-            self.note_refused(now_ns, why, emit);
+        match &fed {
+            Fed::Refused(why) => self.note_refused(now_ns, why, emit),
+            Fed::Unused => self.counts.probes_not_compared += 1,
+            _ => {}
         }
         self.emit_margin(now_ns, emit);
         fed
@@ -347,9 +367,14 @@ impl Driver {
                 return Fed::Taken;
             }
         };
-        for (plane, u) in self.unbalance.iter().enumerate() {
-            if let Some((me, phase)) = *u {
-                // checked when received: the plane exists and the values are finite
+        let calibrated = self
+            .calibration
+            .as_ref()
+            .is_some_and(|c| c.unbalance.is_some());
+        for plane in 0..self.unbalance.len() {
+            if self.unbalance[plane].is_some() || calibrated {
+                let (me, phase) = self.unbalance_in_force(plane);
+                // checked when received or applied: the plane exists and the values are finite
                 let _ = s.twin_mut().set_unbalance(plane, me, phase);
             }
         }
@@ -367,6 +392,16 @@ impl Driver {
             Ok(s) => s,
             Err(why) => return Fed::Refused(why),
         };
+        self.oil_scale = Some(scale);
+        self.oil_temperature_k = Some(t_k);
+        if self
+            .calibration
+            .as_ref()
+            .is_some_and(|c| c.viscosity_scale.is_some())
+        {
+            // a calibrated viscosity is in force; this one comes back with revert_calibration
+            return Fed::Taken;
+        }
         if let Err(e) = self.rotor.set_viscosity_scale(scale) {
             return Fed::Refused(format!("oil temperature: {e}"));
         }
@@ -375,7 +410,6 @@ impl Driver {
                 return Fed::Refused(format!("oil temperature: {e}"));
             }
         }
-        self.oil_temperature_k = Some(t_k);
         Fed::Taken
     }
 

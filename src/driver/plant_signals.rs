@@ -293,6 +293,9 @@ impl Driver {
         if self.signals.stations.len() < self.rotor.probes.len() {
             self.signals.stations = vec![RawStation::default(); self.rotor.probes.len()];
         }
+        if self.signals.stations[station].last[axis].is_some() {
+            self.counts.readings_unpaired += 1;
+        }
         self.signals.stations[station].last[axis] = Some((t, d));
         self.pair_station(now_ns, station, axis, emit)
     }
@@ -363,6 +366,14 @@ impl Driver {
         self.compare_probe(now_ns, &StationRef::Index(station), xy, t0, emit)
     }
 
+    /// The probe axis angles (rad) of every probe station, in axis order: the machine file's
+    /// raw probes where it lists them, else x and y.
+    pub fn probe_axes(&self) -> Vec<[f64; 2]> {
+        (0..self.rotor.probes.len())
+            .map(|k| self.station_axes(k))
+            .collect()
+    }
+
     /// The two axis angles (rad) of a raw-probe station, in axis order.
     fn station_axes(&self, station: usize) -> [f64; 2] {
         let mut a = [0.0, std::f64::consts::FRAC_PI_2];
@@ -377,7 +388,8 @@ impl Driver {
         a
     }
 
-    fn station_is_ac(&self, station: usize) -> bool {
+    /// True if a probe of raw-probe station `station` is AC-coupled (its mean is the twin's).
+    pub fn station_is_ac(&self, station: usize) -> bool {
         self.rotor.proximity_probes.iter().any(|p| {
             p.station == station && p.coupling == crate::signals::probes::ProbeCoupling::Ac
         })

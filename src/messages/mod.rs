@@ -349,6 +349,94 @@ ros_message!(
         value: f64 = "float64",
     }
 );
+
+ros_message!(
+    /// The 1X vectors of one probe station over a block of whole revolutions, per probe axis,
+    /// measured and predicted; phase lags from the keyphasor (API 670), empty when null.
+    OneXVectors, "OneXVectors.msg" {
+        /// Time of the block's last sample; frame: the station.
+        header: Header = "std_msgs/Header",
+        /// Probe station name.
+        station: String = "string",
+        /// Mean speed (rad/s).
+        speed: f64 = "float64",
+        /// Whole revolutions in the block.
+        revolutions: u32 = "uint32",
+        /// Probe samples in the block.
+        samples: u32 = "uint32",
+        /// Probe axis angles (rad).
+        axis_angles: Vec<f64> = "float64[]",
+        /// Measured 1X amplitudes (m).
+        measured_amplitudes: Vec<f64> = "float64[]",
+        /// Measured 1X phase lags (deg); empty when null.
+        measured_phase_lags_deg: Vec<f64> = "float64[]",
+        /// Predicted 1X amplitudes (m).
+        predicted_amplitudes: Vec<f64> = "float64[]",
+        /// Predicted 1X phase lags (deg); empty when null.
+        predicted_phase_lags_deg: Vec<f64> = "float64[]",
+        /// Predicted − measured phase lags (deg); empty when null.
+        phase_lag_errors_deg: Vec<f64> = "float64[]",
+        /// Why the phase lags are empty ('' when keyphasor-referenced).
+        phase_null_reason: String = "string",
+    }
+);
+
+ros_message!(
+    /// The live calibration: viscosity from the mean positions, unbalance from the 1X vectors
+    /// (see `msg/msg/CalibrationEstimate.msg`).
+    CalibrationEstimate, "CalibrationEstimate.msg" {
+        /// Time of the estimate.
+        header: Header = "std_msgs/Header",
+        /// 1X vectors used.
+        vectors: u32 = "uint32",
+        /// Mean positions used.
+        positions: u32 = "uint32",
+        /// The viscosity was fitted.
+        viscosity_valid: bool = "bool",
+        /// Why not.
+        viscosity_reason: String = "string",
+        /// µ / µ of the machine file.
+        viscosity_scale: f64 = "float64",
+        /// Its 1σ.
+        viscosity_scale_std: f64 = "float64",
+        /// Effective viscosity (Pa·s).
+        viscosity: f64 = "float64",
+        /// The law gives a temperature.
+        temperature_valid: bool = "bool",
+        /// Oil temperature (K).
+        oil_temperature: f64 = "float64",
+        /// Its 1σ (K).
+        oil_temperature_std: f64 = "float64",
+        /// Offset from the design supply temperature (K).
+        temperature_offset: f64 = "float64",
+        /// Position residual RMS (m).
+        viscosity_residual: f64 = "float64",
+        /// The unbalance was fitted.
+        unbalance_valid: bool = "bool",
+        /// Why not.
+        unbalance_reason: String = "string",
+        /// Node per plane.
+        unbalance_nodes: Vec<u32> = "uint32[]",
+        /// m·e per plane (kg·m).
+        unbalance_magnitudes: Vec<f64> = "float64[]",
+        /// Heavy-spot angle per plane (rad).
+        unbalance_phases: Vec<f64> = "float64[]",
+        /// Correction mass per plane (kg).
+        correction_masses: Vec<f64> = "float64[]",
+        /// Correction angle per plane (rad).
+        correction_angles: Vec<f64> = "float64[]",
+        /// Correction radius (m).
+        correction_radius: f64 = "float64",
+        /// 1X residual RMS (m).
+        unbalance_residual: f64 = "float64",
+        /// Relative 1X residual.
+        unbalance_relative_residual: f64 = "float64",
+        /// Condition number.
+        condition_number: f64 = "float64",
+        /// In force in the running twin.
+        applied: bool = "bool",
+    }
+);
 // --- end plant signals ---
 
 // --- forecast (issue 14) ---

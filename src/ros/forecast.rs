@@ -60,7 +60,7 @@ impl ForecastLink {
         config: TwinConfig,
         settings: ForecastSettings,
         period_s: f64,
-        out: SyncSender<Outgoing>,
+        out: SyncSender<super::model::Published>,
     ) -> std::io::Result<Self> {
         let (tx, rx) = mpsc::sync_channel::<ForecastStart>(1);
         let stats = Arc::new(ForecastStats::default());
@@ -89,9 +89,9 @@ impl ForecastLink {
                         .worst_duration_us
                         .fetch_max(us, Ordering::Relaxed);
                     if out
-                        .try_send(Outgoing::Forecast(Box::new(
+                        .try_send(super::model::Published::Twin(Outgoing::Forecast(Box::new(
                             f.to_message(took.as_secs_f64()),
-                        )))
+                        ))))
                         .is_err()
                     {
                         thread_stats.dropped.fetch_add(1, Ordering::Relaxed);

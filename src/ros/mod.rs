@@ -20,7 +20,9 @@
 //! - in  `/clock` rosgraph_msgs/Clock with `use_sim_time:=true`: the model is paced by it and its
 //!   outputs are stamped in simulation time.
 
+mod calibration;
 mod forecast;
+pub mod loss;
 pub mod model;
 mod param_client;
 mod params;
@@ -28,7 +30,8 @@ mod recording;
 
 pub use param_client::{run as param_call, ParamCall};
 pub use params::{
-    parse_ros_args, LogLevel, NodeParams, RosArgs, SpeedType, SpeedUnit, RUNTIME_PARAMETERS,
+    parse_ros_args, KeyphasorType, LogLevel, NodeParams, RosArgs, SpeedType, SpeedUnit,
+    RUNTIME_PARAMETERS,
 };
 
 use crate::driver::Input;
@@ -40,7 +43,7 @@ use crate::topics::{
 };
 use anyhow::Context as _;
 use futures::StreamExt;
-use model::{now_ns, Inbox, NodeClock, Outgoing};
+use model::{now_ns, Inbox, NodeClock, Outgoing, Published};
 use recording::ToRecord;
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, NodeName, NodeOptions, ParameterValue,
@@ -237,7 +240,7 @@ async fn run_async(
         sim: params.use_sim_time,
         ..NodeClock::default()
     });
-    let (out_tx, out_rx) = mpsc::sync_channel::<Outgoing>(4096);
+    let (out_tx, out_rx) = mpsc::sync_channel::<model::Published>(4096);
     let mut model = model::ModelLoop::new(
         rotor.clone(),
         params.clone(),
@@ -346,14 +349,7 @@ fn start_recorder(
         return Ok((None, None));
     };
     let (tx, rx) = mpsc::sync_channel::<ToRecord>(65_536);
-    let thread = recording::spawn(
-        dir,
-        setup.record_split,
-        params.speed_type == SpeedType::Float64,
-        &params.probe_point_topics,
-        rx,
-        stop.clone(),
-    )?;
+    let thread = recording::spawn(dir, setup.record_split, params, rx, stop.clone())?;
     Ok((Some(thread), Some(tx)))
 }
 
@@ -476,7 +472,35 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
     for (name, value) in forecast_parameters(params) {
         options = options.declare_parameter(name, value);
     }
+    for (name, value) in plant_signal_parameters(params) {
+        options = options.declare_parameter(name, value);
+    }
     options
+}
+
+/// The plant-signal parameters (issue 12) as declared.
+fn plant_signal_parameters(params: &NodeParams) -> Vec<(&'static str, ParameterValue)> {
+    let signals = params
+        .probe_signal_topics
+        .iter()
+        .map(|(p, t)| format!("{p}={t}"))
+        .collect::<Vec<_>>()
+        .join(",");
+    vec![
+        (
+            "keyphasor_type",
+            ParameterValue::String(params.keyphasor_type.to_string()),
+        ),
+        ("probe_signal_topics", ParameterValue::String(signals)),
+        (
+            "calibration_period_s",
+            ParameterValue::Double(params.calibration_period_s),
+        ),
+        (
+            "calibration_apply",
+            ParameterValue::Boolean(params.calibration_apply),
+        ),
+    ]
 }
 
 /// The forecast's parameters (issue 14) as declared.
@@ -510,6 +534,8 @@ struct Publishers {
     residual: ros2_client::Publisher<messages::OrbitResidual>,
     margin: ros2_client::Publisher<messages::StabilityMargin>,
     forecast: ros2_client::Publisher<messages::Forecast>,
+    one_x: ros2_client::Publisher<messages::OneXVectors>,
+    calibration: ros2_client::Publisher<messages::CalibrationEstimate>,
 }
 
 fn publisher<M: RosMessage>(
@@ -537,6 +563,8 @@ impl Publishers {
             residual: publisher(node, ros, RESIDUAL, qos::STATE)?,
             margin: publisher(node, ros, MARGIN, qos::MARGIN_QOS)?,
             forecast: publisher(node, ros, qos::FORECAST, qos::FORECAST_QOS)?,
+            one_x: publisher(node, ros, qos::ONE_X, qos::STATE)?,
+            calibration: publisher(node, ros, qos::CALIBRATION, qos::CALIBRATION_QOS)?,
         })
     }
 
@@ -544,7 +572,7 @@ impl Publishers {
     /// sample: the model is never blocked) and hands it to the recorder.
     fn spawn(
         self,
-        out: mpsc::Receiver<Outgoing>,
+        out: mpsc::Receiver<Published>,
         rec: Option<mpsc::SyncSender<ToRecord>>,
         counters: Arc<model::NodeCounters>,
     ) -> std::io::Result<std::thread::JoinHandle<()>> {
@@ -554,14 +582,11 @@ impl Publishers {
                 for item in out {
                     let t = now_ns();
                     let sent = match &item {
-                        Outgoing::Journal(m) => self.journal.publish(m.clone()).is_ok(),
-                        Outgoing::Film(m) => self.film.publish(m.clone()).is_ok(),
-                        Outgoing::Orbit(m) => self.orbit.publish(m.clone()).is_ok(),
-                        Outgoing::Warning(m) => self.warning.publish(m.clone()).is_ok(),
-                        Outgoing::Diagnostics(m) => self.diagnostics.publish(m.clone()).is_ok(),
-                        Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
-                        Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
-                        Outgoing::Forecast(m) => self.forecast.publish((**m).clone()).is_ok(),
+                        Published::Twin(o) => self.publish_twin(o),
+                        Published::OneX(m) => self.one_x.publish(m.clone()).is_ok(),
+                        Published::Calibration(m) => {
+                            self.calibration.publish((**m).clone()).is_ok()
+                        }
                     };
                     if !sent {
                         counters.publish_failed.fetch_add(1, Ordering::Relaxed);
@@ -571,6 +596,22 @@ impl Publishers {
                     }
                 }
             })
+    }
+}
+
+impl Publishers {
+    /// Publishes one of the twin's messages; false if the bus refused it.
+    fn publish_twin(&self, item: &Outgoing) -> bool {
+        match item {
+            Outgoing::Journal(m) => self.journal.publish(m.clone()).is_ok(),
+            Outgoing::Film(m) => self.film.publish(m.clone()).is_ok(),
+            Outgoing::Orbit(m) => self.orbit.publish(m.clone()).is_ok(),
+            Outgoing::Warning(m) => self.warning.publish(m.clone()).is_ok(),
+            Outgoing::Diagnostics(m) => self.diagnostics.publish(m.clone()).is_ok(),
+            Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
+            Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
+            Outgoing::Forecast(m) => self.forecast.publish((**m).clone()).is_ok(),
+        }
     }
 }
 
@@ -643,25 +684,64 @@ fn subscribe_inputs(
             move |m, t| ToRecord::Point(i, m, t),
         )?;
     }
-    // --- plant signals (issue 12): keyphasor events and raw probe readings, best effort ---
-    route.subscribe::<messages::Keyphasor>(
-        node,
-        &topic_name(ros, crate::topics::KEYPHASOR)?,
-        qos::SENSOR_READER,
-        |m| Ok(Input::from(m)),
-        ToRecord::Keyphasor,
-    )?;
+    subscribe_plant_signals(node, ros, params, rotor, route)?;
+    if params.use_sim_time {
+        // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
+        subscribe_clock(node, &topic_name(ros, CLOCK)?, route)?;
+    }
+    Ok(())
+}
+
+/// The plant's signals (issue 12), best effort: keyphasor events (rotor_twin_msgs/Keyphasor, or
+/// std_msgs/Header with `keyphasor_type:=header`), raw probe readings (rotor_twin_msgs/ProbeSignal,
+/// and one std_msgs/Float64 topic per probe named in `probe_signal_topics`).
+fn subscribe_plant_signals(
+    node: &mut ros2_client::Node,
+    ros: &RosArgs,
+    params: &NodeParams,
+    rotor: &Rotor,
+    route: &InputRoute,
+) -> anyhow::Result<()> {
+    use crate::topics as qos;
+    let keyphasor = topic_name(ros, qos::KEYPHASOR)?;
+    match params.keyphasor_type {
+        KeyphasorType::Keyphasor => route.subscribe::<messages::Keyphasor>(
+            node,
+            &keyphasor,
+            qos::SENSOR_READER,
+            |m| Ok(Input::from(m)),
+            ToRecord::Keyphasor,
+        )?,
+        KeyphasorType::Header => route.subscribe::<messages::Header>(
+            node,
+            &keyphasor,
+            qos::SENSOR_READER,
+            |m| Ok(Input::from(m)),
+            ToRecord::KeyphasorHeader,
+        )?,
+    }
     route.subscribe::<messages::ProbeSignal>(
         node,
-        &topic_name(ros, crate::topics::PROBE_SIGNAL)?,
+        &topic_name(ros, qos::PROBE_SIGNAL)?,
         qos::SENSOR_READER,
         |m| Ok(Input::from(m)),
         ToRecord::ProbeSignal,
     )?;
-    // --- end plant signals ---
-    if params.use_sim_time {
-        // rosgraph_msgs/Clock on /clock (ros2-client's own /clock handling uses another type)
-        subscribe_clock(node, &topic_name(ros, CLOCK)?, route)?;
+    for (i, (probe, topic_text)) in params.probe_signal_topics.iter().enumerate() {
+        let k = rotor
+            .proximity_probes
+            .iter()
+            .position(|p| p.name == *probe)
+            .ok_or_else(|| anyhow::anyhow!("parameter probe_signal_topics: probe '{probe}' is not in the machine description's proximity_probes"))?;
+        let name = Name::parse(topic_text)
+            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+        route.subscribe::<messages::Float64>(
+            node,
+            &name,
+            qos::SENSOR_READER,
+            move |m| Ok(Input::probe_value(m.data, k)),
+            move |m, t| ToRecord::ProbeValue(i, m, t),
+        )?;
     }
     Ok(())
 }
@@ -701,19 +781,26 @@ impl InputRoute {
         let (inbox, clock, rec) = (self.inbox.clone(), self.clock.clone(), self.rec.clone());
         let counters = self.counters.clone();
         let label = name.to_string();
+        let topic_index = counters.add_topic(&label);
         tokio::spawn(async move {
             let mut stream = Box::pin(sub.async_stream());
+            let mut gaps = loss::SequenceGaps::default();
             while let Some(item) = stream.next().await {
                 let at = clock.now_ns();
                 let queued = match item {
-                    Ok((m, _info)) => {
+                    Ok((m, info)) => {
+                        let lost = gaps.sample(info.publisher_gid(), info.sequence_number());
+                        counters.lost(topic_index, lost);
                         let input = to_input(&m);
                         if let Some(rec) = &rec {
                             counters.record(rec, to_record(m, now_ns()));
                         }
                         input
                     }
-                    Err(e) => Err(format!("{label}: a sample that does not decode ({e:?})")),
+                    Err(e) => {
+                        gaps.undecoded();
+                        Err(format!("{label}: a sample that does not decode ({e:?})"))
+                    }
                 };
                 inbox
                     .lock()

@@ -4,7 +4,9 @@
 //! falls behind it says so.
 
 use super::params::NodeParams;
-use crate::driver::{Driver, DriverSettings, Input};
+use crate::driver::{
+    Applied, Driver, DriverSettings, Fed, Input, LiveCalibration, LiveEstimate, OneXBlocks,
+};
 use crate::messages::*;
 use crate::rotor::Rotor;
 pub use crate::session::Outgoing;
@@ -14,6 +16,19 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// What the model thread hands to the publishing thread: the twin's messages (those of the
+/// driver, shared with the replay) and the node's own (issue 12: the live 1X vectors and the
+/// calibration estimates).
+#[derive(Debug, Clone)]
+pub enum Published {
+    /// A message of the twin.
+    Twin(Outgoing),
+    /// The 1X vectors of one station over a block.
+    OneX(OneXVectors),
+    /// The live calibration estimate (boxed: the largest message).
+    Calibration(Box<CalibrationEstimate>),
+}
 
 /// Inputs waiting for the model thread beyond this many are dropped, oldest first, and counted.
 pub const INBOX_CAPACITY: usize = 65_536;
@@ -55,9 +70,38 @@ pub struct NodeCounters {
     pub publish_failed: AtomicU64,
     /// The recording stopped before the node (e.g. a full disk): what follows is not recorded.
     pub recording_failed: AtomicBool,
+    /// Input samples lost before the node read them, per input topic (gaps in each writer's
+    /// sequence numbers, [`super::loss`]): (topic, count).
+    pub lost_inputs: Mutex<Vec<(String, u64)>>,
+    /// `lost_inputs` in all at the last diagnostics.
+    pub lost_reported: AtomicU64,
 }
 
 impl NodeCounters {
+    /// Registers an input topic for the loss counts; returns its index.
+    pub fn add_topic(&self, topic: &str) -> usize {
+        let mut t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        t.push((topic.to_string(), 0));
+        t.len() - 1
+    }
+
+    /// Counts `n` input samples of topic `index` lost before the node read them.
+    pub fn lost(&self, index: usize, n: u64) {
+        if n == 0 {
+            return;
+        }
+        let mut t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = t.get_mut(index) {
+            e.1 += n;
+        }
+    }
+
+    /// Input samples lost before the node read them, all topics.
+    pub fn lost_total(&self) -> u64 {
+        let t = self.lost_inputs.lock().unwrap_or_else(|e| e.into_inner());
+        t.iter().map(|e| e.1).sum()
+    }
+
     /// Hands `item` to the recorder; a full queue loses it, counted.
     pub fn record<T>(&self, rec: &std::sync::mpsc::SyncSender<T>, item: T) {
         if rec.try_send(item).is_err() {
@@ -174,6 +218,20 @@ pub struct ModelLoop {
     counts_before: crate::driver::DriverCounts,
     /// the forecast thread's link, when `forecast_period_s` > 0 (issue 14)
     forecast: Option<super::forecast::ForecastLink>,
+    /// the live 1X blocks per probe station (issue 12)
+    one_x: OneXBlocks,
+    /// the node's own messages of this wake, sent after the twin's
+    pending: Vec<Published>,
+    /// the live calibration's measurements, fitting thread and last estimate (issue 12)
+    calibration: LiveCalibration,
+    calibration_worker: Option<super::calibration::CalibrationWorker>,
+    next_calibration_ns: i64,
+    last_estimate: Option<LiveEstimate>,
+    /// `calibration_apply` as last acted upon
+    apply_seen: bool,
+    /// the viscosity scale the threshold was computed at, and whether a computation runs
+    threshold_scale: f64,
+    threshold_busy: Arc<AtomicBool>,
 }
 
 impl ModelLoop {
@@ -188,15 +246,28 @@ impl ModelLoop {
         clock: Arc<NodeClock>,
     ) -> Self {
         let threshold = Arc::new(Mutex::new(None));
-        {
-            let (rotor, threshold) = (rotor.clone(), threshold.clone());
-            std::thread::spawn(move || {
-                let value = crate::session::linear_threshold(&rotor);
-                *threshold.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
+        let threshold_busy = Arc::new(AtomicBool::new(false));
+        spawn_threshold(&rotor, &threshold, &threshold_busy);
+        let driver = Driver::new(rotor.clone(), driver_settings(&params, &rotor));
+        let calibration_worker = (params.calibration_period_s > 0.0)
+            .then(super::calibration::CalibrationWorker::spawn)
+            .and_then(|w| {
+                w.map_err(|e| {
+                    eprintln!("rotor_twin: ERROR: the calibration thread did not start: {e}")
+                })
+                .ok()
             });
-        }
         Self {
-            driver: Driver::new(rotor.clone(), driver_settings(&params, &rotor)),
+            calibration: LiveCalibration::default(),
+            calibration_worker,
+            next_calibration_ns: i64::MIN,
+            last_estimate: None,
+            apply_seen: false,
+            threshold_scale: rotor.viscosity_scale(),
+            threshold_busy,
+            one_x: OneXBlocks::new(driver.probe_axes()),
+            pending: Vec::with_capacity(64),
+            driver,
             params,
             live,
             seen_version: 0,
@@ -215,20 +286,32 @@ impl ModelLoop {
 
     /// Runs until `stop` is set. Messages go to `out`; when `out` is full a message is dropped
     /// and counted (the model never waits for the bus).
-    pub fn run(mut self, out: SyncSender<Outgoing>, stop: Arc<AtomicBool>) {
+    pub fn run(mut self, out: SyncSender<Published>, stop: Arc<AtomicBool>) {
         self.start_forecast(&out);
         let mut dropped = 0u64;
         while !stop.load(Ordering::Relaxed) {
             let mut emit = |m: Outgoing| {
-                if out.try_send(m).is_err() {
+                if out.try_send(Published::Twin(m)).is_err() {
                     dropped += 1;
                 }
             };
-            if !self.wake(&mut emit) {
+            let busy = self.wake(&mut emit);
+            for m in self.pending.drain(..) {
+                if out.try_send(m).is_err() {
+                    dropped += 1;
+                }
+            }
+            if !busy {
                 std::thread::sleep(Duration::from_millis(1));
             }
             self.dropped_out = dropped;
         }
+    }
+
+    /// The node's own messages of the last wakes (the live 1X vectors, the calibration), for a
+    /// caller that drives [`ModelLoop::wake`] itself (tests).
+    pub fn take_published(&mut self) -> Vec<Published> {
+        std::mem::take(&mut self.pending)
     }
 
     /// One wake: parameter changes, the queued inputs, the steps now due, the reports. False
@@ -243,6 +326,8 @@ impl ModelLoop {
         };
         let fed = self.feed_inputs(now, emit);
         let steps = self.step_until(now, emit);
+        self.calibrate(now);
+        self.refresh_threshold();
         if let Some(f) = self.forecast.as_mut() {
             f.after_wake(&self.driver);
         }
@@ -251,7 +336,7 @@ impl ModelLoop {
     }
 
     /// Starts the forecast thread when `forecast_period_s` > 0; its messages go to `out`.
-    fn start_forecast(&mut self, out: &SyncSender<Outgoing>) {
+    fn start_forecast(&mut self, out: &SyncSender<Published>) {
         let p = &self.params;
         if p.forecast_period_s <= 0.0 {
             return;
@@ -323,12 +408,126 @@ impl ModelLoop {
             self.timing.steps += steps as u64;
             match input {
                 Ok(input) => {
-                    self.driver.feed(t, input, emit);
+                    let fed = self.driver.feed(t, input, emit);
+                    self.after_feed(&fed);
                 }
                 Err(why) => self.driver.refuse(t, &why, emit),
             }
         }
         any
+    }
+
+    /// What the node makes of a fed input beyond the driver's messages: a compared probe sample
+    /// goes into its station's 1X block, and a finished block is published.
+    fn after_feed(&mut self, fed: &Fed) {
+        let Fed::Compared(c) = fed else {
+            return;
+        };
+        let Some(block) = self.one_x.add(c) else {
+            return;
+        };
+        let name = self
+            .driver
+            .rotor()
+            .probes
+            .get(block.station)
+            .map_or("", |p| p.name.as_str());
+        self.pending.push(Published::OneX(block.to_message(name)));
+        let dc = !self.driver.station_is_ac(block.station);
+        self.calibration.add(&block, dc);
+    }
+
+    /// The live calibration (issue 12): a change of `calibration_apply` acted upon, a finished
+    /// fit published (and applied while `calibration_apply` is true), the next fit asked for
+    /// every `calibration_period_s`.
+    fn calibrate(&mut self, now: i64) {
+        self.follow_apply(now);
+        let Some(finished) = self.calibration_worker.as_ref().map(|w| w.take()) else {
+            return;
+        };
+        if let Some(e) = finished {
+            if self.params.calibration_apply {
+                self.apply(&e);
+            }
+            let applied = self.driver.calibration().is_some();
+            self.pending
+                .push(Published::Calibration(Box::new(e.to_message(now, applied))));
+            self.last_estimate = Some(e);
+        }
+        if now < self.next_calibration_ns {
+            return;
+        }
+        let measured = self.calibration.measurements();
+        if measured.0.is_empty() && measured.1.len() < 2 {
+            return;
+        }
+        let asked = self
+            .calibration_worker
+            .as_ref()
+            .is_some_and(|w| w.request(self.driver.rotor(), measured));
+        if asked {
+            let period = crate::driver::seconds_to_ns(self.params.calibration_period_s);
+            self.next_calibration_ns = now.saturating_add(period);
+        }
+    }
+
+    /// Applies an estimate's fitted values to the twin, logged.
+    fn apply(&mut self, e: &LiveEstimate) {
+        let (unbalance, viscosity_scale) = e.values();
+        if unbalance.is_none() && viscosity_scale.is_none() {
+            return;
+        }
+        let applied = Applied {
+            unbalance,
+            viscosity_scale,
+        };
+        match self.driver.apply_calibration(applied) {
+            Ok(said) => eprintln!("rotor_twin: calibration applied to the twin: {said}"),
+            Err(why) => eprintln!("rotor_twin: WARN: calibration not applied: {why}"),
+        }
+    }
+
+    /// `calibration_apply` changed: true applies the last estimate, false takes the calibration
+    /// back (the machine file's and the received values in force again); logged, and the
+    /// estimate published again with what is in force.
+    fn follow_apply(&mut self, now: i64) {
+        let want = self.params.calibration_apply;
+        if want == self.apply_seen {
+            return;
+        }
+        self.apply_seen = want;
+        let Some(e) = self.last_estimate.take() else {
+            if !want {
+                let _ = self.driver.revert_calibration();
+            }
+            return;
+        };
+        if want {
+            self.apply(&e);
+        } else {
+            match self.driver.revert_calibration() {
+                Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
+                Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
+            }
+        }
+        let applied = self.driver.calibration().is_some();
+        self.pending
+            .push(Published::Calibration(Box::new(e.to_message(now, applied))));
+        self.last_estimate = Some(e);
+    }
+
+    /// The linear stability threshold recomputed, off the model thread, when the viscosity in
+    /// force has moved by more than [`super::calibration::THRESHOLD_RESCALE`] since it was
+    /// computed (an oil temperature, or a calibration); the old one is published meanwhile.
+    fn refresh_threshold(&mut self) {
+        let s = self.driver.viscosity_scale();
+        let moved = (s / self.threshold_scale - 1.0).abs() > super::calibration::THRESHOLD_RESCALE;
+        if !moved || self.threshold_busy.load(Ordering::Acquire) {
+            return;
+        }
+        self.threshold_scale = s;
+        eprintln!("rotor_twin: viscosity × {s:.4} in force: the stability threshold is recomputed");
+        spawn_threshold(self.driver.rotor(), &self.threshold, &self.threshold_busy);
     }
 
     /// Steps up to `now`, one at a time to time each, at most [`MAX_STEPS_PER_WAKE`].
@@ -529,11 +728,20 @@ impl ModelLoop {
             ),
             kv("refused_inputs", counts.refused.to_string()),
             kv("dropped_inputs", dropped_in.to_string()),
+            kv(
+                "keyphasor",
+                keyphasor_state(self.driver.phase_reference(now)).into(),
+            ),
         ];
+        let (values, lost_now) = self.loss_values(values);
         let timeout = self.driver.settings().input_timeout_s;
         let (level, message) = match age {
             None => (DiagnosticStatus::STALE, "no speed received yet".into()),
             Some(a) if a > timeout => (DiagnosticStatus::STALE, format!("no speed for {a:.2} s")),
+            Some(_) if lost_now > 0 => (
+                DiagnosticStatus::WARN,
+                format!("{lost_now} input sample(s) lost before the node in the last second"),
+            ),
             Some(_) if refused > 0 => (
                 DiagnosticStatus::WARN,
                 format!("{refused} input(s) refused in the last second"),
@@ -542,6 +750,68 @@ impl ModelLoop {
         };
         self.status("inputs", level, message, values)
     }
+
+    /// Every count of input samples lost or not used, where it happened (issue 15, item 8):
+    /// lost before the node (`lost_samples`, in all and per topic: sequence gaps), queued
+    /// beyond the inbox (`dropped_inputs`, already in `values`), valid probes not compared
+    /// (no twin at their time), raw readings never paired, 1X blocks given up; and the losses
+    /// since the last diagnostics.
+    fn loss_values(&self, mut values: Vec<KeyValue>) -> (Vec<KeyValue>, u64) {
+        let counts = self.driver.counts();
+        let total = self.counters.lost_total();
+        let before = self
+            .counters
+            .lost_reported
+            .swap(total, std::sync::atomic::Ordering::Relaxed);
+        values.push(kv("lost_samples", total.to_string()));
+        for (topic, n) in self
+            .counters
+            .lost_inputs
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .iter()
+            .filter(|e| e.1 > 0)
+        {
+            values.push(kv(&format!("lost_samples {topic}"), n.to_string()));
+        }
+        values.push(kv(
+            "probes_not_compared",
+            counts.probes_not_compared.to_string(),
+        ));
+        values.push(kv(
+            "raw_readings_unpaired",
+            counts.readings_unpaired.to_string(),
+        ));
+        values.push(kv(
+            "one_x_blocks_overflowed",
+            self.one_x.overflowed.to_string(),
+        ));
+        (values, total.saturating_sub(before))
+    }
+}
+
+/// The keyphasor's state as `<node>: inputs` reports it: locked, not_locked (events come, the
+/// running twin is not locked yet), stopped (no event for 3 revolutions: phases null), none.
+fn keyphasor_state(r: crate::signals::PhaseReference) -> &'static str {
+    use crate::signals::PhaseReference::*;
+    match r {
+        Locked => "locked",
+        NotLocked => "not_locked",
+        Stopped => "stopped",
+        NoKeyphasor => "none",
+    }
+}
+
+/// Computes the linear stability threshold of `rotor` on a helper thread into `slot`
+/// (`busy` while it runs).
+fn spawn_threshold(rotor: &Rotor, slot: &Arc<Mutex<ThresholdSlot>>, busy: &Arc<AtomicBool>) {
+    let (rotor, slot, busy) = (rotor.clone(), slot.clone(), busy.clone());
+    busy.store(true, Ordering::Release);
+    std::thread::spawn(move || {
+        let value = crate::session::linear_threshold(&rotor);
+        *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(value);
+        busy.store(false, Ordering::Release);
+    });
 }
 
 fn kv(key: &str, value: String) -> KeyValue {

@@ -40,6 +40,54 @@ impl fmt::Display for SpeedType {
     }
 }
 
+/// The type of the keyphasor topic (issue 12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum KeyphasorType {
+    /// rotor_twin_msgs/Keyphasor (stamped event, revolution count).
+    #[default]
+    Keyphasor,
+    /// std_msgs/Header: its stamp is the event.
+    Header,
+}
+
+impl FromStr for KeyphasorType {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "keyphasor" => Ok(KeyphasorType::Keyphasor),
+            "header" => Ok(KeyphasorType::Header),
+            other => Err(format!("'{other}' must be keyphasor or header")),
+        }
+    }
+}
+
+impl fmt::Display for KeyphasorType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            KeyphasorType::Keyphasor => "keyphasor",
+            KeyphasorType::Header => "header",
+        })
+    }
+}
+
+/// `name=/topic,…` pairs of a topic-mapping parameter (`probe_point_topics`,
+/// `probe_signal_topics`): each topic absolute.
+fn topic_pairs(parameter: &str, value: &str) -> Result<Vec<(String, String)>, String> {
+    let mut pairs = Vec::new();
+    for item in value.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (name, topic) = item
+            .split_once('=')
+            .ok_or_else(|| format!("parameter {parameter}: '{item}' must be name=topic"))?;
+        if !topic.trim().starts_with('/') {
+            return Err(format!(
+                "parameter {parameter}: topic '{topic}' must be absolute (/…)"
+            ));
+        }
+        pairs.push((name.trim().to_string(), topic.trim().to_string()));
+    }
+    Ok(pairs)
+}
+
 /// The node's parameters (ROS 2 parameters; set with `-p name:=value` or a params file).
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeParams {
@@ -85,6 +133,19 @@ pub struct NodeParams {
     /// `forecast_offsets_rpm`: constant speeds a forecast probes above the present one (rpm,
     /// ascending, comma separated; empty: the expected path only, no margin).
     pub forecast_offsets_rpm: Vec<f64>,
+    /// `keyphasor_type`: keyphasor (rotor_twin_msgs/Keyphasor) | header (std_msgs/Header, its
+    /// stamp the event), on `/rotor_twin/keyphasor` (remap it to the plant's topic).
+    pub keyphasor_type: KeyphasorType,
+    /// `probe_signal_topics`: raw probe readings as std_msgs/Float64, one topic per probe of
+    /// the machine file's `proximity_probes`, `probe=topic,…` (the reading in the probe's unit;
+    /// no stamp: the receive time is its time).
+    pub probe_signal_topics: Vec<(String, String)>,
+    /// `calibration_period_s`: node-clock time between live calibration fits (s); 0 (the
+    /// default): none. Each fit takes a core for a while (the README's "Calibration").
+    pub calibration_period_s: f64,
+    /// `calibration_apply`: apply each live estimate to the running twin (may change at run
+    /// time; false takes the calibration back).
+    pub calibration_apply: bool,
 }
 
 impl Default for NodeParams {
@@ -110,6 +171,10 @@ impl Default for NodeParams {
             forecast_period_s: 0.0,
             forecast_horizon_s: crate::forecast::DEFAULT_HORIZON_S,
             forecast_offsets_rpm: crate::forecast::DEFAULT_OFFSETS_RPM.to_vec(),
+            keyphasor_type: KeyphasorType::default(),
+            probe_signal_topics: Vec::new(),
+            calibration_period_s: 0.0,
+            calibration_apply: false,
         }
     }
 }
@@ -164,21 +229,7 @@ impl NodeParams {
             "warning_amplitude_ratio" => {
                 self.warning_amplitude_ratio = positive(num(value)?, "must be above zero")?
             }
-            "probe_point_topics" => {
-                let mut pairs = Vec::new();
-                for item in value.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-                    let (station, topic) = item.split_once('=').ok_or_else(|| {
-                        format!("parameter probe_point_topics: '{item}' must be station=topic")
-                    })?;
-                    if !topic.starts_with('/') {
-                        return Err(format!(
-                            "parameter probe_point_topics: topic '{topic}' must be absolute (/…)"
-                        ));
-                    }
-                    pairs.push((station.trim().to_string(), topic.trim().to_string()));
-                }
-                self.probe_point_topics = pairs;
-            }
+            "probe_point_topics" => self.probe_point_topics = topic_pairs(name, value)?,
             "speed_type" => {
                 self.speed_type = value
                     .parse()
@@ -243,6 +294,32 @@ impl NodeParams {
                 .map_err(|e| format!("parameter forecast_offsets_rpm: {e}"))?;
                 self.forecast_offsets_rpm = offsets;
             }
+            _ => return self.set_plant_signals(name, value),
+        }
+        Ok(())
+    }
+
+    /// Sets one of the plant-signal parameters (issue 12); any other name is unknown.
+    fn set_plant_signals(&mut self, name: &str, value: &str) -> Result<(), String> {
+        match name {
+            "keyphasor_type" => {
+                self.keyphasor_type = value
+                    .parse()
+                    .map_err(|e| format!("parameter keyphasor_type: {e}"))?
+            }
+            "probe_signal_topics" => self.probe_signal_topics = topic_pairs(name, value)?,
+            "calibration_period_s" => {
+                let p: f64 = value.trim().parse().map_err(|_| {
+                    format!("parameter calibration_period_s: '{value}' is not a number")
+                })?;
+                if !(p == 0.0 || (p.is_finite() && p >= MIN_CALIBRATION_PERIOD_S)) {
+                    return Err(format!(
+                        "parameter calibration_period_s: {p} must be 0 (off) or at least {MIN_CALIBRATION_PERIOD_S} s"
+                    ));
+                }
+                self.calibration_period_s = p;
+            }
+            "calibration_apply" => self.calibration_apply = boolean(name, value)?,
             _ => return Err(format!("unknown parameter '{name}'")),
         }
         Ok(())
@@ -258,6 +335,10 @@ fn boolean(name: &str, value: &str) -> Result<bool, String> {
     }
 }
 
+/// Shortest period of the live calibration (s): 1 s, the diagnostics' rate (a fit takes a
+/// fraction of a second to seconds).
+pub const MIN_CALIBRATION_PERIOD_S: f64 = 1.0;
+
 /// Parameters that may change while the node runs (`ros2 param set`); the others shape the model
 /// or its subscriptions and are set at start only.
 pub const RUNTIME_PARAMETERS: &[&str] = &[
@@ -266,6 +347,7 @@ pub const RUNTIME_PARAMETERS: &[&str] = &[
     "input_timeout_s",
     "min_speed_rpm",
     "warning_amplitude_ratio",
+    "calibration_apply",
 ];
 
 impl NodeParams {
@@ -610,6 +692,30 @@ mod tests {
             ("probe_pulley_end".to_string(), "/plant/probe_b".to_string())
         );
         assert!(p.set("probe_point_topics", "x:/a").is_err());
+        // issue 12: the keyphasor as std_msgs/Header, raw probes as std_msgs/Float64 topics
+        p.set("keyphasor_type", "header").unwrap();
+        assert_eq!(p.keyphasor_type, KeyphasorType::Header);
+        assert!(p
+            .set("keyphasor_type", "bool")
+            .unwrap_err()
+            .contains("keyphasor_type"));
+        p.set(
+            "probe_signal_topics",
+            "probe_outboard_x=/plant/px,probe_outboard_y=/plant/py",
+        )
+        .unwrap();
+        assert_eq!(p.probe_signal_topics[1].1, "/plant/py");
+        assert!(p
+            .set("probe_signal_topics", "probe_outboard_x=plant/px")
+            .unwrap_err()
+            .contains("absolute"));
+        p.set("calibration_period_s", "5").unwrap();
+        assert!(p
+            .set("calibration_period_s", "0.2")
+            .unwrap_err()
+            .contains("at least 1"));
+        p.set_at_runtime("calibration_apply", "true").unwrap();
+        assert!(p.calibration_apply);
         // at run time: rates and thresholds yes, the model no
         p.set_at_runtime("state_rate_hz", "50").unwrap();
         assert_eq!(p.state_rate_hz, 50.0);

@@ -1,0 +1,348 @@
+//! Live calibration (issue 12): the measured 1X vectors and mean positions of the node's 1X
+//! blocks ([`super::OneXBlock`]), gathered by speed, fitted to the twin's viscosity and unbalance
+//! by [`crate::calibrate`] (the replay's `--calibrate` fit: the viscosity scale first, from the
+//! mean journal positions by the films' static equilibrium, then the unbalance from the 1X
+//! vectors by the twin's influence coefficients at that viscosity), and the estimate applied to
+//! the running twin on request and taken back ([`super::Driver::apply_calibration`]).
+//!
+//! A block is used for the unbalance only when it is referenced to the keyphasor (the phase is
+//! then from the mark), and for either only when its 1X and mean leave at most
+//! `MAX_WINDOW_RESIDUAL_SHARE` (30 %) of its 1X semi-major axis (no whirl), the replay's rule.
+//! Mean positions count only at stations whose probes keep the DC gap (DC-coupled raw probes, or
+//! displacement pairs): an AC-coupled station's mean is the twin's own. Blocks within
+//! [`SPEED_BIN_RPM`] share one vector (their phasors averaged), so the fit computes the influence
+//! coefficients and the equilibria at a few speeds, and the most recent [`MAX_SPEED_BINS`] speeds
+//! are kept.
+
+use super::OneXBlock;
+use crate::calibrate::{
+    estimate_unbalance, estimate_viscosity, CalibrationError, MeanPosition, OneXVector,
+    UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
+};
+use crate::replay::calibration::MAX_WINDOW_RESIDUAL_SHARE;
+use crate::rotor::Rotor;
+
+/// Width of a speed bin (rpm): 10 rpm, 0.1 % of the rated speed. The influence coefficients
+/// move by less than that between two speeds of one bin below the first critical's
+/// neighbourhood (they vary on the scale of the modes' half-power bandwidth).
+pub const SPEED_BIN_RPM: f64 = 10.0;
+
+/// Speed bins kept (the most recently updated).
+pub const MAX_SPEED_BINS: usize = 16;
+
+/// The sums of one station at one speed bin.
+#[derive(Debug, Clone, Copy, Default)]
+struct Bin {
+    station: usize,
+    bin: i64,
+    speed_sum: f64,
+    /// keyphasor-referenced 1X phasors (x, y axes), summed, and their count
+    phasors: [[f64; 2]; 2],
+    locked: usize,
+    /// mean positions summed, and their count (DC stations only)
+    mean: [f64; 2],
+    means: usize,
+    blocks: usize,
+    updated: u64,
+}
+
+/// The averaged measurements a fit takes: 1X vectors and mean positions.
+pub type MeasuredSet = (Vec<OneXVector>, Vec<MeanPosition>);
+
+/// The measurements gathered for the live calibration.
+#[derive(Debug, Clone, Default)]
+pub struct LiveCalibration {
+    bins: Vec<Bin>,
+    updates: u64,
+    /// Blocks left out for non-synchronous motion.
+    pub whirl_blocks: u64,
+}
+
+/// What one fit gives: the viscosity (None with the reason) and the unbalance at it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiveEstimate {
+    /// The viscosity estimate, or why there is none.
+    pub viscosity: Result<ViscosityEstimate, String>,
+    /// The unbalance estimate, or why there is none.
+    pub unbalance: Result<UnbalanceEstimate, String>,
+    /// 1X vectors and mean positions used.
+    pub vectors: usize,
+    /// Mean positions used.
+    pub positions: usize,
+}
+
+impl LiveCalibration {
+    /// Adds a block of station `dc` (its probes keep the DC gap) to its speed bin.
+    pub fn add(&mut self, b: &OneXBlock, dc: bool) {
+        if b.residual_rms_m > MAX_WINDOW_RESIDUAL_SHARE * b.measured_major_m() {
+            self.whirl_blocks += 1;
+            return;
+        }
+        let rpm = crate::units::rad_s_to_rpm(b.speed_rad_s);
+        let bin = (rpm / SPEED_BIN_RPM).round() as i64;
+        self.updates += 1;
+        let i = match self
+            .bins
+            .iter()
+            .position(|e| e.station == b.station && e.bin == bin)
+        {
+            Some(i) => i,
+            None => {
+                if self.bins.len() >= MAX_SPEED_BINS * 4 {
+                    self.drop_oldest();
+                }
+                self.bins.push(Bin {
+                    station: b.station,
+                    bin,
+                    ..Bin::default()
+                });
+                self.bins.len() - 1
+            }
+        };
+        let e = &mut self.bins[i];
+        e.updated = self.updates;
+        e.blocks += 1;
+        e.speed_sum += b.speed_rad_s;
+        if b.null_reason.is_none() {
+            for a in 0..2 {
+                let p = b.measured_xy[a].phasor_m();
+                e.phasors[a] = [e.phasors[a][0] + p[0], e.phasors[a][1] + p[1]];
+            }
+            e.locked += 1;
+        }
+        if dc {
+            e.mean = [
+                e.mean[0] + b.measured_mean_m[0],
+                e.mean[1] + b.measured_mean_m[1],
+            ];
+            e.means += 1;
+        }
+    }
+
+    fn drop_oldest(&mut self) {
+        if let Some((i, _)) = self.bins.iter().enumerate().min_by_key(|(_, e)| e.updated) {
+            self.bins.swap_remove(i);
+        }
+    }
+
+    /// The averaged measurements: keyphasor-referenced 1X vectors per station, axis and speed
+    /// bin, and DC mean positions per station and speed bin.
+    pub fn measurements(&self) -> MeasuredSet {
+        let mut vectors = Vec::new();
+        let mut positions = Vec::new();
+        for e in &self.bins {
+            let w = e.speed_sum / e.blocks as f64;
+            if e.locked > 0 {
+                for a in 0..2 {
+                    let n = e.locked as f64;
+                    let x = [e.phasors[a][0] / n, e.phasors[a][1] / n];
+                    vectors.push(OneXVector::from_complex(e.station, a, w, x));
+                }
+            }
+            if e.means > 0 {
+                let n = e.means as f64;
+                positions.push(MeanPosition {
+                    station: e.station,
+                    speed_rad_s: w,
+                    position_m: [e.mean[0] / n, e.mean[1] / n],
+                });
+            }
+        }
+        (vectors, positions)
+    }
+}
+
+/// The fit of `measured` (as [`LiveCalibration::measurements`] gives them) for the machine
+/// `rotor` describes (at its file's viscosity): the viscosity scale from the mean positions
+/// (when there are at least two), then the unbalance at that viscosity (at the file's when the
+/// viscosity cannot be fitted).
+pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
+    let (vectors, positions) = measured;
+    let mut reference = rotor.clone();
+    // the scale is fitted against the machine file's viscosity
+    let _ = reference.set_viscosity_scale(1.0);
+    let text = |e: CalibrationError| e.to_string();
+    let viscosity = estimate_viscosity(&reference, positions).map_err(text);
+    let mut at = reference.clone();
+    if let Ok(v) = &viscosity {
+        if let Err(e) = at.set_viscosity_scale(v.scale) {
+            return LiveEstimate {
+                viscosity: Err(format!("fitted scale {}: {e}", v.scale)),
+                unbalance: Err("not fitted: the viscosity was refused".into()),
+                vectors: vectors.len(),
+                positions: positions.len(),
+            };
+        }
+    }
+    let unbalance = match vectors.is_empty() {
+        true => {
+            Err("no keyphasor-referenced 1X vector yet (a 1X phase needs the keyphasor)".into())
+        }
+        false => estimate_unbalance(&at, vectors, DEFAULT_CORRECTION_RADIUS_M).map_err(text),
+    };
+    LiveEstimate {
+        viscosity,
+        unbalance,
+        vectors: vectors.len(),
+        positions: positions.len(),
+    }
+}
+
+impl LiveEstimate {
+    /// The message of this estimate, stamped `ns`; `applied`: in force in the running twin.
+    pub fn to_message(&self, ns: i64, applied: bool) -> crate::messages::CalibrationEstimate {
+        let mut m = crate::messages::CalibrationEstimate {
+            header: crate::session::header(ns, ""),
+            vectors: self.vectors as u32,
+            positions: self.positions as u32,
+            applied,
+            correction_radius: DEFAULT_CORRECTION_RADIUS_M,
+            ..Default::default()
+        };
+        match &self.viscosity {
+            Ok(v) => {
+                m.viscosity_valid = true;
+                m.viscosity_scale = v.scale;
+                m.viscosity_scale_std = v.scale_std;
+                m.viscosity = v.viscosity_pa_s;
+                m.viscosity_residual = v.residual_rms_m;
+                if let (Some(t), Some(s), Some(o)) =
+                    (v.temperature_c, v.temperature_std_k, v.temperature_offset_k)
+                {
+                    m.temperature_valid = true;
+                    m.oil_temperature = t + crate::film::ZERO_CELSIUS_K;
+                    m.oil_temperature_std = s;
+                    m.temperature_offset = o;
+                }
+            }
+            Err(why) => m.viscosity_reason = why.clone(),
+        }
+        match &self.unbalance {
+            Ok(u) => {
+                m.unbalance_valid = true;
+                for p in &u.planes {
+                    m.unbalance_nodes.push(p.node as u32);
+                    m.unbalance_magnitudes.push(p.magnitude_g_mm * 1e-6);
+                    m.unbalance_phases.push(p.phase_deg.to_radians());
+                    m.correction_masses.push(p.correction.mass_g * 1e-3);
+                    m.correction_angles
+                        .push(p.correction.angle_deg.to_radians());
+                }
+                m.unbalance_residual = u.residual_rms_m;
+                m.unbalance_relative_residual = u.relative_residual;
+                m.condition_number = u.condition_number;
+            }
+            Err(why) => m.unbalance_reason = why.clone(),
+        }
+        m
+    }
+
+    /// What applying it sets: the unbalance per plane (m·e kg·m, phase rad), if fitted, and
+    /// the viscosity scale, if fitted.
+    pub fn values(&self) -> (Option<Vec<(f64, f64)>>, Option<f64>) {
+        let unbalance = self.unbalance.as_ref().ok().map(|u| {
+            u.planes
+                .iter()
+                .map(|p| {
+                    let me = (p.magnitude_g_mm * 1e-6).min(super::inputs::MAX_UNBALANCE_KG_M);
+                    (me, p.phase_deg.to_radians())
+                })
+                .collect()
+        });
+        (unbalance, self.viscosity.as_ref().ok().map(|v| v.scale))
+    }
+}
+
+/// The calibration in force in the running twin (set by [`super::Driver::apply_calibration`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Applied {
+    /// m·e (kg·m) and phase (rad) per plane, if applied.
+    pub unbalance: Option<Vec<(f64, f64)>>,
+    /// Viscosity scale, if applied.
+    pub viscosity_scale: Option<f64>,
+}
+
+impl super::Driver {
+    /// Applies a calibration to the running twin and to every later start: the unbalance per
+    /// plane (m·e kg·m, phase rad from the mark) and the viscosity scale (over the machine
+    /// file's; it then takes the place of the oil temperature's, which is kept for
+    /// [`Self::revert_calibration`]). Returns what changed, for the log.
+    pub fn apply_calibration(&mut self, applied: Applied) -> Result<String, String> {
+        let mut said = Vec::new();
+        if let Some(s) = applied.viscosity_scale {
+            self.set_scale(s)?;
+            said.push(format!("viscosity × {s:.4}"));
+        }
+        if let Some(u) = &applied.unbalance {
+            for (p, &(me, phase)) in u.iter().enumerate() {
+                super::check_unbalance(p as u32, me, phase, self.limits.planes)?;
+                if let Some(s) = self.session.as_mut() {
+                    s.twin_mut()
+                        .set_unbalance(p, me, phase)
+                        .map_err(|e| format!("unbalance: {e}"))?;
+                }
+                said.push(format!(
+                    "plane {p}: {:.1} g·mm at {:.1}°",
+                    me * 1e6,
+                    phase.to_degrees().rem_euclid(360.0)
+                ));
+            }
+        }
+        self.calibration = Some(applied);
+        Ok(said.join(", "))
+    }
+
+    /// Takes a calibration back: the unbalance received (else the machine file's) and the oil
+    /// temperature's viscosity scale (else the machine file's).
+    pub fn revert_calibration(&mut self) -> Result<(), String> {
+        let Some(applied) = self.calibration.take() else {
+            return Ok(());
+        };
+        if applied.viscosity_scale.is_some() {
+            self.set_scale(self.oil_scale.unwrap_or(1.0))?;
+        }
+        if applied.unbalance.is_some() {
+            for p in 0..self.unbalance.len() {
+                let (me, phase) = self.unbalance_in_force(p);
+                if let Some(s) = self.session.as_mut() {
+                    s.twin_mut()
+                        .set_unbalance(p, me, phase)
+                        .map_err(|e| format!("unbalance: {e}"))?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The calibration in force, if any.
+    pub fn calibration(&self) -> Option<&Applied> {
+        self.calibration.as_ref()
+    }
+
+    /// The unbalance of plane `p` a (re)started twin gets: the calibration's when applied, else
+    /// the last received, else the machine file's (m·e kg·m, phase rad).
+    pub(super) fn unbalance_in_force(&self, p: usize) -> (f64, f64) {
+        if let Some(u) = self.calibration.as_ref().and_then(|c| c.unbalance.as_ref()) {
+            if let Some(&v) = u.get(p) {
+                return v;
+            }
+        }
+        self.unbalance[p].unwrap_or_else(|| {
+            let u = &self.rotor.unbalance[p];
+            (u.magnitude_kg_m, u.phase_rad)
+        })
+    }
+
+    /// Sets the viscosity scale of the machine and of the running twin.
+    fn set_scale(&mut self, s: f64) -> Result<(), String> {
+        self.rotor
+            .set_viscosity_scale(s)
+            .map_err(|e| format!("viscosity scale: {e}"))?;
+        if let Some(t) = self.session.as_mut() {
+            t.twin_mut()
+                .set_viscosity_scale(s)
+                .map_err(|e| format!("viscosity scale: {e}"))?;
+        }
+        Ok(())
+    }
+}

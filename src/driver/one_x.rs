@@ -1,0 +1,347 @@
+//! Live 1X vectors (issue 12): the probe comparisons of one station gathered over blocks of
+//! [`ONE_X_BLOCK_REVS`] whole revolutions of the twin's shaft angle (the replay's block,
+//! `replay::compare::BLOCK_REVS`), and at each block's end the 1X vector of the measured and
+//! of the predicted signal along each of the station's two probe axes, by the one 1X rule of
+//! [`crate::signals::one_x_vector`] (Hann-windowed DFT at order 1, phase lag in the API 670 /
+//! Bently convention), as the replay computes them. The phase lags are null, with the reason,
+//! unless every sample of the block was referenced to a locked keyphasor
+//! ([`crate::signals::PhaseReference::null_reason`]); the amplitudes do not depend on the phase reference.
+//!
+//! A block also gives, per machine axis, the measured 1X vector and mean position that the live
+//! calibration uses ([`crate::calibrate`]'s convention: a = Re(X e^{iθ})), and how much of the
+//! measured motion the 1X and the mean leave (a whirl makes that large).
+
+use super::ProbeComparison;
+use crate::signals::{one_x_vector, OneXVector};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Revolutions of one block: 8, the replay's (`replay::compare::BLOCK_REVS`).
+pub const ONE_X_BLOCK_REVS: usize = crate::replay::compare::BLOCK_REVS;
+
+/// Samples a block holds at most: 32,768 (8 revolutions at 1,000 rpm, the default minimum
+/// speed, are 0.48 s: room for 68 kHz of probe samples). A block that fills before its
+/// revolutions are complete is given up and counted ([`OneXBlocks::overflowed`]).
+pub const ONE_X_BLOCK_CAPACITY: usize = 32_768;
+
+/// One sample of a block.
+#[derive(Debug, Clone, Copy, Default)]
+struct BlockSample {
+    angle_rad: f64,
+    speed_rad_s: f64,
+    measured_m: [f64; 2],
+    predicted_m: [f64; 2],
+}
+
+/// What a finished block gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OneXBlock {
+    /// Probe station index.
+    pub station: usize,
+    /// Time of the block's last sample (ns, the driver's time base).
+    pub end_ns: i64,
+    /// Mean speed over the block (rad/s).
+    pub speed_rad_s: f64,
+    /// Whole revolutions in the block.
+    pub revolutions: usize,
+    /// Samples in the block.
+    pub samples: usize,
+    /// The station's probe axis angles (rad, from +x towards +y).
+    pub axes_rad: [f64; 2],
+    /// Measured 1X vector along each probe axis (its phase lag valid only without a reason).
+    pub measured: [OneXVector; 2],
+    /// Predicted 1X vector along each probe axis.
+    pub predicted: [OneXVector; 2],
+    /// Measured 1X vector along the machine axes x, y (for the calibration).
+    pub measured_xy: [OneXVector; 2],
+    /// Measured mean position `[x, y]` (m).
+    pub measured_mean_m: [f64; 2],
+    /// RMS of the measured motion less its mean and 1X (m, both axes).
+    pub residual_rms_m: f64,
+    /// Why the phase lags are null (None: keyphasor-referenced over the whole block).
+    pub null_reason: Option<&'static str>,
+}
+
+impl OneXBlock {
+    /// The measured 1X semi-major axis (m) from the machine-axis vectors.
+    pub fn measured_major_m(&self) -> f64 {
+        let (x, y) = (
+            self.measured_xy[0].phasor_m(),
+            self.measured_xy[1].phasor_m(),
+        );
+        let f = ((x[0] - y[1]).powi(2) + (x[1] + y[0]).powi(2)).sqrt() / 2.0;
+        let b = ((x[0] + y[1]).powi(2) + (x[1] - y[0]).powi(2)).sqrt() / 2.0;
+        f + b
+    }
+}
+
+impl OneXBlock {
+    /// The message of this block at station `name`: phase lags empty, with the reason, unless
+    /// keyphasor-referenced; amplitudes always.
+    pub fn to_message(&self, name: &str) -> crate::messages::OneXVectors {
+        let lags = |v: &[OneXVector; 2]| match self.null_reason {
+            None => v.iter().map(|a| a.phase_lag_deg).collect(),
+            Some(_) => Vec::new(),
+        };
+        let errors = match self.null_reason {
+            None => (0..2)
+                .map(|j| {
+                    let d = self.predicted[j].phase_lag_deg - self.measured[j].phase_lag_deg;
+                    (d + 180.0).rem_euclid(360.0) - 180.0
+                })
+                .collect(),
+            Some(_) => Vec::new(),
+        };
+        crate::messages::OneXVectors {
+            header: crate::session::header(self.end_ns, name),
+            station: name.to_string(),
+            speed: self.speed_rad_s,
+            revolutions: self.revolutions as u32,
+            samples: self.samples as u32,
+            axis_angles: self.axes_rad.to_vec(),
+            measured_amplitudes: self.measured.iter().map(|a| a.amplitude_m).collect(),
+            measured_phase_lags_deg: lags(&self.measured),
+            predicted_amplitudes: self.predicted.iter().map(|a| a.amplitude_m).collect(),
+            predicted_phase_lags_deg: lags(&self.predicted),
+            phase_lag_errors_deg: errors,
+            phase_null_reason: self.null_reason.unwrap_or_default().to_string(),
+        }
+    }
+}
+
+/// The block being gathered at one station.
+#[derive(Debug, Clone)]
+struct Gathering {
+    samples: Vec<BlockSample>,
+    start_angle_rad: f64,
+    reason: Option<&'static str>,
+}
+
+/// The blocks of every probe station.
+#[derive(Debug, Clone)]
+pub struct OneXBlocks {
+    stations: Vec<Gathering>,
+    axes: Vec<[f64; 2]>,
+    /// Blocks given up because they filled before their revolutions were complete.
+    pub overflowed: u64,
+}
+
+impl OneXBlocks {
+    /// Blocks for stations whose probe axes are `axes` (rad); the buffers are allocated here.
+    pub fn new(axes: Vec<[f64; 2]>) -> Self {
+        let stations = axes
+            .iter()
+            .map(|_| Gathering {
+                samples: Vec::with_capacity(ONE_X_BLOCK_CAPACITY),
+                start_angle_rad: 0.0,
+                reason: None,
+            })
+            .collect();
+        Self {
+            stations,
+            axes,
+            overflowed: 0,
+        }
+    }
+
+    /// Adds a comparison; returns the block it completes, if it does. A twin that restarted
+    /// (its angle went back by more than half a revolution) or a revolution without a sample
+    /// starts a new block.
+    pub fn add(&mut self, c: &ProbeComparison) -> Option<OneXBlock> {
+        let g = self.stations.get_mut(c.station)?;
+        let last = g.samples.last().map(|s| s.angle_rad);
+        if last.is_some_and(|a| c.angle_rad < a - PI || c.angle_rad > a + TAU) {
+            g.samples.clear();
+        }
+        if g.samples.len() >= ONE_X_BLOCK_CAPACITY {
+            g.samples.clear();
+            self.overflowed += 1;
+        }
+        if g.samples.is_empty() {
+            g.start_angle_rad = c.angle_rad;
+            g.reason = None;
+        }
+        g.reason = g.reason.or(c.phase_reference.null_reason());
+        g.samples.push(BlockSample {
+            angle_rad: c.angle_rad,
+            speed_rad_s: c.speed_rad_s,
+            measured_m: c.measured_m,
+            predicted_m: c.predicted_m,
+        });
+        if c.angle_rad - g.start_angle_rad < ONE_X_BLOCK_REVS as f64 * TAU {
+            return None;
+        }
+        let block = finish(c.station, c.time_ns, self.axes[c.station], g);
+        // the sample that closed this block opens the next one
+        let last = g.samples[g.samples.len() - 1];
+        g.samples.clear();
+        g.samples.push(last);
+        g.start_angle_rad = last.angle_rad;
+        g.reason = c.phase_reference.null_reason();
+        block
+    }
+}
+
+/// The 1X vectors of a gathered block (the last sample, which reached the block's end, is
+/// left out: the block spans whole revolutions).
+fn finish(station: usize, end_ns: i64, axes: [f64; 2], g: &Gathering) -> Option<OneXBlock> {
+    let s = &g.samples[..g.samples.len().saturating_sub(1)];
+    let n = s.len();
+    let along = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
+        let (sn, cs) = a.sin_cos();
+        one_x_vector(
+            s.iter().map(move |q| {
+                let p = pick(q);
+                (q.angle_rad, p[0] * cs + p[1] * sn)
+            }),
+            n,
+        )
+    };
+    let measured = |q: &BlockSample| q.measured_m;
+    let predicted = |q: &BlockSample| q.predicted_m;
+    let m = [along(measured, axes[0])?, along(measured, axes[1])?];
+    let p = [along(predicted, axes[0])?, along(predicted, axes[1])?];
+    let xy = [along(measured, 0.0)?, along(measured, FRAC_PI_2)?];
+    let mean = [0, 1].map(|j| s.iter().map(|q| q.measured_m[j]).sum::<f64>() / n as f64);
+    let rss: f64 = s
+        .iter()
+        .map(|q| {
+            (0..2)
+                .map(|j| {
+                    let fit = mean[j] + crate::signals::probes::runout_at(&xy[j], q.angle_rad);
+                    (q.measured_m[j] - fit).powi(2)
+                })
+                .sum::<f64>()
+        })
+        .sum();
+    Some(OneXBlock {
+        station,
+        end_ns,
+        speed_rad_s: s.iter().map(|q| q.speed_rad_s).sum::<f64>() / n as f64,
+        revolutions: ONE_X_BLOCK_REVS,
+        samples: n,
+        axes_rad: axes,
+        measured: m,
+        predicted: p,
+        measured_xy: xy,
+        measured_mean_m: mean,
+        residual_rms_m: (rss / (2 * n) as f64).sqrt(),
+        null_reason: g.reason,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signals::PhaseReference;
+
+    fn comparison(k: usize, psi: f64, w: f64, lag: f64, r: PhaseReference) -> ProbeComparison {
+        // a forward 1X circle of 3 µm lagging the mark by `lag`, about a mean of (5, −20) µm;
+        // the prediction: 1 µm lagging by lag + 40°
+        let a = 3e-6;
+        let q = lag + 40f64.to_radians();
+        ProbeComparison {
+            station: 0,
+            time_ns: (psi / w * 1e9) as i64 + k as i64,
+            angle_rad: psi,
+            speed_rad_s: w,
+            measured_m: [5e-6 + a * (psi - lag).cos(), -20e-6 + a * (psi - lag).sin()],
+            predicted_m: [1e-6 * (psi - q).cos(), 1e-6 * (psi - q).sin()],
+            phase_reference: r,
+        }
+    }
+
+    /// A forward circle x = A cos(ψ − β), y = A sin(ψ − β) read by probes at α: d = A cos(ψ −
+    /// β − α), so each probe's lag is β + α (the plant-signal tests' closed form), here with
+    /// probes at 45° and 135° and β = 50°: 95° and 185°, within 0.5°, 3 µm within 1 %; the
+    /// machine axes read β and β + 90°, the mean (5, −20) µm, the residual nothing.
+    #[test]
+    fn a_block_gives_the_lag_of_each_probe_axis() {
+        let axes = [45f64.to_radians(), 135f64.to_radians()];
+        let mut blocks = OneXBlocks::new(vec![axes]);
+        let (w, lag) = (800.0, 50f64.to_radians());
+        let per_rev = 37; // not a divisor of anything in particular
+        let mut out = None;
+        for k in 0..(9 * per_rev) {
+            let psi = TAU * k as f64 / per_rev as f64 + 0.3;
+            let c = comparison(k, psi, w, lag, PhaseReference::Locked);
+            if let Some(b) = blocks.add(&c) {
+                out.get_or_insert(b);
+            }
+        }
+        let b = out.expect("a block after 8 revolutions");
+        assert_eq!(b.null_reason, None);
+        assert_eq!(b.samples, 8 * per_rev);
+        for (j, want) in [95.0, 185.0].iter().enumerate() {
+            let d = (b.measured[j].phase_lag_deg - want + 180.0).rem_euclid(360.0) - 180.0;
+            assert!(d.abs() < 0.5, "axis {j}: {:?}", b.measured[j]);
+            assert!((b.measured[j].amplitude_m / 3e-6 - 1.0).abs() < 0.01);
+            let dp = (b.predicted[j].phase_lag_deg - want - 40.0 + 180.0).rem_euclid(360.0) - 180.0;
+            assert!(dp.abs() < 0.5, "predicted axis {j}: {:?}", b.predicted[j]);
+        }
+        assert!((b.measured_xy[0].phase_lag_deg - 50.0).abs() < 0.5, "{b:?}");
+        assert!(
+            (b.measured_xy[1].phase_lag_deg - 140.0).abs() < 0.5,
+            "{b:?}"
+        );
+        assert!((b.measured_mean_m[0] - 5e-6).abs() < 0.05e-6);
+        assert!((b.measured_mean_m[1] + 20e-6).abs() < 0.05e-6);
+        assert!(b.residual_rms_m < 0.05e-6, "{b:?}");
+        assert!((b.measured_major_m() / 3e-6 - 1.0).abs() < 0.01);
+        let m = b.to_message("probe_outboard");
+        assert_eq!(m.measured_phase_lags_deg.len(), 2);
+        assert!((m.phase_lag_errors_deg[0] - 40.0).abs() < 0.5, "{m:?}");
+        assert!(m.phase_null_reason.is_empty());
+    }
+
+    /// One sample without the lock in a block makes its phases null with that reason; a twin
+    /// that restarts (angle back to 0) starts a new block.
+    #[test]
+    fn a_block_not_locked_throughout_has_null_phases_with_the_reason() {
+        let mut blocks = OneXBlocks::new(vec![[0.0, FRAC_PI_2]]);
+        let lag = 0.2;
+        let mut got = Vec::new();
+        for k in 0..(20 * 16) {
+            let psi = TAU * k as f64 / 16.0;
+            let r = if k == 30 {
+                PhaseReference::Stopped
+            } else {
+                PhaseReference::Locked
+            };
+            got.extend(blocks.add(&comparison(k, psi, 900.0, lag, r)));
+        }
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert_eq!(
+            got[0].null_reason,
+            PhaseReference::Stopped.null_reason(),
+            "{:?}",
+            got[0]
+        );
+        assert_eq!(got[1].null_reason, None);
+        let m = got[0].to_message("s");
+        assert!(m.measured_phase_lags_deg.is_empty() && m.phase_lag_errors_deg.is_empty());
+        assert_eq!(m.measured_amplitudes.len(), 2);
+        assert!(m.phase_null_reason.contains("stopped"), "{m:?}");
+        // a restart: back to angle 0 half-way through a block
+        let mut blocks = OneXBlocks::new(vec![[0.0, FRAC_PI_2]]);
+        let mut n = 0;
+        for k in (0..(6 * 16)).chain(0..(6 * 16)) {
+            let psi = TAU * k as f64 / 16.0;
+            n += blocks
+                .add(&comparison(k, psi, 900.0, lag, PhaseReference::Locked))
+                .is_some() as usize;
+        }
+        assert_eq!(
+            n, 0,
+            "two halves of a block across a restart are not one block"
+        );
+        // a revolution and a half without a sample: the block starts again after the gap
+        let mut blocks = OneXBlocks::new(vec![[0.0, FRAC_PI_2]]);
+        let mut got = Vec::new();
+        for k in (0..(4 * 16)).chain((4 * 16 + 24)..(14 * 16)) {
+            let psi = TAU * k as f64 / 16.0;
+            got.extend(blocks.add(&comparison(k, psi, 900.0, lag, PhaseReference::Locked)));
+        }
+        assert_eq!(got.len(), 1, "{got:?}");
+        assert_eq!(got[0].samples, 8 * 16);
+    }
+}

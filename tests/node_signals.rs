@@ -1,0 +1,202 @@
+//! The live node with a plant's own signals (issue 12) and the count of every input sample lost
+//! (issue 15, item 8), against an independent Cyclone DDS peer (tests/interop/signal_peer.py) in a
+//! private network namespace (`unshare -n`, loopback only): the keyphasor as std_msgs/Header and
+//! the raw probes as std_msgs/Float64 topics, selected by node parameters (`keyphasor_type`,
+//! `probe_signal_topics`), all best effort.
+
+use rotor_twin::rotor::DEFAULT_MACHINE_YAML;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The built-in machine with AC-coupled raw probes in µm at 45° and 135° at probe_outboard.
+fn machine(out: &Path) -> PathBuf {
+    let mut yaml = format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n");
+    for (suffix, angle) in [("x", 45.0), ("y", 135.0)] {
+        yaml += &format!(
+            "  - {{name: probe_outboard_{suffix}, station: probe_outboard, angle_deg: {angle}, unit: um, coupling: ac}}\n"
+        );
+    }
+    let path = out.join("machine.yaml");
+    std::fs::write(&path, yaml).unwrap();
+    path
+}
+
+/// Runs tests/interop/signal_scenario.sh (SECONDS RPM STOP_KEYPHASOR_AFTER LOSS_PER_MILLE
+/// UNAPPLY_AFTER) and
+/// returns (peer.json, recorded.json, the node's log).
+fn scenario(name: &str, args: [&str; 5]) -> (Value, Value, String) {
+    // one scenario at a time: two nodes and two peers side by side starve the pairing of
+    // unstamped Float64 readings on two cores
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let setup = Command::new("bash")
+        .arg(root.join("tests/interop/setup-venv.sh"))
+        .output()
+        .expect("setup-venv.sh");
+    assert!(setup.status.success());
+    let py = root.join("tests/.venv/bin/python");
+    let out = std::env::temp_dir().join(format!("rotor-twin-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    let status = Command::new("unshare")
+        .args(["-n", "bash"])
+        .arg(root.join("tests/interop/signal_scenario.sh"))
+        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
+        .arg(&py)
+        .arg(&out)
+        .arg(machine(&out))
+        .args(args)
+        .status()
+        .expect("unshare (needs root: every DDS test runs in a private network namespace)");
+    assert!(status.success());
+    let read = |file: &str| -> Value {
+        let text = std::fs::read_to_string(out.join(file)).unwrap_or_default();
+        serde_json::from_str(&text).unwrap_or_else(|e| {
+            panic!(
+                "{file}: {e}: '{text}'\nnode: {}\npeer: {}",
+                std::fs::read_to_string(out.join("node.err")).unwrap_or_default(),
+                std::fs::read_to_string(out.join("peer.err")).unwrap_or_default()
+            )
+        })
+    };
+    let log = std::fs::read_to_string(out.join("node.err")).unwrap_or_default();
+    let got = (read("peer.json"), read("recorded.json"), log);
+    std::fs::remove_dir_all(&out).ok();
+    got
+}
+
+fn lag_gap(a: f64, b: f64) -> f64 {
+    (a - b + 180.0).rem_euclid(360.0) - 180.0
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// A forward 1X circle of 2 µm lagging the keyphasor by 50° at 1,500 rpm, read by probes at 45°
+/// and 135°: the node publishes, per block of 8 revolutions, each axis's phase lag β + α (95°,
+/// 185°) and amplitude. The peer computes each value for the instant it sends it, and a Float64
+/// is timed by its receive time, so the lag reads late by ω × the transport latency (1° is
+/// 0.11 ms here) and the scheduling jitter of both processes is phase noise: the median over the
+/// blocks within 5° (the issue's tolerance) and 3 %, each block within 15° and 10 % (a loaded
+/// machine: 3.6° and 3 % seen with another test running). When the keyphasor stops at 4 s (the
+/// speed topic goes on), the blocks after it have empty phase lags with the reason and the node
+/// warns "keyphasor stopped"; the amplitudes go on.
+#[test]
+fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
+    let (peer, rec, log) = scenario("signals", ["6", "1500", "4", "0", "4.5"]);
+    let blocks = peer["one_x"].as_array().unwrap();
+    let stop = peer["keyphasor_stopped_at_s"].as_f64().unwrap();
+    let (mut gaps, mut amps, mut null) = ([Vec::new(), Vec::new()], Vec::new(), 0);
+    for b in blocks {
+        let t = b["t_s"].as_f64().unwrap();
+        for a in b["measured_amplitudes"].as_array().unwrap() {
+            let r = a.as_f64().unwrap() / 2e-6 - 1.0;
+            assert!(r.abs() < 0.1, "{b}");
+            amps.push(r);
+        }
+        let lags = b["measured_phase_lags_deg"].as_array().unwrap();
+        if t < stop {
+            assert_eq!(lags.len(), 2, "{b}");
+            for (j, want) in [95.0, 185.0].iter().enumerate() {
+                let d = lag_gap(lags[j].as_f64().unwrap(), *want);
+                println!(
+                    "block at {t:.3} s: axis {j} lag {} against {want} ({d:+.2}°)",
+                    lags[j]
+                );
+                assert!(d.abs() < 15.0, "{b}");
+                gaps[j].push(d);
+            }
+        } else if t > stop + 0.1 {
+            assert!(lags.is_empty(), "{b}");
+            assert!(b["reason"].as_str().unwrap().contains("stopped"), "{b}");
+            null += 1;
+        }
+    }
+    let locked = gaps[0].len();
+    let (g0, g1, a) = (
+        median(gaps[0].clone()),
+        median(gaps[1].clone()),
+        median(amps),
+    );
+    println!(
+        "{locked} locked blocks: median lag error {g0:+.2}° / {g1:+.2}°, amplitude {:+.2} %; {null} null after the stop; {}",
+        100.0 * a,
+        rec["diagnostics"]
+    );
+    assert!(locked >= 6 && null >= 4, "{peer}");
+    assert!(g0.abs() < 5.0 && g1.abs() < 5.0 && a.abs() < 0.03);
+    let stale = peer["warnings"]["stale_input"].to_string();
+    assert!(stale.contains("keyphasor stopped"), "{stale}");
+    assert_eq!(rec["diagnostics"]["keyphasor"], "stopped");
+    // recorded as received, in their own types
+    let c = &rec["counts"];
+    assert_eq!(
+        c["/plant/probe_outboard_x"],
+        peer["sent"]["/plant/probe_outboard_x"]
+    );
+    assert_eq!(c["/rotor_twin/keyphasor"], peer["sent"]["/plant/keyphasor"]);
+    assert_eq!(
+        c["/rotor_twin/one_x"].as_u64().unwrap(),
+        blocks.len() as u64
+    );
+    assert_eq!(rec["diagnostics"]["lost_samples"], "0");
+    // the live calibration (calibration_period_s:=2, calibration_apply:=true): the unbalance
+    // from the keyphasor-referenced 1X vectors, published, recorded and applied (logged); no
+    // viscosity from AC-coupled probes, with the reason; `param set calibration_apply:=false`
+    // at 4.5 s takes it back (logged), and the last estimate recorded says it is not applied
+    let cal = &rec["calibration"];
+    println!("calibration: {cal}");
+    assert_eq!(cal["unbalance_valid"], true, "{cal}");
+    assert_eq!(cal["applied_before"], true, "{cal}");
+    assert_eq!(cal["applied"], false, "{cal}");
+    assert!(log.contains("calibration taken back"), "{log}");
+    assert_eq!(cal["viscosity_valid"], false, "{cal}");
+    assert!(
+        cal["viscosity_reason"]
+            .as_str()
+            .unwrap()
+            .contains("mean position"),
+        "{cal}"
+    );
+    assert!(log.contains("calibration applied to the twin"), "{log}");
+}
+
+/// The peer's Cyclone DDS drops 5 % of the datagrams it sends (its XmitLossiness test option): a
+/// lossy best-effort link. Every sample sent is recorded or counted lost (the sequence gaps of
+/// /diagnostics' `lost_samples <topic>`), per topic, up to 2 (a loss before a writer's first
+/// or after its last delivered sample shows no gap), and losses were counted on every topic.
+/// Before, such losses were invisible (`dropped_messages 0`).
+#[test]
+fn every_sample_lost_on_a_best_effort_link_is_counted() {
+    let (peer, rec, _) = scenario("signal-loss", ["6", "1500", "100", "50", "0"]);
+    let d = &rec["diagnostics"];
+    println!("{d}");
+    let mut lost_all = 0;
+    for (sent_topic, recorded_topic) in [
+        ("/plant/probe_outboard_x", "/plant/probe_outboard_x"),
+        ("/plant/probe_outboard_y", "/plant/probe_outboard_y"),
+        ("/rotor_twin/speed", "/rotor_twin/speed"),
+        ("/plant/keyphasor", "/rotor_twin/keyphasor"),
+    ] {
+        let sent = peer["sent"][sent_topic].as_u64().unwrap();
+        let recorded = rec["counts"][recorded_topic].as_u64().unwrap();
+        let lost: u64 = d[format!("lost_samples {sent_topic}")]
+            .as_str()
+            .unwrap_or("0")
+            .parse()
+            .unwrap();
+        println!("{sent_topic}: sent {sent}, recorded {recorded}, counted lost {lost}");
+        assert!(
+            recorded + lost <= sent && recorded + lost + 2 >= sent,
+            "{sent_topic}"
+        );
+        if sent > 500 {
+            assert!(lost > 0, "{sent_topic}: 5 % of {sent} lost, none counted");
+        }
+        lost_all += lost;
+    }
+    assert_eq!(d["lost_samples"].as_str().unwrap(), lost_all.to_string());
+}
