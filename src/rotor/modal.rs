@@ -757,6 +757,7 @@ mod eigen_failure_tests {
             FilmCoefficients {
                 stiffness_n_per_m: [[1e8, 2e7], [-3e7, 9e7]],
                 damping_n_s_per_m: [[1e5, 0.0], [0.0, 1e5]],
+                ..FilmCoefficients::default()
             };
             rotor.bearings.len()
         ];
