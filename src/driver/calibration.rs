@@ -327,10 +327,13 @@ impl super::Driver {
                 return v;
             }
         }
-        self.unbalance[p].unwrap_or_else(|| {
-            let u = &self.rotor.unbalance[p];
-            (u.magnitude_kg_m, u.phase_rad)
-        })
+        match self.unbalance[p] {
+            Some(u) => (u.magnitude_kg_m, u.phase_rad),
+            None => {
+                let u = &self.rotor.unbalance[p];
+                (u.magnitude_kg_m, u.phase_rad)
+            }
+        }
     }
 
     /// Sets the viscosity scale of the machine and of the running twin.

@@ -831,7 +831,10 @@ impl InputRoute {
                 inbox
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
-                    .push((at, queued));
+                    .push(model::Queued {
+                        received_ns: at,
+                        input: queued,
+                    });
             }
         });
         Ok(())
@@ -878,7 +881,10 @@ fn subscribe_clock(
                         crate::driver::CLOCK_CONFIRM
                     );
                     let mut inbox = inbox.lock().unwrap_or_else(|e| e.into_inner());
-                    inbox.push((Some(clock_ns), Err(why)));
+                    inbox.push(model::Queued {
+                        received_ns: Some(clock_ns),
+                        input: Err(why),
+                    });
                 }
                 ClockSample::Jumped { from_ns } => eprintln!(
                     "rotor_twin: /clock jumped from {:.6} s to {:.6} s",
