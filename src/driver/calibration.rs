@@ -159,7 +159,8 @@ impl LiveCalibration {
 pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
     let (vectors, positions) = measured;
     let mut reference = rotor.clone();
-    // the scale is fitted against the machine file's viscosity
+    // the scale is fitted against the machine file's viscosity (1.0 is always valid: the
+    // result cannot be an error)
     let _ = reference.set_viscosity_scale(1.0);
     let text = |e: CalibrationError| e.to_string();
     let viscosity = estimate_viscosity(&reference, positions).map_err(text);

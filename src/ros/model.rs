@@ -503,23 +503,28 @@ impl ModelLoop {
         }
         self.apply_seen = want;
         let Some(e) = self.last_estimate.take() else {
-            if !want {
-                let _ = self.driver.revert_calibration();
+            if !want && self.driver.calibration().is_some() {
+                self.revert_calibration();
             }
             return;
         };
         if want {
             self.apply(&e);
         } else {
-            match self.driver.revert_calibration() {
-                Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
-                Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
-            }
+            self.revert_calibration();
         }
         let applied = self.driver.calibration().is_some();
         self.pending
             .push(Published::Calibration(Box::new(e.to_message(now, applied))));
         self.last_estimate = Some(e);
+    }
+
+    /// Takes the calibration back, saying so or why it could not.
+    fn revert_calibration(&mut self) {
+        match self.driver.revert_calibration() {
+            Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
+            Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
+        }
     }
 
     /// The linear stability threshold recomputed, off the model thread, when the viscosity in
