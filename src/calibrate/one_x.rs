@@ -106,7 +106,8 @@ impl WindowFits {
     /// whole window's angle past the window's first.
     pub fn push(&mut self, s: AngleSample) {
         self.theta = match self.previous_angle_rad {
-            Some(prev) => self.theta + (s.angle_rad - prev + PI).rem_euclid(TAU) - PI,
+            // the step wrapped to (−π, π], added as one term (the batch fit's rounding)
+            Some(prev) => self.theta + ((s.angle_rad - prev + PI).rem_euclid(TAU) - PI),
             None => s.angle_rad,
         };
         self.previous_angle_rad = Some(s.angle_rad);
