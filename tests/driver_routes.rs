@@ -10,7 +10,7 @@ use rotor_twin::dynamics::FilmEvaluation;
 use rotor_twin::messages::{self, to_cdr, Header, Time};
 use rotor_twin::record::{Recorder, TopicQos};
 use rotor_twin::replay::{replay, ReplayOptions};
-use rotor_twin::ros::model::{Inbox, ModelLoop, NodeClock, Outgoing};
+use rotor_twin::ros::model::{Inbox, ModelLoop, NodeClock, Outgoing, Queued};
 use rotor_twin::ros::NodeParams;
 use rotor_twin::rotor::{MachineDescription, Rotor};
 use std::sync::atomic::AtomicU64;
@@ -128,7 +128,10 @@ fn node_route(inputs: &[(i64, Msg)]) -> Vec<(u8, i64, Vec<u8>)> {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
     for (t, m) in inputs {
-        inbox.lock().unwrap().push((Some(*t), Ok(input_of(m))));
+        inbox.lock().unwrap().push(Queued {
+            received_ns: Some(*t),
+            input: Ok(input_of(m)),
+        });
         let taken = clock.sim_clock.lock().unwrap().offer(*t);
         assert_eq!(taken, rotor_twin::driver::ClockSample::Taken);
         model.wake(&mut |o| out.push(o));
@@ -227,6 +230,111 @@ fn the_node_and_the_replay_give_the_same_outputs_for_the_same_inputs() {
         ))
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Inputs from `from_ns` to `to_ns` after T0, on a 0.5 ms grid: a speed of `rpm` every 5 ms
+/// (None: no speed), and a probe sample at every other grid point when `probes`.
+fn segment(out: &mut Vec<(i64, Msg)>, from_ns: i64, to_ns: i64, rpm: Option<f64>, probes: bool) {
+    for k in (from_ns / 500_000)..(to_ns / 500_000) {
+        let t = T0_NS + k * 500_000;
+        if k % 10 == 0 {
+            if let Some(rpm) = rpm {
+                out.push((
+                    t,
+                    Msg::Speed(messages::RotorSpeed {
+                        header: stamped(t),
+                        speed: rpm * std::f64::consts::PI / 30.0,
+                        acceleration: 0.0,
+                    }),
+                ));
+            }
+        } else if probes {
+            let station = if k % 2 == 0 {
+                "probe_pulley_end"
+            } else {
+                "probe_outboard"
+            };
+            out.push((
+                t,
+                Msg::Probe(messages::ProbeDisplacement {
+                    header: stamped(t - 100_000),
+                    station: station.into(),
+                    x: 1e-6 * (k as f64 * 0.01).sin(),
+                    y: 1e-6 * (k as f64 * 0.01).cos(),
+                }),
+            ));
+        }
+    }
+}
+
+#[test]
+fn the_routes_agree_through_a_pause_a_restart_and_input_gaps() {
+    const MS: i64 = 1_000_000;
+    let mut run = Vec::new();
+    segment(&mut run, 0, 100 * MS, Some(8000.0), true);
+    // below the minimum speed (1,000 rpm): the twin pauses; an unbalance comes while paused
+    segment(&mut run, 100 * MS, 150 * MS, Some(500.0), true);
+    run.push((
+        T0_NS + 120 * MS + 250_000,
+        Msg::Unbalance(messages::Unbalance {
+            plane: 0,
+            magnitude: 2.8e-4,
+            phase: 0.7,
+            ..Default::default()
+        }),
+    ));
+    // back up: it restarts with that unbalance
+    segment(&mut run, 150 * MS, 250 * MS, Some(7000.0), true);
+    // probes without speed for 1.5 s (over the 1 s input timeout): stale-speed warnings
+    segment(&mut run, 250 * MS, 1750 * MS, None, true);
+    // then no input at all for 6 s (over the 5 s gap): the twin stops; the next speed restarts it
+    segment(&mut run, 7750 * MS, 7850 * MS, Some(8000.0), true);
+    run.sort_by_key(|(t, _)| *t);
+    let dir = std::env::temp_dir().join(format!("rotor-twin-routes-gap-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let node = node_route(&run);
+    let replayed = replay_route(&run, &dir);
+    // the run did pause, restart and stop: no journal state in the pause or the silence, states
+    // after each restart, and stale-input warnings for the missing speed and the silence
+    let states_in = |from_ms: i64, to_ms: i64| {
+        node.iter()
+            .filter(|k| k.0 == 0 && k.1 > T0_NS + from_ms * MS && k.1 < T0_NS + to_ms * MS)
+            .count()
+    };
+    assert!(states_in(0, 100) > 10, "states before the pause");
+    assert_eq!(states_in(106, 150), 0, "no state while paused");
+    assert!(states_in(150, 250) > 10, "states after the restart");
+    assert!(states_in(250, 1750) > 200, "held speed: the twin runs on");
+    assert_eq!(states_in(1760, 7750), 0, "no state in the silence");
+    assert!(
+        states_in(7750, 7850) > 10,
+        "states after the restart at 7.75 s"
+    );
+    let warnings = node.iter().filter(|k| k.0 == 3).count();
+    assert!(
+        warnings >= 2,
+        "stale speed and silence warned about: {warnings}"
+    );
+    assert_same(&node, &replayed);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The outputs of the two routes are the same, byte for byte.
+fn assert_same(node: &[(u8, i64, Vec<u8>)], replayed: &[(u8, i64, Vec<u8>)]) {
+    let count = |keys: &[(u8, i64, Vec<u8>)], kind: u8| keys.iter().filter(|k| k.0 == kind).count();
+    for kind in 0..6 {
+        assert_eq!(
+            count(node, kind),
+            count(replayed, kind),
+            "outputs of kind {kind}"
+        );
+    }
+    let first = node.iter().zip(replayed).position(|(a, b)| a != b);
+    assert!(
+        first.is_none(),
+        "byte-identical outputs by either route; first difference: {:?}",
+        first.map(|i| (node[i].0, node[i].1, replayed[i].1))
+    );
 }
 
 /// The journal positions a driver publishes, for a run fed `inputs`.

@@ -247,7 +247,7 @@ fn the_live_estimate_recovers_the_plant_and_applying_it_moves_the_prediction_ont
 #[test]
 fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes() {
     use rotor_twin::messages::{Header, Temperature, Time};
-    use rotor_twin::ros::model::{Inbox, ModelLoop, NodeClock};
+    use rotor_twin::ros::model::{Inbox, ModelLoop, NodeClock, Queued};
     use rotor_twin::ros::NodeParams;
     use std::sync::atomic::AtomicU64;
     use std::sync::{Arc, Mutex};
@@ -289,7 +289,10 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
         temperature: 60.0,
         variance: 0.0,
     });
-    inbox.lock().unwrap().push((None, Ok(oil)));
+    inbox.lock().unwrap().push(Queued {
+        received_ns: None,
+        input: Ok(oil),
+    });
     let moved = move |m: &ModelLoop| {
         m.driver()
             .linear_threshold()

@@ -22,7 +22,7 @@ mod one_x;
 mod unbalance;
 mod viscosity;
 
-pub use one_x::{fit_windows, AngleSample, WindowFit};
+pub use one_x::{fit_windows, AngleSample, WindowFit, WindowFits, MAX_WINDOW_SAMPLES};
 pub use unbalance::{
     estimate_unbalance, CorrectionMass, PlaneEstimate, UnbalanceEstimate,
     DEFAULT_CORRECTION_RADIUS_M,

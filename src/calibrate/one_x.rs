@@ -61,28 +61,83 @@ impl WindowFit {
 /// samples a window) over `samples`, in time order. Angles are unwrapped (consecutive samples
 /// less than half a revolution apart).
 pub fn fit_windows(samples: &[AngleSample], revolutions: f64) -> Vec<WindowFit> {
-    let mut out = Vec::new();
-    let span = revolutions.max(1.0) * TAU;
-    let mut start = 0;
-    let mut unwrapped = Vec::with_capacity(samples.len());
-    let mut theta = 0.0;
-    for (k, s) in samples.iter().enumerate() {
-        if k > 0 {
-            theta += (s.angle_rad - samples[k - 1].angle_rad + PI).rem_euclid(TAU) - PI;
-        } else {
-            theta = s.angle_rad;
-        }
-        unwrapped.push(theta);
+    let mut fits = WindowFits::new(revolutions);
+    for s in samples {
+        fits.push(*s);
     }
-    for k in 1..samples.len() {
-        if unwrapped[k] - unwrapped[start] >= span {
-            if let Some(f) = fit(&samples[start..k], &unwrapped[start..k]) {
-                out.push(f);
+    fits.finish()
+}
+
+/// A window that gathers more samples than this without completing its revolutions (a shaft
+/// all but stopped) is dropped unfitted: the memory of a fit is bounded by it whatever the length
+/// of the data (2^20 samples of 40 bytes: 40 MB).
+pub const MAX_WINDOW_SAMPLES: usize = 1 << 20;
+
+/// [`fit_windows`] as the samples arrive: only the window being gathered is held, so memory
+/// does not grow with the length of the data; the fits are the same, bit for bit.
+#[derive(Debug, Clone)]
+pub struct WindowFits {
+    span: f64,
+    /// the unwrapped angle of the last sample, and its raw angle
+    theta: f64,
+    previous_angle_rad: Option<f64>,
+    window: Vec<AngleSample>,
+    window_theta: Vec<f64>,
+    fits: Vec<WindowFit>,
+    /// windows dropped for holding over [`MAX_WINDOW_SAMPLES`]
+    pub overlong_windows: usize,
+}
+
+impl WindowFits {
+    /// Windows of `revolutions` whole revolutions (at least 1).
+    pub fn new(revolutions: f64) -> Self {
+        Self {
+            span: revolutions.max(1.0) * TAU,
+            theta: 0.0,
+            previous_angle_rad: None,
+            window: Vec::new(),
+            window_theta: Vec::new(),
+            fits: Vec::new(),
+            overlong_windows: 0,
+        }
+    }
+
+    /// The next sample in time order; a window completes (and is fitted) when this sample is a
+    /// whole window's angle past the window's first.
+    pub fn push(&mut self, s: AngleSample) {
+        self.theta = match self.previous_angle_rad {
+            // the step wrapped to (−π, π], added as one term (the batch fit's rounding)
+            Some(prev) => self.theta + ((s.angle_rad - prev + PI).rem_euclid(TAU) - PI),
+            None => s.angle_rad,
+        };
+        self.previous_angle_rad = Some(s.angle_rad);
+        let complete = self
+            .window_theta
+            .first()
+            .is_some_and(|&t0| self.theta - t0 >= self.span);
+        if complete {
+            if let Some(f) = fit(&self.window, &self.window_theta) {
+                self.fits.push(f);
             }
-            start = k;
         }
+        if complete || self.window.len() >= MAX_WINDOW_SAMPLES {
+            self.overlong_windows += usize::from(!complete);
+            self.window.clear();
+            self.window_theta.clear();
+        }
+        self.window.push(s);
+        self.window_theta.push(self.theta);
     }
-    out
+
+    /// The windows fitted so far.
+    pub fn fits(&self) -> &[WindowFit] {
+        &self.fits
+    }
+
+    /// The fitted windows (a window not complete at the end is not fitted).
+    pub fn finish(self) -> Vec<WindowFit> {
+        self.fits
+    }
 }
 
 /// The fit over one window (None with fewer than 8 samples or a singular fit).

@@ -266,7 +266,6 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     check_args(args)?;
     let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
-    say_film_tables(&rotor, args.film)?;
     let out_dir = args
         .out
         .clone()
@@ -275,6 +274,9 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let bag = read_bag(&args.bag)?;
     let options = replay_options(args, &out_dir);
     crate::replay::check_mapping(&bag, &rotor, &options)?;
+    // after the bag and its mapping are checked: a bad bag is refused before a table build
+    // that may take minutes
+    say_film_tables(&rotor, args.film)?;
     prepare_out_dir(&out_dir)?;
     if args.calibrate {
         return run_calibrated(args, &bag, &rotor, &options, &out_dir);

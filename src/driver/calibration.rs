@@ -159,7 +159,8 @@ impl LiveCalibration {
 pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
     let (vectors, positions) = measured;
     let mut reference = rotor.clone();
-    // the scale is fitted against the machine file's viscosity
+    // the scale is fitted against the machine file's viscosity (1.0 is always valid: the
+    // result cannot be an error)
     let _ = reference.set_viscosity_scale(1.0);
     let text = |e: CalibrationError| e.to_string();
     let viscosity = estimate_viscosity(&reference, positions).map_err(text);
@@ -327,10 +328,13 @@ impl super::Driver {
                 return v;
             }
         }
-        self.unbalance[p].unwrap_or_else(|| {
-            let u = &self.rotor.unbalance[p];
-            (u.magnitude_kg_m, u.phase_rad)
-        })
+        match self.unbalance[p] {
+            Some(u) => (u.magnitude_kg_m, u.phase_rad),
+            None => {
+                let u = &self.rotor.unbalance[p];
+                (u.magnitude_kg_m, u.phase_rad)
+            }
+        }
     }
 
     /// Sets the viscosity scale of the machine and of the running twin.

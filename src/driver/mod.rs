@@ -92,6 +92,26 @@ pub struct DriverCounts {
     pub readings_unpaired: u64,
 }
 
+/// The latest accepted speed input.
+#[derive(Debug, Clone, Copy)]
+struct SpeedInput {
+    /// shaft speed (rad/s)
+    speed_rad_s: f64,
+    /// its rate of change (rad/s²)
+    accel_rad_s2: f64,
+    /// when it came, on the driver's clock (ns)
+    received_ns: i64,
+}
+
+/// An unbalance received for one plane.
+#[derive(Debug, Clone, Copy)]
+struct PlaneUnbalance {
+    /// m·e (kg·m)
+    magnitude_kg_m: f64,
+    /// phase from the shaft's zero mark (rad)
+    phase_rad: f64,
+}
+
 /// The twin of one machine, driven by timed inputs.
 pub struct Driver {
     rotor: Rotor,
@@ -99,10 +119,10 @@ pub struct Driver {
     limits: InputLimits,
     gate: SpeedGate,
     session: Option<Session>,
-    /// the latest accepted speed (rad/s, rad/s²) and when it came (ns)
-    speed: Option<(f64, f64, i64)>,
-    /// the latest accepted unbalance per plane (m·e kg·m, phase rad), applied at every start
-    unbalance: Vec<Option<(f64, f64)>>,
+    /// the latest accepted speed
+    speed: Option<SpeedInput>,
+    /// the latest accepted unbalance per plane, applied at every start
+    unbalance: Vec<Option<PlaneUnbalance>>,
     /// the linear stability threshold once known: Some((rad/s, whirl ratio)) or None
     threshold: Option<Option<(f64, f64)>>,
     last_input_ns: Option<i64>,
@@ -184,13 +204,13 @@ impl Driver {
 
     /// The latest accepted speed (rad/s).
     pub fn speed_rad_s(&self) -> Option<f64> {
-        self.speed.map(|s| s.0)
+        self.speed.map(|s| s.speed_rad_s)
     }
 
     /// The latest accepted speed and acceleration (rad/s, rad/s²): what the twin is stepped at
     /// (the forecast's starting point).
     pub fn speed_input(&self) -> Option<(f64, f64)> {
-        self.speed.map(|s| (s.0, s.1))
+        self.speed.map(|s| (s.speed_rad_s, s.accel_rad_s2))
     }
 
     /// The linear stability threshold (rad/s, whirl ratio), if known and found.
@@ -200,7 +220,7 @@ impl Driver {
 
     /// Age (s) of the latest accepted speed at `now_ns`.
     pub fn speed_age_s(&self, now_ns: i64) -> Option<f64> {
-        self.speed.map(|s| (now_ns - s.2) as f64 * 1e-9)
+        self.speed.map(|s| (now_ns - s.received_ns) as f64 * 1e-9)
     }
 
     /// The linear stability threshold (as [`crate::session::linear_threshold`] gives it), once
@@ -286,7 +306,8 @@ impl Driver {
         self.check_keyphasor_stop(now_ns, emit);
         self.warn_refusals(now_ns, emit);
         let mut taken = 0;
-        if let (Some(s), Some((w, a, _))) = (self.session.as_mut(), self.speed) {
+        if let (Some(s), Some(speed)) = (self.session.as_mut(), self.speed) {
+            let (w, a) = (speed.speed_rad_s, speed.accel_rad_s2);
             let input = StepInput {
                 speed_rad_s: w,
                 accel_rad_s2: a,
@@ -330,7 +351,11 @@ impl Driver {
             Ok(v) => v,
             Err(why) => return Fed::Refused(why),
         };
-        self.speed = Some((w, a, now_ns));
+        self.speed = Some(SpeedInput {
+            speed_rad_s: w,
+            accel_rad_s2: a,
+            received_ns: now_ns,
+        });
         self.last_stale_warning_ns = None;
         self.signals.speed_from_keyphasor = from_keyphasor;
         if w < self.settings.min_speed_rad_s {
@@ -427,7 +452,10 @@ impl Driver {
     fn take_unbalance(&mut self, plane: u32, me: f64, phase: f64) -> Fed {
         match check_unbalance(plane, me, phase, self.limits.planes) {
             Ok((p, me, phase)) => {
-                self.unbalance[p] = Some((me, phase));
+                self.unbalance[p] = Some(PlaneUnbalance {
+                    magnitude_kg_m: me,
+                    phase_rad: phase,
+                });
                 if let Some(s) = self.session.as_mut() {
                     if let Err(e) = s.twin_mut().set_unbalance(p, me, phase) {
                         return Fed::Refused(format!("unbalance: {e}"));
@@ -540,9 +568,10 @@ impl Driver {
 
     /// A speed older than the timeout is warned about, once per timeout interval, and held.
     fn check_stale(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
-        let (Some((w, _, at)), true) = (self.speed, self.session.is_some()) else {
+        let (Some(speed), true) = (self.speed, self.session.is_some()) else {
             return;
         };
+        let (w, at) = (speed.speed_rad_s, speed.received_ns);
         let timeout = seconds_to_ns(self.settings.input_timeout_s);
         let due = self
             .last_stale_warning_ns
@@ -564,7 +593,7 @@ impl Driver {
     }
 
     fn emit_margin(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
-        let (Some(threshold), Some((w, _, _))) = (self.threshold, self.speed) else {
+        let (Some(threshold), Some(w)) = (self.threshold, self.speed_rad_s()) else {
             return;
         };
         if now_ns < self.next_margin_ns {

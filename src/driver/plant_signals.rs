@@ -138,7 +138,7 @@ impl Driver {
     }
 
     fn keyphasor_stopped(&self, t_ns: i64) -> bool {
-        let (Some(last), Some((w, _, _))) = (self.signals.keyphasor.last_event_ns(), self.speed)
+        let (Some(last), Some(w)) = (self.signals.keyphasor.last_event_ns(), self.speed_rad_s())
         else {
             return false;
         };
@@ -165,8 +165,8 @@ impl Driver {
         let topic_speed = self
             .speed
             .filter(|_| !self.signals.speed_from_keyphasor)
-            .filter(|s| (now_ns - s.2) <= tolerance)
-            .map(|s| s.0);
+            .filter(|s| (now_ns - s.received_ns) <= tolerance)
+            .map(|s| s.speed_rad_s);
         let angle = self.session.as_ref().map(|s| s.angle_at(t));
         let ev = match self.signals.keyphasor.event(t, angle, topic_speed) {
             Ok(ev) => ev,
@@ -206,7 +206,7 @@ impl Driver {
 
     /// Starts the twin at the event at `t_ns` if the speed in force allows and none runs.
     fn start_at_event(&mut self, t_ns: i64, fed: Fed, emit: &mut impl FnMut(Outgoing)) -> Fed {
-        let Some((w, _, _)) = self.speed else {
+        let Some(w) = self.speed_rad_s() else {
             return fed;
         };
         if self.session.is_some() || w < self.settings.min_speed_rad_s {
@@ -309,7 +309,7 @@ impl Driver {
             self.signals.measured_runout = vec![None; n];
         }
         let slow = self.rotor.slow_roll_speed_rad_s;
-        let w = self.speed.map(|s| s.0);
+        let w = self.speed_rad_s();
         if let (Some(limit), Some(w), Some(psi)) = (slow, w, self.keyphasor_angle(t_ns)) {
             if w > 0.0 && w < limit {
                 self.signals.slow_roll[k].add(psi, d);
@@ -332,7 +332,7 @@ impl Driver {
     /// growing at the speed in force), for slow roll where no twin runs.
     fn keyphasor_angle(&self, t_ns: i64) -> Option<f64> {
         let last = self.signals.keyphasor.last_event_ns()?;
-        let (w, _, _) = self.speed?;
+        let w = self.speed_rad_s()?;
         let dt = (t_ns - last) as f64 * 1e-9;
         (dt >= 0.0 && self.signals.seen && !self.keyphasor_stopped(t_ns)).then_some(w * dt)
     }
@@ -350,7 +350,7 @@ impl Driver {
         let (Some((t0, d0)), Some((t1, d1))) = (st.last[axis], st.last[1 - axis]) else {
             return Fed::Taken;
         };
-        let w = self.speed.map_or(0.0, |s| s.0).max(1e-3);
+        let w = self.speed_rad_s().unwrap_or(0.0).max(1e-3);
         if ((t0 - t1).abs() as f64 * 1e-9) > PAIR_TOLERANCE_REVS * TAU / w {
             return Fed::Taken;
         }

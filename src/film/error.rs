@@ -25,10 +25,22 @@ pub enum FilmError {
         eccentricity_ratio: f64,
     },
     /// The complementarity (cavitation) iteration did not settle.
-    #[error("cavitation active-set iteration did not converge in {iterations} iterations")]
+    #[error(
+        "cavitation active-set iteration did not converge in {iterations} iterations, journal at ε {eccentricity_ratio:.4}, attitude {attitude_deg:.1}° from +x, velocity ({:.3e}, {:.3e}) m/s, speed {speed_rad_s:.2} rad/s",
+        velocity_m_s[0],
+        velocity_m_s[1]
+    )]
     CavitationNotConverged {
         /// Iterations made.
         iterations: usize,
+        /// e / c of the journal (dimensionless).
+        eccentricity_ratio: f64,
+        /// Angle of the journal centre from +x, in the direction of rotation (degrees).
+        attitude_deg: f64,
+        /// Journal velocity (ẋ, ẏ) (m/s).
+        velocity_m_s: [f64; 2],
+        /// Shaft speed (rad/s).
+        speed_rad_s: f64,
     },
     /// The film matrix was not positive definite (film thickness not positive somewhere).
     #[error("film matrix not positive definite: the film thickness is not positive everywhere")]

@@ -90,6 +90,9 @@ pub struct FiniteFilm {
     sensitivity_base: Option<[f64; 4]>,
     /// Active-set passes taken by the last solve.
     last_passes: usize,
+    /// Active-set passes allowed ([`MAX_ACTIVE_SET_PASSES`]; lowered by a test to make one
+    /// fail).
+    max_passes: usize,
     /// Unknowns in the last factored system (free nodes).
     n_free: usize,
 }
@@ -154,6 +157,7 @@ impl FiniteFilm {
             warm: false,
             sensitivity_base: None,
             last_passes: 0,
+            max_passes: MAX_ACTIVE_SET_PASSES,
             n_free: 0,
             geometry,
             lubricant,
@@ -345,8 +349,9 @@ impl FiniteFilm {
         }
     }
 
-    /// Solves the complementarity problem for the current film shape.
-    fn solve_complementarity(&mut self) -> Result<(), FilmError> {
+    /// Solves the complementarity problem for the current film shape (that of `kin`, named in
+    /// the error when the active set does not settle).
+    fn solve_complementarity(&mut self, kin: &JournalKinematics) -> Result<(), FilmError> {
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         if !self.warm {
             for i in 0..nt {
@@ -354,7 +359,7 @@ impl FiniteFilm {
                 self.free[i * nz..(i + 1) * nz].fill(pressurising);
             }
         }
-        for pass in 1..=MAX_ACTIVE_SET_PASSES {
+        for pass in 1..=self.max_passes {
             let n = self.assemble_and_factor()?;
             let mut x = std::mem::take(&mut self.rhs);
             self.band.solve(&mut x[..n]);
@@ -378,8 +383,16 @@ impl FiniteFilm {
             }
         }
         self.warm = false;
+        let c = self.geometry.radial_clearance_m;
         Err(FilmError::CavitationNotConverged {
-            iterations: MAX_ACTIVE_SET_PASSES,
+            iterations: self.max_passes,
+            eccentricity_ratio: kin.eccentricity_ratio(c),
+            attitude_deg: kin.position_m[1]
+                .atan2(kin.position_m[0])
+                .to_degrees()
+                .rem_euclid(360.0),
+            velocity_m_s: kin.velocity_m_s,
+            speed_rad_s: kin.speed_rad_s,
         })
     }
 
@@ -550,7 +563,7 @@ impl FilmModel for FiniteFilm {
             self.predict_active_set(now);
         }
         self.sensitivity_base = None;
-        let solved = self.solve_complementarity();
+        let solved = self.solve_complementarity(kin);
         if solved.is_err() {
             self.sensitivity_base = None;
         }
@@ -623,3 +636,34 @@ impl FilmModel for FiniteFilm {
 }
 
 mod outputs;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_active_set_that_does_not_settle_names_the_journal_state() {
+        // issue 15: the error named no bearing state. One pass from a cold start cannot settle
+        // (the initial set is a guess the first solve always corrects)
+        let g = BearingGeometry::plain(0.055, 0.02, 60e-6).unwrap();
+        let mut film = FiniteFilm::new(
+            g,
+            Lubricant::new(860.0, 0.02).unwrap(),
+            FilmGrid::new(60, 10).unwrap(),
+        )
+        .unwrap();
+        film.max_passes = 1;
+        let kin = JournalKinematics {
+            position_m: [0.0, -0.6 * 60e-6],
+            velocity_m_s: [1e-4, 0.0],
+            speed_rad_s: 942.5,
+        };
+        let e = film.solve(&kin).unwrap_err().to_string();
+        for part in ["ε 0.6000", "attitude 270.0°", "1.000e-4", "942.50 rad/s"] {
+            assert!(e.contains(part), "'{part}' not in: {e}");
+        }
+        // and with the passes it is given, the same state solves
+        film.max_passes = MAX_ACTIVE_SET_PASSES;
+        assert!(film.solve(&kin).is_ok());
+    }
+}

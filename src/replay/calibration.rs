@@ -12,8 +12,8 @@
 
 use crate::bag::Bag;
 use crate::calibrate::{
-    estimate_unbalance, estimate_viscosity, fit_windows, AngleSample, CalibrationError,
-    UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
+    estimate_unbalance, estimate_viscosity, AngleSample, CalibrationError, UnbalanceEstimate,
+    ViscosityEstimate, WindowFits, DEFAULT_CORRECTION_RADIUS_M,
 };
 use crate::messages::{self, from_cdr, RosMessage};
 use crate::rotor::Rotor;
@@ -50,6 +50,19 @@ pub fn angle_samples(
     remaps: &[(String, String)],
     window_s: [f64; 2],
 ) -> Vec<Vec<AngleSample>> {
+    let mut out = vec![Vec::new(); rotor.probes.len()];
+    each_angle_sample(bag, rotor, remaps, window_s, &mut |k, s| out[k].push(s));
+    out
+}
+
+/// [`angle_samples`] one at a time, in bag order, as (station index, sample): nothing is held.
+pub fn each_angle_sample(
+    bag: &Bag,
+    rotor: &Rotor,
+    remaps: &[(String, String)],
+    window_s: [f64; 2],
+    take: &mut dyn FnMut(usize, AngleSample),
+) {
     let name = |i: usize| {
         let n = &bag.topics[i].name;
         remaps
@@ -58,7 +71,6 @@ pub fn angle_samples(
             .map_or(n.as_str(), |(_, t)| t.as_str())
     };
     let t0 = bag.time_span_ns().map_or(0, |(a, _)| a);
-    let mut out = vec![Vec::new(); rotor.probes.len()];
     // (time s, angle rad, speed rad/s, accel rad/s²) at the last speed message
     let mut last: Option<(f64, f64, f64, f64)> = None;
     for m in bag.messages() {
@@ -99,15 +111,17 @@ pub fn angle_samples(
                 continue;
             };
             if p.x.is_finite() && p.y.is_finite() {
-                out[k].push(AngleSample {
-                    angle_rad: angle,
-                    speed_rad_s: w,
-                    displacement_m: [p.x, p.y],
-                });
+                take(
+                    k,
+                    AngleSample {
+                        angle_rad: angle,
+                        speed_rad_s: w,
+                        displacement_m: [p.x, p.y],
+                    },
+                );
             }
         }
     }
-    out
 }
 
 /// A keyphasor event's type: ours, or a bare std_msgs/Header (the replay accepts both).
@@ -123,10 +137,15 @@ pub fn calibrate_bag(
     remaps: &[(String, String)],
     window_s: [f64; 2],
 ) -> Result<(BagCalibration, Rotor), CalibrationError> {
-    let samples = angle_samples(bag, rotor, remaps, window_s);
+    // the windows are fitted as the samples arrive: memory is bounded by one window a station
+    // (issue 15), not by the length of `window_s`
+    let mut fits = vec![WindowFits::new(CALIBRATION_WINDOW_REVS); rotor.probes.len()];
+    each_angle_sample(bag, rotor, remaps, window_s, &mut |k, s| fits[k].push(s));
     let (mut means, mut vectors, mut skipped) = (Vec::new(), Vec::new(), 0);
-    for (station, s) in samples.iter().enumerate() {
-        for w in fit_windows(s, CALIBRATION_WINDOW_REVS) {
+    for (station, f) in fits.into_iter().enumerate() {
+        // a window that never completed its revolutions (a shaft all but stopped) is left out
+        skipped += f.overlong_windows;
+        for w in f.finish() {
             if w.residual_rms_m > MAX_WINDOW_RESIDUAL_SHARE * w.one_x_major_m() {
                 skipped += 1;
                 continue;

@@ -171,26 +171,7 @@ pub fn replay(
     progress: &mut dyn FnMut(f64),
 ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
     let wall = std::time::Instant::now();
-    let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
-    let raw: Vec<String> = rotor
-        .proximity_probes
-        .iter()
-        .map(|p| p.name.clone())
-        .collect();
-    let roles = map_topics(bag, options, &stations, &raw)?;
-    let clearance = rotor
-        .bearings
-        .iter()
-        .filter_map(|b| match &b.model {
-            crate::rotor::BearingModel::Film(f) => Some(f.geometry.radial_clearance_m),
-            _ => None,
-        })
-        .fold(f64::INFINITY, f64::min);
-    let comparisons: Vec<StationComparison> = stations
-        .iter()
-        .zip(&rotor.probes)
-        .map(|(s, p)| StationComparison::new(s, clearance).with_axes(p.angles_rad))
-        .collect();
+    let (roles, comparisons) = roles_and_comparisons(bag, rotor, options)?;
     let mut out = match &options.out_bag {
         Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
         None => None,
@@ -223,22 +204,9 @@ pub fn replay(
         }
         run.message(bag, &m, roles[m.topic], options.speed_unit);
         run.forecast();
-        // the report and the output bag
-        for o in run.emitted.drain(..) {
-            run.report.note_output(&o, t0, run.driver.session_slot());
-            if let Some(out) = out.as_mut() {
-                out.write_outgoing(&o)?;
-            }
-        }
-        if let Some(out) = out.as_mut() {
-            out.write_input(&m)?;
-        }
+        run.write_out(&m, out.as_mut())?;
         if let Some(rate) = options.rate {
-            let due = m.log_time_ns.saturating_sub(t0) as f64 * 1e-9 / rate;
-            let ahead = due - wall.elapsed().as_secs_f64();
-            if ahead > 0.0 {
-                std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
-            }
+            pace(m.log_time_ns.saturating_sub(t0), rate, wall);
         }
         if last_progress.elapsed().as_millis() >= 200 {
             last_progress = std::time::Instant::now();
@@ -247,18 +215,46 @@ pub fn replay(
     }
     progress(1.0);
     run.report.notes.extend(messages.problems().iter().cloned());
-    let Replaying {
-        mut report,
-        comparisons,
-        forecasting,
-        ..
-    } = run;
-    report.finish(&comparisons, wall.elapsed().as_secs_f64());
-    report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
-    if let Some(out) = out {
-        report.messages_out = out.finish()?;
+    run.finish(out, wall)
+}
+
+/// The topic roles of `bag` for a twin of `rotor`, and an empty comparison for each of the
+/// machine's probe stations.
+fn roles_and_comparisons(
+    bag: &Bag,
+    rotor: &Rotor,
+    options: &ReplayOptions,
+) -> Result<(Vec<Role>, Vec<StationComparison>), ReplayError> {
+    let stations: Vec<String> = rotor.probes.iter().map(|p| p.name.clone()).collect();
+    let raw: Vec<String> = rotor
+        .proximity_probes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let roles = map_topics(bag, options, &stations, &raw)?;
+    let clearance = rotor
+        .bearings
+        .iter()
+        .filter_map(|b| match &b.model {
+            crate::rotor::BearingModel::Film(f) => Some(f.geometry.radial_clearance_m),
+            _ => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    let comparisons = stations
+        .iter()
+        .zip(&rotor.probes)
+        .map(|(s, p)| StationComparison::new(s, clearance).with_axes(p.angles_rad))
+        .collect();
+    Ok((roles, comparisons))
+}
+
+/// Sleeps until bag time `since_t0_ns` is due at `rate` times the bag's pace (`--rate`).
+fn pace(since_t0_ns: u64, rate: f64, wall: std::time::Instant) {
+    let due = since_t0_ns as f64 * 1e-9 / rate;
+    let ahead = due - wall.elapsed().as_secs_f64();
+    if ahead > 0.0 {
+        std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
     }
-    Ok((report, comparisons))
 }
 
 /// The driver of a replay of `bag` (topic roles `roles`) on `rotor`: the linear threshold
@@ -287,6 +283,48 @@ struct Replaying {
 }
 
 impl Replaying {
+    /// What the driver emitted for message `m` into the report and the output bag, then `m`
+    /// itself into the output bag.
+    fn write_out(
+        &mut self,
+        m: &BagMessage,
+        mut out: Option<&mut OutputBag>,
+    ) -> Result<(), ReplayError> {
+        // exact: t0_ns is the bag's u64 start time cast to i64
+        let t0 = self.t0_ns as u64;
+        for o in self.emitted.drain(..) {
+            self.report.note_output(&o, t0, self.driver.session_slot());
+            if let Some(out) = out.as_deref_mut() {
+                out.write_outgoing(&o)?;
+            }
+        }
+        if let Some(out) = out {
+            out.write_input(m)?;
+        }
+        Ok(())
+    }
+
+    /// The finished report (wall time `wall`, the forecast's score, the output bag's count) and
+    /// the comparisons.
+    fn finish(
+        self,
+        out: Option<OutputBag>,
+        wall: std::time::Instant,
+    ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
+        let Replaying {
+            mut report,
+            comparisons,
+            forecasting,
+            ..
+        } = self;
+        report.finish(&comparisons, wall.elapsed().as_secs_f64());
+        report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
+        if let Some(out) = out {
+            report.messages_out = out.finish()?;
+        }
+        Ok((report, comparisons))
+    }
+
     /// A forecast from the twin's present state, when one is due (`--forecast`).
     fn forecast(&mut self) {
         if let Some(f) = self.forecasting.as_mut() {
@@ -366,8 +404,6 @@ pub fn check_mapping(bag: &Bag, rotor: &Rotor, options: &ReplayOptions) -> Resul
 }
 
 /// The role of each bag topic, checking that the speed topic is there and the types fit.
-// Long (≈95 lines): one match over the input roles (speed, unbalance, probes, keyphasor, oil
-// temperature), each a few lines; a table of roles is open in issue 10.
 fn map_topics(
     bag: &Bag,
     options: &ReplayOptions,
@@ -390,78 +426,93 @@ fn map_topics(
             ));
         }
     }
-    let mut roles = Vec::with_capacity(bag.topics.len());
-    for t in &bag.topics {
-        let name = remap(&t.name);
-        let wrong = |expected: &str| ReplayError::WrongType {
-            topic: t.name.clone(),
-            found: t.type_name.clone(),
-            expected: expected.into(),
-        };
-        let role = if name == SPEED_TOPIC {
-            match t.type_name.as_str() {
-                messages::RotorSpeed::TYPE_NAME => Role::SpeedRotor,
-                messages::Float64::TYPE_NAME => Role::SpeedFloat,
-                _ => {
-                    return Err(wrong(
-                        "rotor_twin_msgs/msg/RotorSpeed or std_msgs/msg/Float64",
-                    ))
-                }
-            }
-        } else if name == UNBALANCE_TOPIC {
-            if t.type_name != messages::Unbalance::TYPE_NAME {
-                return Err(wrong(messages::Unbalance::TYPE_NAME));
-            }
-            Role::Unbalance
-        } else if name == PROBE_TOPIC {
-            if t.type_name != messages::ProbeDisplacement::TYPE_NAME {
-                return Err(wrong(messages::ProbeDisplacement::TYPE_NAME));
-            }
-            Role::Probe
-        } else if name == crate::topics::OIL_TEMPERATURE {
-            if t.type_name != messages::Temperature::TYPE_NAME {
-                return Err(wrong(messages::Temperature::TYPE_NAME));
-            }
-            Role::OilTemperature
-        } else if let Some(role) = plant_signal_role(&name, t, options, rotor_probes)? {
-            role
-        } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| *tp == name) {
-            if t.type_name != messages::PointStamped::TYPE_NAME {
-                return Err(wrong(messages::PointStamped::TYPE_NAME));
-            }
-            Role::ProbePoint(stations.iter().position(|s| s == station).unwrap_or(0))
-        } else {
-            Role::Other
-        };
-        if role != Role::Other && t.message_encoding != "cdr" {
-            return Err(wrong("a CDR-encoded message"));
-        }
-        roles.push(role);
-    }
+    let roles = bag
+        .topics
+        .iter()
+        .map(|t| topic_role(t, &remap(&t.name), options, stations, rotor_probes))
+        .collect::<Result<Vec<Role>, ReplayError>>()?;
     check_named_topics_exist(bag, options, &remap)?;
-    // the keyphasor's intervals give the speed where no speed topic does
+    check_speed_source(bag, &roles)?;
+    Ok(roles)
+}
+
+/// The role of bag topic `t`, named `name` after remapping, or why its type or encoding does
+/// not fit that role.
+fn topic_role(
+    t: &crate::bag::BagTopic,
+    name: &str,
+    options: &ReplayOptions,
+    stations: &[String],
+    rotor_probes: &[String],
+) -> Result<Role, ReplayError> {
+    let wrong = |expected: &str| ReplayError::WrongType {
+        topic: t.name.clone(),
+        found: t.type_name.clone(),
+        expected: expected.into(),
+    };
+    // a topic whose single accepted type is `type_name`
+    let typed = |type_name: &str, role: Role| {
+        if t.type_name == type_name {
+            Ok(role)
+        } else {
+            Err(wrong(type_name))
+        }
+    };
+    let role = if name == SPEED_TOPIC {
+        match t.type_name.as_str() {
+            messages::RotorSpeed::TYPE_NAME => Role::SpeedRotor,
+            messages::Float64::TYPE_NAME => Role::SpeedFloat,
+            _ => {
+                return Err(wrong(
+                    "rotor_twin_msgs/msg/RotorSpeed or std_msgs/msg/Float64",
+                ))
+            }
+        }
+    } else if name == UNBALANCE_TOPIC {
+        typed(messages::Unbalance::TYPE_NAME, Role::Unbalance)?
+    } else if name == PROBE_TOPIC {
+        typed(messages::ProbeDisplacement::TYPE_NAME, Role::Probe)?
+    } else if name == crate::topics::OIL_TEMPERATURE {
+        typed(messages::Temperature::TYPE_NAME, Role::OilTemperature)?
+    } else if let Some(role) = plant_signal_role(name, t, options, rotor_probes)? {
+        role
+    } else if let Some((_, station)) = options.probe_points.iter().find(|(tp, _)| tp == name) {
+        let k = stations.iter().position(|s| s == station).unwrap_or(0);
+        typed(messages::PointStamped::TYPE_NAME, Role::ProbePoint(k))?
+    } else {
+        Role::Other
+    };
+    if role != Role::Other && t.message_encoding != "cdr" {
+        return Err(wrong("a CDR-encoded message"));
+    }
+    Ok(role)
+}
+
+/// Some topic drives the twin's speed: a speed topic, or a keyphasor whose intervals give the
+/// speed where no speed topic does.
+fn check_speed_source(bag: &Bag, roles: &[Role]) -> Result<(), ReplayError> {
     let drives = |r: &Role| {
         use Role::*;
         matches!(r, SpeedRotor | SpeedFloat | Keyphasor | KeyphasorHeader)
     };
-    if !roles.iter().any(drives) {
-        let present = bag
-            .topics
-            .iter()
-            .map(|t| format!("{} [{}]", t.name, t.type_name))
-            .collect::<Vec<_>>()
-            .join(", ");
-        return Err(ReplayError::MissingTopic {
-            topic: SPEED_TOPIC.into(),
-            why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed (or a keyphasor to /rotor_twin/keyphasor)".into(),
-            present: if present.is_empty() {
-                "none".into()
-            } else {
-                present
-            },
-        });
+    if roles.iter().any(drives) {
+        return Ok(());
     }
-    Ok(roles)
+    let present = bag
+        .topics
+        .iter()
+        .map(|t| format!("{} [{}]", t.name, t.type_name))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Err(ReplayError::MissingTopic {
+        topic: SPEED_TOPIC.into(),
+        why: "the rotor speed drives the twin; map the bag's speed topic with --remap FROM:=/rotor_twin/speed (or a keyphasor to /rotor_twin/keyphasor)".into(),
+        present: if present.is_empty() {
+            "none".into()
+        } else {
+            present
+        },
+    })
 }
 
 /// Every `--remap` source and `--probe-point` topic is a topic of the bag (issue 15, item 21:

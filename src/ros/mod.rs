@@ -206,8 +206,6 @@ fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::
 }
 
 /// The node's life: DDS participant, readers and writers, model thread, until a signal.
-// Long (≈105 lines): start-up in the order DDS requires; splitting it along the publishers, the
-// parameter services and the shutdown is open in issue 10.
 async fn run_async(
     setup: NodeSetup,
     ros: RosArgs,
@@ -241,6 +239,7 @@ async fn run_async(
         ..NodeClock::default()
     });
     let (out_tx, out_rx) = mpsc::sync_channel::<model::Published>(4096);
+    let counters = Arc::new(model::NodeCounters::default());
     let mut model = model::ModelLoop::new(
         rotor.clone(),
         params.clone(),
@@ -249,7 +248,6 @@ async fn run_async(
         clock.clone(),
     );
     model.set_node_name(&ros.fully_qualified_name());
-    let counters = Arc::new(model::NodeCounters::default());
     model.set_counters(counters.clone());
     let model_stop = stop.clone();
     let model_thread = std::thread::Builder::new()
@@ -265,18 +263,43 @@ async fn run_async(
     };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
+    spawn_spinner(&mut node)?;
+    announce_up(&ros, domain, started);
+    wait_for_stop(&counters, &recorder_thread).await?;
+    if ros.log_level <= LogLevel::Info {
+        eprintln!("rotor_twin: shutting down");
+    }
+    stop.store(true, Ordering::Relaxed);
+    join_reporting_panic(model_thread, "model");
+    join_reporting_panic(publish_thread, "publishing");
+    drop(node);
+    match recorder_thread {
+        Some(t) => finish_recording(t, &ros),
+        None => Ok(()),
+    }
+}
+
+/// The node's spinner (parameter services, graph) on the runtime; its end is logged.
+fn spawn_spinner(node: &mut ros2_client::Node) -> anyhow::Result<()> {
     let spinner = node
         .spinner()
         .map_err(|e| anyhow::anyhow!("spinner: {e:?}"))?;
     tokio::spawn(async move {
-        let _ = spinner.spin().await;
+        if let Err(e) = spinner.spin().await {
+            eprintln!("rotor_twin: the node's spinner stopped: {e:?}");
+        }
     });
+    Ok(())
+}
+
+/// The start-up line (at log level info) and the ROS arguments that have no effect.
+fn announce_up(ros: &RosArgs, domain: u16, started: std::time::Instant) {
     if ros.log_level <= LogLevel::Info {
         eprintln!(
             "rotor_twin: node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
             ros.fully_qualified_name(),
             started.elapsed().as_secs_f64(),
-            speed_topic_label(&ros)
+            speed_topic_label(ros)
         );
     }
     if !ros.ignored.is_empty() {
@@ -285,32 +308,35 @@ async fn run_async(
             ros.ignored.join(", ")
         );
     }
+}
 
-    // until SIGINT or SIGTERM; a recording that stops before (a full disk) is an ERROR
-    let watch = watch_recording(&counters, &recorder_thread);
-    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+/// Until SIGINT or SIGTERM. A recording that stops before (a full disk) is an ERROR
+/// (`watch_recording`); the twin keeps running, since the bus still gets its outputs.
+async fn wait_for_stop(
+    counters: &model::NodeCounters,
+    recorder_thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
+) -> anyhow::Result<()> {
+    use tokio::signal::unix::{signal, SignalKind};
+    let watch = watch_recording(counters, recorder_thread);
+    let mut term = signal(SignalKind::terminate())?;
     tokio::select! {
         _ = tokio::signal::ctrl_c() => {},
         _ = term.recv() => {},
         _ = watch => {
-            // keep the twin running: the bus still gets its outputs
-            let mut term2 = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+            let mut term2 = signal(SignalKind::terminate())?;
             tokio::select! {
                 _ = tokio::signal::ctrl_c() => {},
                 _ = term2.recv() => {},
             }
         }
     }
-    if ros.log_level <= LogLevel::Info {
-        eprintln!("rotor_twin: shutting down");
-    }
-    stop.store(true, Ordering::Relaxed);
-    let _ = model_thread.join();
-    let _ = publish_thread.join();
-    drop(node);
-    match recorder_thread {
-        Some(t) => finish_recording(t, &ros),
-        None => Ok(()),
+    Ok(())
+}
+
+/// Joins a node thread at shutdown; a panic in it is reported (it was dropped with `let _`).
+fn join_reporting_panic(thread: std::thread::JoinHandle<()>, name: &str) {
+    if thread.join().is_err() {
+        eprintln!("rotor_twin: the {name} thread panicked before shutdown");
     }
 }
 
@@ -805,7 +831,10 @@ impl InputRoute {
                 inbox
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
-                    .push((at, queued));
+                    .push(model::Queued {
+                        received_ns: at,
+                        input: queued,
+                    });
             }
         });
         Ok(())
@@ -852,7 +881,10 @@ fn subscribe_clock(
                         crate::driver::CLOCK_CONFIRM
                     );
                     let mut inbox = inbox.lock().unwrap_or_else(|e| e.into_inner());
-                    inbox.push((Some(clock_ns), Err(why)));
+                    inbox.push(model::Queued {
+                        received_ns: Some(clock_ns),
+                        input: Err(why),
+                    });
                 }
                 ClockSample::Jumped { from_ns } => eprintln!(
                     "rotor_twin: /clock jumped from {:.6} s to {:.6} s",

@@ -37,9 +37,15 @@ pub const INBOX_CAPACITY: usize = 65_536;
 /// and 64 steps a revolution, 256 steps are 27 ms of model time).
 pub const MAX_STEPS_PER_WAKE: usize = 256;
 
-/// A queued input: its receive time on the node's clock (None: under use_sim_time before the
-/// first `/clock`) and the input, or why it could not be decoded.
-pub type Queued = (Option<i64>, Result<Input, String>);
+/// An input waiting for the model thread.
+#[derive(Debug)]
+pub struct Queued {
+    /// Its receive time on the node's clock (ns; None: under use_sim_time before the first
+    /// `/clock`, fed at the model's present time).
+    pub received_ns: Option<i64>,
+    /// The input, or why it could not be decoded (refused, counted and warned about).
+    pub input: Result<Input, String>,
+}
 
 /// What the subscriptions hand to the model thread.
 #[derive(Debug, Default)]
@@ -399,8 +405,8 @@ impl ModelLoop {
     fn feed_inputs(&mut self, now: i64, emit: &mut impl FnMut(Outgoing)) -> bool {
         let batch = std::mem::take(&mut self.inbox.lock().unwrap_or_else(|e| e.into_inner()).queue);
         let any = !batch.is_empty();
-        for (at, input) in batch {
-            let t = at.unwrap_or(now).clamp(self.last_fed_ns, now);
+        for Queued { received_ns, input } in batch {
+            let t = received_ns.unwrap_or(now).clamp(self.last_fed_ns, now);
             self.last_fed_ns = t;
             // the steps up to the input's time count in the real-time factor too (they were
             // left out: a node woken late by a busy machine reported 0.01–0.3 while keeping up)
@@ -497,23 +503,28 @@ impl ModelLoop {
         }
         self.apply_seen = want;
         let Some(e) = self.last_estimate.take() else {
-            if !want {
-                let _ = self.driver.revert_calibration();
+            if !want && self.driver.calibration().is_some() {
+                self.revert_calibration();
             }
             return;
         };
         if want {
             self.apply(&e);
         } else {
-            match self.driver.revert_calibration() {
-                Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
-                Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
-            }
+            self.revert_calibration();
         }
         let applied = self.driver.calibration().is_some();
         self.pending
             .push(Published::Calibration(Box::new(e.to_message(now, applied))));
         self.last_estimate = Some(e);
+    }
+
+    /// Takes the calibration back, saying so or why it could not.
+    fn revert_calibration(&mut self) {
+        match self.driver.revert_calibration() {
+            Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
+            Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
+        }
     }
 
     /// The linear stability threshold recomputed, off the model thread, when the viscosity in
