@@ -22,16 +22,18 @@
 
 mod calibration;
 mod forecast;
+pub mod log;
 pub mod loss;
 pub mod model;
 mod param_client;
+mod param_services;
 mod params;
 mod recording;
 
 pub use param_client::{run as param_call, ParamCall};
 pub use params::{
-    parse_ros_args, KeyphasorType, LogLevel, NodeParams, RosArgs, SpeedType, SpeedUnit,
-    RUNTIME_PARAMETERS,
+    parameter_doc, parse_ros_args, KeyphasorType, LogLevel, NodeParams, ParamDoc, RosArgs,
+    SpeedType, SpeedUnit, PARAMETER_DOCS, RUNTIME_PARAMETERS,
 };
 
 use crate::driver::Input;
@@ -155,6 +157,7 @@ fn domain_id() -> anyhow::Result<u16> {
 pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
+    log::set_level(ros.log_level);
     let mut params = NodeParams::default();
     for (k, v) in &ros.params {
         params.set(k, v).map_err(anyhow::Error::msg)?;
@@ -187,20 +190,20 @@ fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::
     let info = ros.log_level <= LogLevel::Info;
     if info {
         let cache = crate::film::disk_cache().map(|c| c.dir().display().to_string());
-        eprintln!(
-            "rotor_twin: film tables (cache: {}): read, or built in about 11 s on 2 idle cores…",
+        log::info(&format!(
+            "film tables (cache: {}): read, or built in about 11 s on 2 idle cores…",
             cache.as_deref().unwrap_or("off")
-        );
+        ));
     }
     let start = std::time::Instant::now();
     let origins = crate::dynamics::prepare_film_tables(rotor)?;
     if info {
         let said: Vec<String> = origins.iter().map(ToString::to_string).collect();
-        eprintln!(
-            "rotor_twin: film tables ready in {:.2} s ({})",
+        log::info(&format!(
+            "film tables ready in {:.2} s ({})",
             start.elapsed().as_secs_f64(),
             said.join("; ")
-        );
+        ));
     }
     Ok(())
 }
@@ -222,6 +225,7 @@ async fn run_async(
         Arc::new(Mutex::new(params.clone())),
         Arc::new(std::sync::atomic::AtomicU64::new(0)),
     );
+    let live_params = live.0.clone();
     let mut node = context
         .new_node(
             NodeName::new(&ros.namespace, &ros.node_name)
@@ -265,45 +269,29 @@ async fn run_async(
     };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
-    let spinner = node
-        .spinner()
-        .map_err(|e| anyhow::anyhow!("spinner: {e:?}"))?;
-    tokio::spawn(async move {
-        let _ = spinner.spin().await;
-    });
-    if ros.log_level <= LogLevel::Info {
-        eprintln!(
-            "rotor_twin: node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
-            ros.fully_qualified_name(),
-            started.elapsed().as_secs_f64(),
-            speed_topic_label(&ros)
-        );
-    }
+    // no ros2-client Spinner: it would add a builtin_interfaces/Time reader on /clock
+    let services = param_services::ParameterServices::create(
+        &mut node,
+        &ros.fully_qualified_name(),
+        live_params,
+    )?;
+    log::to_rosout(node.logging_handle(), &ros.fully_qualified_name());
+    log::info(&format!(
+        "node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
+        ros.fully_qualified_name(),
+        started.elapsed().as_secs_f64(),
+        speed_topic_label(&ros)
+    ));
     if !ros.ignored.is_empty() {
-        eprintln!(
-            "rotor_twin: ROS argument(s) without effect here, ignored: {}",
+        log::info(&format!(
+            "ROS argument(s) without effect here, ignored: {}",
             ros.ignored.join(", ")
-        );
+        ));
     }
 
-    // until SIGINT or SIGTERM; a recording that stops before (a full disk) is an ERROR
-    let watch = watch_recording(&counters, &recorder_thread);
-    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {},
-        _ = term.recv() => {},
-        _ = watch => {
-            // keep the twin running: the bus still gets its outputs
-            let mut term2 = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
-            tokio::select! {
-                _ = tokio::signal::ctrl_c() => {},
-                _ = term2.recv() => {},
-            }
-        }
-    }
-    if ros.log_level <= LogLevel::Info {
-        eprintln!("rotor_twin: shutting down");
-    }
+    until_stopped(&services, &node, &counters, &recorder_thread).await?;
+    log::info("shutting down");
+    drop(services);
     stop.store(true, Ordering::Relaxed);
     let _ = model_thread.join();
     let _ = publish_thread.join();
@@ -312,6 +300,33 @@ async fn run_async(
         Some(t) => finish_recording(t, &ros),
         None => Ok(()),
     }
+}
+
+/// Serves the parameters until SIGINT or SIGTERM; a recording that stops before (a full disk)
+/// is an ERROR, and the twin keeps running: the bus still gets its outputs.
+async fn until_stopped(
+    services: &param_services::ParameterServices,
+    node: &ros2_client::Node,
+    counters: &model::NodeCounters,
+    recorder_thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
+) -> anyhow::Result<()> {
+    let watch = watch_recording(counters, recorder_thread);
+    let serve = services.serve(node);
+    tokio::pin!(serve);
+    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {},
+        _ = term.recv() => {},
+        _ = &mut serve => {},
+        _ = watch => {
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {},
+                _ = term.recv() => {},
+                _ = &mut serve => {},
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Resolves when the recorder thread has ended before the node (its error is reported when the
@@ -328,7 +343,7 @@ async fn watch_recording(
         tokio::time::sleep(std::time::Duration::from_millis(200)).await;
         if thread.as_ref().is_some_and(|t| t.is_finished()) {
             counters.recording_failed.store(true, Ordering::Relaxed);
-            eprintln!("rotor_twin: ERROR: the recording stopped before the node; nothing more is recorded");
+            log::error("the recording stopped before the node; nothing more is recorded");
             return;
         }
     }
@@ -363,7 +378,7 @@ fn finish_recording(
     match t.join() {
         Ok(Ok(dir)) => {
             if ros.log_level <= LogLevel::Info {
-                eprintln!("rotor_twin: recording finished in {}", dir.display());
+                log::info(&format!("recording finished in {}", dir.display()));
             }
             Ok(())
         }
@@ -405,7 +420,8 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
     let validator_params = live.0.clone();
     let (action_params, action_version) = (live.0.clone(), live.1.clone());
     let mut options = NodeOptions::new()
-        .enable_rosout(false)
+        .enable_rosout(true)
+        .start_parameter_services(false)
         .parameter_validator(Box::new(move |name, value| {
             let text = parameter_text(value)
                 .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
@@ -854,11 +870,11 @@ fn subscribe_clock(
                     let mut inbox = inbox.lock().unwrap_or_else(|e| e.into_inner());
                     inbox.push((Some(clock_ns), Err(why)));
                 }
-                ClockSample::Jumped { from_ns } => eprintln!(
-                    "rotor_twin: /clock jumped from {:.6} s to {:.6} s",
+                ClockSample::Jumped { from_ns } => log::info(&format!(
+                    "/clock jumped from {:.6} s to {:.6} s",
                     s(from_ns),
                     s(ns)
-                ),
+                )),
             }
         }
     });
