@@ -131,6 +131,32 @@ fn discovery_localhost_only() -> anyhow::Result<bool> {
     })
 }
 
+/// What the node cannot honour of ROS 2's discovery settings, said at start (REP 2000 / the ROS 2
+/// Jazzy "Improved discovery" design): RustDDS 0.15 has no static (initial) peers and no
+/// discovery-off mode.
+fn discovery_notices(var: impl Fn(&str) -> Option<String>) -> Vec<String> {
+    let set = |name: &str| var(name).filter(|v| !v.trim().is_empty());
+    let mut notices = Vec::new();
+    if let Some(peers) = set("ROS_STATIC_PEERS") {
+        notices.push(format!(
+            "ROS_STATIC_PEERS '{peers}' not honoured: RustDDS 0.15 has no static peers; this node \
+             is found by multicast (or by peers that list its host as theirs)"
+        ));
+    }
+    if set("ROS_AUTOMATIC_DISCOVERY_RANGE")
+        .as_deref()
+        .map(str::trim)
+        == Some("OFF")
+    {
+        notices.push(
+            "ROS_AUTOMATIC_DISCOVERY_RANGE OFF taken as LOCALHOST: RustDDS cannot turn \
+             discovery off"
+                .into(),
+        );
+    }
+    notices
+}
+
 /// Largest ROS domain id (REP 2000 / the ROS 2 docs: 0–232 with Fast DDS and Cyclone's port
 /// mapping; higher ids map to ports beyond 65535).
 pub const MAX_DOMAIN_ID: u16 = 232;
@@ -283,7 +309,7 @@ async fn run_async(
         speed_topic_label(&ros)
     ));
     if !ros.ignored.is_empty() {
-        log::info(&format!(
+        log::warn(&format!(
             "ROS argument(s) without effect here, ignored: {}",
             ros.ignored.join(", ")
         ));
@@ -390,6 +416,9 @@ fn finish_recording(
 /// The DDS context on `domain`: on the loopback interface only when the environment asks for
 /// discovery on this host.
 fn dds_context(domain: u16) -> anyhow::Result<Context> {
+    for notice in discovery_notices(|name| std::env::var(name).ok()) {
+        log::warn(&notice);
+    }
     if discovery_localhost_only()? {
         // only the loopback interface for multicast and advertised locators
         let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(domain)
@@ -879,4 +908,28 @@ fn subscribe_clock(
         }
     });
     Ok(())
+}
+
+#[cfg(test)]
+mod discovery_tests {
+    #[test]
+    fn static_peers_and_off_are_said_not_honoured() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |name: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, v)| v.to_string())
+            }
+        };
+        assert!(super::discovery_notices(env(&[])).is_empty());
+        let n = super::discovery_notices(env(&[
+            ("ROS_STATIC_PEERS", "10.0.0.2;host-b"),
+            ("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF"),
+        ]));
+        assert_eq!(n.len(), 2, "{n:?}");
+        assert!(n[0].contains("10.0.0.2;host-b") && n[1].contains("OFF"));
+        let n = super::discovery_notices(env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")]));
+        assert!(n.is_empty());
+    }
 }
