@@ -1,6 +1,9 @@
-//! The Foxglove layout (config/foxglove_layout.json) only refers to topics the node publishes,
-//! fields their messages have, bearings of the built-in machine and panels it defines; the orbit
-//! plots are square (equal x and y ranges, the clearance of the built-in machine).
+//! The Foxglove layouts (config/foxglove_layout.json for the node, config/foxglove_layout_replay.json
+//! for a replay's output, which has no /diagnostics) only refer to topics the node publishes,
+//! fields their messages have, bearings of the built-in machine and panels they define; the orbit
+//! plots are square (equal x and y ranges, the clearance of the built-in machine); every panel has
+//! its title where Foxglove and Lichtblick read it (`foxglovePanelTitle`, `lichtblickPanelTitle`:
+//! ../shared/notes/foxglove-lichtblick.md; `title` is not read); no plot mixes units on its y axis.
 
 use rotor_twin::messages::{FilmState, JournalState, Orbit, RosMessage};
 use rotor_twin::rotor::MachineDescription;
@@ -38,10 +41,60 @@ fn check_path(path: &str, bearings: &[String]) {
     }
 }
 
+/// The unit of a plotted field, from the naming rule of the messages (`msg/*.msg`): `*_ratio`
+/// fields are ratios (1), the amplitudes and coordinates plotted here metres.
+fn unit_of(path: &str) -> &'static str {
+    if path.trim_end_matches("[:]").ends_with("_ratio") {
+        "1"
+    } else {
+        "m"
+    }
+}
+
+fn load(name: &str) -> Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Titles where the viewers read them, and one unit per plot axis.
+fn check_titles_and_units(v: &Value) {
+    for (id, cfg) in v["configById"].as_object().unwrap() {
+        assert!(cfg.get("title").is_none(), "{id}: `title` is not read");
+        let title = cfg["foxglovePanelTitle"].as_str().unwrap_or("");
+        assert!(!title.is_empty(), "{id}: no foxglovePanelTitle");
+        assert_eq!(cfg["lichtblickPanelTitle"], title, "{id}");
+        if id.starts_with("Plot!") {
+            let mut units: Vec<&str> = cfg["paths"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| unit_of(p["value"].as_str().unwrap()))
+                .collect();
+            units.dedup();
+            assert_eq!(units.len(), 1, "{id}: y axis mixes units {units:?}");
+        }
+    }
+}
+
+#[test]
+fn layouts_have_titles_and_one_unit_per_axis() {
+    let node = load("config/foxglove_layout.json");
+    let replay = load("config/foxglove_layout_replay.json");
+    check_titles_and_units(&node);
+    check_titles_and_units(&replay);
+    // the replay's output has no /diagnostics: no panel waits for it
+    let text = replay.to_string();
+    assert!(!text.contains("DiagnosticSummary") && !text.contains("/diagnostics"));
+    assert!(node.to_string().contains("DiagnosticSummary"));
+    check_layout(&replay);
+}
+
 #[test]
 fn layout_refers_to_what_the_node_publishes() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/foxglove_layout.json");
-    let v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    check_layout(&load("config/foxglove_layout.json"));
+}
+
+fn check_layout(v: &Value) {
     let desc = MachineDescription::builtin_default();
     let bearings: Vec<String> = desc.bearings.iter().map(|b| b.name.clone()).collect();
     let configs = v["configById"].as_object().unwrap();
@@ -84,6 +137,8 @@ fn layout_refers_to_what_the_node_publishes() {
     }
     let mut ids = Vec::new();
     leaves(&v["layout"], &mut ids);
+    ids.sort_unstable();
+    ids.dedup();
     assert_eq!(ids.len(), configs.len());
     assert!(ids.iter().all(|i| configs.contains_key(i)));
 }

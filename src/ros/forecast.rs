@@ -74,7 +74,7 @@ impl ForecastLink {
                 let mut forecaster = match Forecaster::new(&rotor, config, settings) {
                     Ok(f) => f,
                     Err(e) => {
-                        eprintln!("rotor_twin: ERROR: the forecast cannot run: {e}");
+                        super::log::error(&format!("the forecast cannot run: {e}"));
                         thread_stats.failed.store(true, Ordering::Relaxed);
                         return;
                     }

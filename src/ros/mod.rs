@@ -22,16 +22,18 @@
 
 mod calibration;
 mod forecast;
+pub mod log;
 pub mod loss;
 pub mod model;
 mod param_client;
+mod param_services;
 mod params;
 mod recording;
 
 pub use param_client::{run as param_call, ParamCall};
 pub use params::{
-    parse_ros_args, KeyphasorType, LogLevel, NodeParams, RosArgs, SpeedType, SpeedUnit,
-    RUNTIME_PARAMETERS,
+    parameter_doc, parse_ros_args, KeyphasorType, LogLevel, NodeParams, ParamDoc, RosArgs,
+    SpeedType, SpeedUnit, PARAMETER_DOCS, RUNTIME_PARAMETERS,
 };
 
 use crate::driver::Input;
@@ -129,6 +131,32 @@ fn discovery_localhost_only() -> anyhow::Result<bool> {
     })
 }
 
+/// What the node cannot honour of ROS 2's discovery settings, said at start (REP 2000 / the ROS 2
+/// Jazzy "Improved discovery" design): RustDDS 0.15 has no static (initial) peers and no
+/// discovery-off mode.
+fn discovery_notices(var: impl Fn(&str) -> Option<String>) -> Vec<String> {
+    let set = |name: &str| var(name).filter(|v| !v.trim().is_empty());
+    let mut notices = Vec::new();
+    if let Some(peers) = set("ROS_STATIC_PEERS") {
+        notices.push(format!(
+            "ROS_STATIC_PEERS '{peers}' not honoured: RustDDS 0.15 has no static peers; this node \
+             is found by multicast (or by peers that list its host as theirs)"
+        ));
+    }
+    if set("ROS_AUTOMATIC_DISCOVERY_RANGE")
+        .as_deref()
+        .map(str::trim)
+        == Some("OFF")
+    {
+        notices.push(
+            "ROS_AUTOMATIC_DISCOVERY_RANGE OFF taken as LOCALHOST: RustDDS cannot turn \
+             discovery off"
+                .into(),
+        );
+    }
+    notices
+}
+
 /// Largest ROS domain id (REP 2000 / the ROS 2 docs: 0–232 with Fast DDS and Cyclone's port
 /// mapping; higher ids map to ports beyond 65535).
 pub const MAX_DOMAIN_ID: u16 = 232;
@@ -155,6 +183,7 @@ fn domain_id() -> anyhow::Result<u16> {
 pub fn run(setup: NodeSetup) -> anyhow::Result<()> {
     let started = std::time::Instant::now();
     let ros = parse_ros_args(&setup.ros_args).map_err(anyhow::Error::msg)?;
+    log::set_level(ros.log_level);
     let mut params = NodeParams::default();
     for (k, v) in &ros.params {
         params.set(k, v).map_err(anyhow::Error::msg)?;
@@ -187,20 +216,20 @@ fn prepare_tables(params: &NodeParams, ros: &RosArgs, rotor: &Rotor) -> anyhow::
     let info = ros.log_level <= LogLevel::Info;
     if info {
         let cache = crate::film::disk_cache().map(|c| c.dir().display().to_string());
-        eprintln!(
-            "rotor_twin: film tables (cache: {}): read, or built in about 11 s on 2 idle cores…",
+        log::info(&format!(
+            "film tables (cache: {}): read, or built in about 11 s on 2 idle cores…",
             cache.as_deref().unwrap_or("off")
-        );
+        ));
     }
     let start = std::time::Instant::now();
     let origins = crate::dynamics::prepare_film_tables(rotor)?;
     if info {
         let said: Vec<String> = origins.iter().map(ToString::to_string).collect();
-        eprintln!(
-            "rotor_twin: film tables ready in {:.2} s ({})",
+        log::info(&format!(
+            "film tables ready in {:.2} s ({})",
             start.elapsed().as_secs_f64(),
             said.join("; ")
-        );
+        ));
     }
     Ok(())
 }
@@ -220,6 +249,7 @@ async fn run_async(
         Arc::new(Mutex::new(params.clone())),
         Arc::new(std::sync::atomic::AtomicU64::new(0)),
     );
+    let live_params = live.0.clone();
     let mut node = context
         .new_node(
             NodeName::new(&ros.namespace, &ros.node_name)
@@ -263,12 +293,17 @@ async fn run_async(
     };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
-    spawn_spinner(&mut node)?;
+    // no ros2-client Spinner: it would add a builtin_interfaces/Time reader on /clock
+    let services = param_services::ParameterServices::create(
+        &mut node,
+        &ros.fully_qualified_name(),
+        live_params,
+    )?;
+    log::to_rosout(node.logging_handle(), &ros.fully_qualified_name());
     announce_up(&ros, domain, started);
-    wait_for_stop(&counters, &recorder_thread).await?;
-    if ros.log_level <= LogLevel::Info {
-        eprintln!("rotor_twin: shutting down");
-    }
+    until_stopped(&services, &node, &counters, &recorder_thread).await?;
+    log::info("shutting down");
+    drop(services);
     stop.store(true, Ordering::Relaxed);
     join_reporting_panic(model_thread, "model");
     join_reporting_panic(publish_thread, "publishing");
@@ -279,65 +314,54 @@ async fn run_async(
     }
 }
 
-/// The node's spinner (parameter services, graph) on the runtime; its end is logged.
-fn spawn_spinner(node: &mut ros2_client::Node) -> anyhow::Result<()> {
-    let spinner = node
-        .spinner()
-        .map_err(|e| anyhow::anyhow!("spinner: {e:?}"))?;
-    tokio::spawn(async move {
-        if let Err(e) = spinner.spin().await {
-            eprintln!("rotor_twin: the node's spinner stopped: {e:?}");
-        }
-    });
-    Ok(())
-}
-
 /// The start-up line (at log level info) and the ROS arguments that have no effect.
 fn announce_up(ros: &RosArgs, domain: u16, started: std::time::Instant) {
-    if ros.log_level <= LogLevel::Info {
-        eprintln!(
-            "rotor_twin: node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
-            ros.fully_qualified_name(),
-            started.elapsed().as_secs_f64(),
-            speed_topic_label(ros)
-        );
-    }
+    log::info(&format!(
+        "node {} up on ROS domain {domain} {:.2} s after start; waiting for {}",
+        ros.fully_qualified_name(),
+        started.elapsed().as_secs_f64(),
+        speed_topic_label(ros)
+    ));
     if !ros.ignored.is_empty() {
-        eprintln!(
-            "rotor_twin: ROS argument(s) without effect here, ignored: {}",
+        log::warn(&format!(
+            "ROS argument(s) without effect here, ignored: {}",
             ros.ignored.join(", ")
-        );
+        ));
     }
-}
-
-/// Until SIGINT or SIGTERM. A recording that stops before (a full disk) is an ERROR
-/// (`watch_recording`); the twin keeps running, since the bus still gets its outputs.
-async fn wait_for_stop(
-    counters: &model::NodeCounters,
-    recorder_thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
-) -> anyhow::Result<()> {
-    use tokio::signal::unix::{signal, SignalKind};
-    let watch = watch_recording(counters, recorder_thread);
-    let mut term = signal(SignalKind::terminate())?;
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {},
-        _ = term.recv() => {},
-        _ = watch => {
-            let mut term2 = signal(SignalKind::terminate())?;
-            tokio::select! {
-                _ = tokio::signal::ctrl_c() => {},
-                _ = term2.recv() => {},
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Joins a node thread at shutdown; a panic in it is reported (it was dropped with `let _`).
 fn join_reporting_panic(thread: std::thread::JoinHandle<()>, name: &str) {
     if thread.join().is_err() {
-        eprintln!("rotor_twin: the {name} thread panicked before shutdown");
+        log::error(&format!("the {name} thread panicked before shutdown"));
     }
+}
+
+/// Serves the parameters until SIGINT or SIGTERM; a recording that stops before (a full disk)
+/// is an ERROR, and the twin keeps running: the bus still gets its outputs.
+async fn until_stopped(
+    services: &param_services::ParameterServices,
+    node: &ros2_client::Node,
+    counters: &model::NodeCounters,
+    recorder_thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
+) -> anyhow::Result<()> {
+    let watch = watch_recording(counters, recorder_thread);
+    let serve = services.serve(node);
+    tokio::pin!(serve);
+    let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {},
+        _ = term.recv() => {},
+        _ = &mut serve => {},
+        _ = watch => {
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {},
+                _ = term.recv() => {},
+                _ = &mut serve => {},
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Resolves when the recorder thread has ended before the node (its error is reported when the
@@ -354,7 +378,7 @@ async fn watch_recording(
         tokio::time::sleep(std::time::Duration::from_millis(200)).await;
         if thread.as_ref().is_some_and(|t| t.is_finished()) {
             counters.recording_failed.store(true, Ordering::Relaxed);
-            eprintln!("rotor_twin: ERROR: the recording stopped before the node; nothing more is recorded");
+            log::error("the recording stopped before the node; nothing more is recorded");
             return;
         }
     }
@@ -389,7 +413,7 @@ fn finish_recording(
     match t.join() {
         Ok(Ok(dir)) => {
             if ros.log_level <= LogLevel::Info {
-                eprintln!("rotor_twin: recording finished in {}", dir.display());
+                log::info(&format!("recording finished in {}", dir.display()));
             }
             Ok(())
         }
@@ -401,6 +425,9 @@ fn finish_recording(
 /// The DDS context on `domain`: on the loopback interface only when the environment asks for
 /// discovery on this host.
 fn dds_context(domain: u16) -> anyhow::Result<Context> {
+    for notice in discovery_notices(|name| std::env::var(name).ok()) {
+        log::warn(&notice);
+    }
     if discovery_localhost_only()? {
         // only the loopback interface for multicast and advertised locators
         let participant = ros2_client::dds::rustdds::DomainParticipantBuilder::new(domain)
@@ -431,7 +458,8 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
     let validator_params = live.0.clone();
     let (action_params, action_version) = (live.0.clone(), live.1.clone());
     let mut options = NodeOptions::new()
-        .enable_rosout(false)
+        .enable_rosout(true)
+        .start_parameter_services(false)
         .parameter_validator(Box::new(move |name, value| {
             let text = parameter_text(value)
                 .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
@@ -886,13 +914,37 @@ fn subscribe_clock(
                         input: Err(why),
                     });
                 }
-                ClockSample::Jumped { from_ns } => eprintln!(
-                    "rotor_twin: /clock jumped from {:.6} s to {:.6} s",
+                ClockSample::Jumped { from_ns } => log::info(&format!(
+                    "/clock jumped from {:.6} s to {:.6} s",
                     s(from_ns),
                     s(ns)
-                ),
+                )),
             }
         }
     });
     Ok(())
+}
+
+#[cfg(test)]
+mod discovery_tests {
+    #[test]
+    fn static_peers_and_off_are_said_not_honoured() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |name: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, v)| v.to_string())
+            }
+        };
+        assert!(super::discovery_notices(env(&[])).is_empty());
+        let n = super::discovery_notices(env(&[
+            ("ROS_STATIC_PEERS", "10.0.0.2;host-b"),
+            ("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF"),
+        ]));
+        assert_eq!(n.len(), 2, "{n:?}");
+        assert!(n[0].contains("10.0.0.2;host-b") && n[1].contains("OFF"));
+        let n = super::discovery_notices(env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "SUBNET")]));
+        assert!(n.is_empty());
+    }
 }

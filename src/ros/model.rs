@@ -259,7 +259,7 @@ impl ModelLoop {
             .then(super::calibration::CalibrationWorker::spawn)
             .and_then(|w| {
                 w.map_err(|e| {
-                    eprintln!("rotor_twin: ERROR: the calibration thread did not start: {e}")
+                    super::log::error(&format!("the calibration thread did not start: {e}"))
                 })
                 .ok()
             });
@@ -361,7 +361,7 @@ impl ModelLoop {
             out.clone(),
         ) {
             Ok(link) => self.forecast = Some(link),
-            Err(e) => eprintln!("rotor_twin: ERROR: the forecast thread did not start: {e}"),
+            Err(e) => super::log::error(&format!("the forecast thread did not start: {e}")),
         }
     }
 
@@ -488,8 +488,8 @@ impl ModelLoop {
             viscosity_scale,
         };
         match self.driver.apply_calibration(applied) {
-            Ok(said) => eprintln!("rotor_twin: calibration applied to the twin: {said}"),
-            Err(why) => eprintln!("rotor_twin: WARN: calibration not applied: {why}"),
+            Ok(said) => super::log::info(&format!("calibration applied to the twin: {said}")),
+            Err(why) => super::log::warn(&format!("calibration not applied: {why}")),
         }
     }
 
@@ -522,8 +522,8 @@ impl ModelLoop {
     /// Takes the calibration back, saying so or why it could not.
     fn revert_calibration(&mut self) {
         match self.driver.revert_calibration() {
-            Ok(()) => eprintln!("rotor_twin: calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
-            Err(why) => eprintln!("rotor_twin: WARN: calibration not taken back: {why}"),
+            Ok(()) => super::log::info("calibration taken back: the machine file's and the received unbalance and viscosity are in force again"),
+            Err(why) => super::log::warn(&format!("calibration not taken back: {why}")),
         }
     }
 
@@ -537,7 +537,9 @@ impl ModelLoop {
             return;
         }
         self.threshold_scale = s;
-        eprintln!("rotor_twin: viscosity × {s:.4} in force: the stability threshold is recomputed");
+        super::log::info(&format!(
+            "viscosity × {s:.4} in force: the stability threshold is recomputed"
+        ));
         spawn_threshold(self.driver.rotor(), &self.threshold, &self.threshold_busy);
     }
 

@@ -823,3 +823,71 @@ mod tests {
         assert!(args(&["--bogus"]).unwrap_err().contains("--bogus"));
     }
 }
+
+/// A parameter's ROS 2 descriptor (rcl_interfaces/ParameterDescriptor): what `ros2 param
+/// describe` shows. The rules themselves are checked in [`NodeParams::set`]; a range here is the
+/// closed interval ROS 2 can express, the open end stated in `constraints`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamDoc {
+    /// The parameter's name.
+    pub name: &'static str,
+    /// One line for a user, with the unit.
+    pub description: &'static str,
+    /// What the range cannot say (an open bound, a list of values, a format).
+    pub constraints: &'static str,
+    /// Closed numeric range (from, to), if any.
+    pub range: Option<(f64, f64)>,
+}
+
+impl ParamDoc {
+    /// True for parameters set at start only (`read_only` in the descriptor).
+    pub fn read_only(&self) -> bool {
+        !RUNTIME_PARAMETERS.contains(&self.name)
+    }
+}
+
+const fn doc(
+    name: &'static str,
+    description: &'static str,
+    constraints: &'static str,
+    range: Option<(f64, f64)>,
+) -> ParamDoc {
+    ParamDoc {
+        name,
+        description,
+        constraints,
+        range,
+    }
+}
+
+/// Every declared parameter's descriptor, in declaration order (one home: the node's parameter
+/// services answer `describe_parameters` from it, and a test checks it covers every parameter).
+pub const PARAMETER_DOCS: &[ParamDoc] = &[
+    doc("model", "rotor-bearing model", "linear, nonlinear or prehistory", None),
+    doc("delta", "prehistory relaxation factor δ", "above 0, at most 1", Some((0.0, 1.0))),
+    doc("film", "film forces: table (tabulated finite-length solutions) or direct (the solver at every step)", "table or direct", None),
+    doc("steps_per_rev", "time steps per revolution at rated speed", "whole number", Some((16.0, 4096.0))),
+    doc("state_rate_hz", "rate of journal and film states (Hz)", "above 0", None),
+    doc("pressure_map_rate_hz", "rate of the pressure profile in the film state (Hz)", "above 0", None),
+    doc("input_timeout_s", "a speed older than this is stale (s)", "above 0", None),
+    doc("min_speed_rpm", "below this speed the model pauses (rpm)", "above 0", None),
+    doc("speed_type", "type of the speed topic", "rotor_speed (rotor_twin_msgs/RotorSpeed) or float64 (std_msgs/Float64)", None),
+    doc("speed_unit", "unit of a std_msgs/Float64 speed", "rpm, rad_s or hz", None),
+    doc("probe_point_topics", "probe pairs as geometry_msgs/PointStamped (m)", "station=topic, comma separated", None),
+    doc("use_sim_time", "follow /clock (rosgraph_msgs/Clock) instead of the wall clock", "", None),
+    doc("film_cache", "read and store the film tables in the cache directory", "", None),
+    doc("film_cache_dir", "film-table cache directory; empty: the command line's or the default", "", None),
+    doc("warning_amplitude_ratio", "orbit amplitude over clearance that raises a warning", "above 0", None),
+    doc("forecast_period_s", "model time between forecasts (s); 0: no forecast", "0 or at least 0.1 s", None),
+    doc("forecast_horizon_s", "how far a forecast looks ahead (s)", "above 0", Some((0.0, 60.0))),
+    doc("forecast_offsets_rpm", "constant speeds a forecast probes above the present one (rpm)", "ascending, comma separated", None),
+    doc("keyphasor_type", "type of the keyphasor topic", "keyphasor (rotor_twin_msgs/Keyphasor) or header (std_msgs/Header)", None),
+    doc("probe_signal_topics", "raw probe readings as std_msgs/Float64, in the probe's unit", "probe=topic, comma separated", None),
+    doc("calibration_period_s", "node-clock time between live calibration fits (s); 0: none", "0 or at least 1 s", None),
+    doc("calibration_apply", "apply each live calibration estimate to the running twin", "", None),
+];
+
+/// The descriptor of parameter `name`, if it is one of the node's.
+pub fn parameter_doc(name: &str) -> Option<&'static ParamDoc> {
+    PARAMETER_DOCS.iter().find(|d| d.name == name)
+}
