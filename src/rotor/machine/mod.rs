@@ -18,7 +18,9 @@ mod rules;
 pub use bearing::{
     BearingModelSpec, BearingSpec, FilmSpec, GroovesSpec, RawBearingSpec, SupportSpec,
 };
-pub use oil::{LubricantSpec, ViscosityTemperatureSpec};
+pub use oil::{
+    LubricantSpec, OilHeatingModel, OilHeatingSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER,
+};
 pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 
 use super::error::ConfigError;
