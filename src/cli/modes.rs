@@ -104,6 +104,23 @@ struct EffectiveTemperatureRow {
     friction_power_w: f64,
 }
 
+/// One line per heated bearing.
+fn print_effective_temperatures(rows: &[EffectiveTemperatureRow]) {
+    for t in rows {
+        println!(
+            "  {} at {:.0} rpm: effective temperature {:.2} °C (supply {:.1} °C, ΔT {:.2} K), µ_eff {:.4} mPa·s, ε {:.3}, friction {:.1} W",
+            t.bearing,
+            t.at_speed_rpm,
+            t.effective_temperature_c,
+            t.supply_temperature_c,
+            t.temperature_rise_k,
+            t.viscosity_pa_s * 1e3,
+            t.eccentricity_ratio,
+            t.friction_power_w
+        );
+    }
+}
+
 /// With `oil_heating`, the films at their effective temperatures at the threshold speed found
 /// at those temperatures: a fixed point on the speed (to 1 rpm), from the rated speed; the
 /// rated speed's temperatures when the machine is stable over the range.
@@ -247,19 +264,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print_tables(&report);
-        for t in &report.effective_temperatures {
-            println!(
-                "  {} at {:.0} rpm: effective temperature {:.2} °C (supply {:.1} °C, ΔT {:.2} K), µ_eff {:.4} mPa·s, ε {:.3}, friction {:.1} W",
-                t.bearing,
-                t.at_speed_rpm,
-                t.effective_temperature_c,
-                t.supply_temperature_c,
-                t.temperature_rise_k,
-                t.viscosity_pa_s * 1e3,
-                t.eccentricity_ratio,
-                t.friction_power_w
-            );
-        }
+        print_effective_temperatures(&report.effective_temperatures);
     }
     Ok(())
 }
