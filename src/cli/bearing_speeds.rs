@@ -171,12 +171,14 @@ pub(crate) struct SpeedRow {
     pub effective_viscosity_pa_s: Option<f64>,
 }
 
-/// The equilibrium of `b` at `omega`, at its effective temperature when its oil heats
-/// (Some((T_eff °C, ΔT K, µ_eff Pa·s))).
+/// A heated bearing's (T_eff °C, ΔT K, µ_eff Pa·s).
+type Heat = (f64, f64, f64);
+
+/// The equilibrium of `b` at `omega`, at its effective temperature when its oil heats.
 fn equilibrium(
     b: &mut SweptBearing,
     omega: f64,
-) -> anyhow::Result<(crate::film::Equilibrium, Option<(f64, f64, f64)>)> {
+) -> anyhow::Result<(crate::film::Equilibrium, Option<Heat>)> {
     let Some(f) = &b.heated else {
         let eq = equilibrium_under_load(b.film.as_mut(), b.viscosity_pa_s, b.load_n, omega)?;
         return Ok((eq, None));

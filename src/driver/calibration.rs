@@ -228,6 +228,10 @@ impl LiveEstimate {
                     m.correction_angles
                         .push(p.correction.angle_deg.to_radians());
                 }
+                // one field in the message: the first plane's (each mass is at its plane's own)
+                if let Some(p) = u.planes.first() {
+                    m.correction_radius = p.correction.radius_m;
+                }
                 m.unbalance_residual = u.residual_rms_m;
                 m.unbalance_relative_residual = u.relative_residual;
                 m.condition_number = u.condition_number;

@@ -142,7 +142,7 @@ pub fn effective_temperature(
     }
     let top = law.range_k()[1];
     let mut hi = (supply_k + h_lo).min(top);
-    let (mut h_hi, mut eq_hi) = at(hi)?;
+    let (mut h_hi, eq_hi) = at(hi)?;
     if h_hi > 0.0 {
         return Err(format!(
             "the effective temperature lies beyond the viscosity law's range (up to {:.1} °C)",
@@ -151,7 +151,7 @@ pub fn effective_temperature(
     }
     let (mut lo, mut h_lo) = (supply_k, h_lo);
     // the point evaluated last: the root when |h| or the bracket is below the tolerance
-    let (mut last_t, mut last_h, mut last_eq) = (hi, h_hi, eq_hi.clone());
+    let (mut last_t, mut last_h, mut last_eq) = (hi, h_hi, eq_hi);
     let mut side = 0;
     while last_h.abs() > TEMPERATURE_TOLERANCE_K && hi - lo > TEMPERATURE_TOLERANCE_K {
         if evaluations.get() >= MAX_EVALUATIONS {
@@ -168,7 +168,7 @@ pub fn effective_temperature(
             }
             side = -1;
         } else {
-            (hi, h_hi, eq_hi) = (t, h, eq.clone());
+            (hi, h_hi) = (t, h);
             if side == 1 {
                 h_lo *= 0.5;
             }
@@ -176,7 +176,6 @@ pub fn effective_temperature(
         }
         (last_t, last_h, last_eq) = (t, h, eq);
     }
-    let _ = eq_hi;
     Ok(done(
         supply_k,
         last_t,

@@ -214,6 +214,8 @@ pub struct Unbalance {
     pub magnitude_kg_m: f64,
     /// Angle of the heavy spot at rotor angle 0, from +x towards +y (rad).
     pub phase_rad: f64,
+    /// Radius of a balancing correction mass in this plane (m), if the machine file gives one.
+    pub correction_radius_m: Option<f64>,
 }
 
 /// A probe station: two probes at a node.
@@ -280,6 +282,7 @@ impl Rotor {
                     node: u.node,
                     magnitude_kg_m: u.magnitude_g_mm * 1e-6,
                     phase_rad: u.phase_deg.to_radians(),
+                    correction_radius_m: u.correction_radius_m,
                 })
                 .collect(),
             probes: desc
