@@ -25,6 +25,7 @@ fn twin_rotor() -> Rotor {
         node: 21,
         magnitude_g_mm: 0.0,
         phase_deg: 0.0,
+        correction_radius_m: None,
     });
     Rotor::from_description(&d)
 }

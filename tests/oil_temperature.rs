@@ -226,3 +226,67 @@ fn a_machine_without_a_law_refuses_a_temperature() {
         other => panic!("{other:?}"),
     }
 }
+
+/// An applied calibrated viscosity is a correction on the law (s_fit / s_law(T_fit)), so a later
+/// oil temperature still moves the viscosity. Reference: the built-in machine's Walther law
+/// computed here from its two points (config/orc_microturbine_100kw.yaml: ν 0.889 mm²/s at
+/// 40 °C, 0.60 at 80 °C, ρ 900, µ_reference 0.8 mPa·s): after calibrating × 1.10 at 40 °C, 60 °C
+/// must give 1.10 × s_law(60 °C) / s_law(40 °C) to 1e-9, and taking the calibration back
+/// s_law(60 °C). (Before, the calibrated 1.10 stayed whatever the temperature.)
+#[test]
+fn a_calibrated_viscosity_follows_later_oil_temperatures() {
+    use rotor_twin::driver::Applied;
+    use rotor_twin::film::WaltherLaw;
+    let k = |c: f64| c + ZERO_CELSIUS_K;
+    let law = WaltherLaw::through(
+        [(k(40.0), 0.889), (k(80.0), 0.60)],
+        900.0,
+        [k(10.0), k(120.0)],
+    )
+    .unwrap();
+    let s_law = |c: f64| law.viscosity_pa_s(k(c)) / 0.0008;
+    let r = rotor();
+    let settings = DriverSettings::new(
+        ModelKind::Nonlinear,
+        FilmEvaluation::Direct,
+        r.rated_speed_rad_s,
+    );
+    let mut d = Driver::new(r, settings);
+    let mut emit = |_: Outgoing| {};
+    let t0 = 1_767_225_600_000_000_000_i64;
+    assert_eq!(d.feed(t0, temperature(40.0), &mut emit), Fed::Taken);
+    let speed = Input::Speed {
+        speed_rad_s: 8000.0 * std::f64::consts::PI / 30.0,
+        accel_rad_s2: 0.0,
+        stamp_ns: 0,
+    };
+    assert!(matches!(
+        d.feed(t0 + 1_000_000, speed, &mut emit),
+        Fed::Started { .. }
+    ));
+    d.apply_calibration(Applied {
+        unbalance: None,
+        viscosity_scale: Some(1.10),
+    })
+    .unwrap();
+    let twin = |d: &Driver| d.session().unwrap().twin().viscosity_scale();
+    assert!((twin(&d) - 1.10).abs() < 1e-12);
+    assert_eq!(
+        d.feed(t0 + 2_000_000, temperature(60.0), &mut emit),
+        Fed::Taken
+    );
+    let expected = 1.10 * s_law(60.0) / s_law(40.0);
+    println!(
+        "calibrated × 1.10 at 40 °C, then 60 °C: × {:.5} (law alone × {:.5})",
+        twin(&d),
+        s_law(60.0)
+    );
+    assert!(
+        (twin(&d) / expected - 1.0).abs() < 1e-9,
+        "{} vs {expected}",
+        twin(&d)
+    );
+    assert!((d.viscosity_scale() / expected - 1.0).abs() < 1e-9);
+    d.revert_calibration().unwrap();
+    assert!((twin(&d) / s_law(60.0) - 1.0).abs() < 1e-9);
+}

@@ -172,7 +172,10 @@ fn solve(
         .iter()
         .zip(&norms)
         .zip(&rotor.unbalance)
-        .map(|((u, n), plane)| plane_estimate(plane.node, [u[0] / n, u[1] / n], radius_m))
+        .map(|((u, n), plane)| {
+            let r = plane.correction_radius_m.unwrap_or(radius_m);
+            plane_estimate(plane.node, [u[0] / n, u[1] / n], r)
+        })
         .collect();
     Ok(UnbalanceEstimate {
         planes,

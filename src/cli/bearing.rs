@@ -167,6 +167,7 @@ fn run_speeds(args: &BearingArgs, speeds: &[f64]) -> anyhow::Result<()> {
                 film,
                 viscosity_pa_s: lubricant.viscosity_pa_s,
                 load_n: [w, 0.0],
+                heated: None,
             }
         }
     };

@@ -73,6 +73,9 @@ pub(crate) struct SweptBearing {
     pub viscosity_pa_s: f64,
     /// Static load on the film, the force of the journal on the bearing, machine frame (N).
     pub load_n: [f64; 2],
+    /// The machine file's bearing when its oil models its own heating: each speed is then
+    /// solved at its effective temperature (from the law's design supply temperature).
+    pub heated: Option<crate::rotor::FilmBearing>,
 }
 
 /// The bearing `name` of the machine file `path` (the first film bearing without a name) and
@@ -136,6 +139,7 @@ pub(crate) fn from_machine(path: &Path, name: Option<&str>) -> anyhow::Result<Sw
         film: f.solver(),
         viscosity_pa_s: f.viscosity_pa_s(),
         load_n,
+        heated: f.heating.is_some().then(|| f.clone()),
     })
 }
 
@@ -158,6 +162,47 @@ pub(crate) struct SpeedRow {
     pub damping_n_s_per_m: [[f64; 2]; 2],
     pub stiffness_dimensionless: [[f64; 2]; 2],
     pub damping_dimensionless: [[f64; 2]; 2],
+    /// With `oil_heating`: the effective temperature (°C), its rise ΔT (K) and µ there (Pa·s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub effective_temperature_c: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temperature_rise_k: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub effective_viscosity_pa_s: Option<f64>,
+}
+
+/// A heated bearing's (T_eff °C, ΔT K, µ_eff Pa·s).
+type Heat = (f64, f64, f64);
+
+/// The equilibrium of `b` at `omega`, at its effective temperature when its oil heats.
+fn equilibrium(
+    b: &mut SweptBearing,
+    omega: f64,
+) -> anyhow::Result<(crate::film::Equilibrium, Option<Heat>)> {
+    let Some(f) = &b.heated else {
+        let eq = equilibrium_under_load(b.film.as_mut(), b.viscosity_pa_s, b.load_n, omega)?;
+        return Ok((eq, None));
+    };
+    let (Some(heating), Some(law), Some(t_s)) =
+        (f.heating, f.viscosity_law, f.design_supply_temperature_k)
+    else {
+        anyhow::bail!("oil_heating needs the lubricant's viscosity_temperature law");
+    };
+    let mut film = f.scaled(f.reference_solver());
+    let e = crate::film::effective_temperature(
+        &mut film,
+        f.lubricant.viscosity_pa_s,
+        &law,
+        &heating,
+        f.lubricant.density_kg_m3,
+        t_s,
+        b.load_n,
+        omega,
+    )
+    .map_err(|e| anyhow::anyhow!(e))?;
+    let t_c = e.effective_temperature_k - crate::film::ZERO_CELSIUS_K;
+    let extra = (t_c, e.temperature_rise_k, e.viscosity_pa_s);
+    Ok((e.equilibrium, Some(extra)))
 }
 
 /// The `--json` report of a sweep.
@@ -188,7 +233,7 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
     let mut rows = Vec::with_capacity(speeds.len());
     for &rpm in speeds {
         let omega = rpm_to_rad_s(rpm);
-        let eq = equilibrium_under_load(b.film.as_mut(), b.viscosity_pa_s, b.load_n, omega)
+        let (eq, heat) = equilibrium(b, omega)
             .with_context(|| format!("static equilibrium of {} at {rpm} rpm", b.name))?;
         let coef = eq.coefficients.turned_back(&r);
         let p = r.inverse() * nalgebra::Vector2::new(eq.position_m[0], eq.position_m[1]);
@@ -206,6 +251,9 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
             damping_n_s_per_m: coef.damping_n_s_per_m,
             stiffness_dimensionless: coef.dimensionless_stiffness(w, c),
             damping_dimensionless: coef.dimensionless_damping(w, c, omega),
+            effective_temperature_c: heat.map(|h| h.0),
+            temperature_rise_k: heat.map(|h| h.1),
+            effective_viscosity_pa_s: heat.map(|h| h.2),
         };
         anyhow::ensure!(
             row_is_finite(&row),
@@ -304,6 +352,16 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
             c[2],
             c[3]
         );
+        if let (Some(t), Some(dt), Some(mu)) = (
+            s.effective_temperature_c,
+            s.temperature_rise_k,
+            s.effective_viscosity_pa_s,
+        ) {
+            outln!(
+                "          effective temperature {t:.2} °C (ΔT {dt:.2} K), µ_eff {:.4} mPa·s",
+                mu * 1e3
+            );
+        }
     }
     Ok(())
 }

@@ -85,6 +85,79 @@ struct ModesReport {
     /// The damped mode shapes at `--shapes-rpm` (absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
     mode_shapes: Option<super::mode_shapes::ModeShapes>,
+    /// With `oil_heating`: each heated bearing at its effective temperature at the speed the
+    /// viscosities were taken at (the threshold found at them, or the rated speed when stable).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    effective_temperatures: Vec<EffectiveTemperatureRow>,
+}
+
+/// One heated bearing in the `modes` report.
+#[derive(Debug, Serialize)]
+struct EffectiveTemperatureRow {
+    bearing: String,
+    at_speed_rpm: f64,
+    supply_temperature_c: f64,
+    effective_temperature_c: f64,
+    temperature_rise_k: f64,
+    viscosity_pa_s: f64,
+    eccentricity_ratio: f64,
+    friction_power_w: f64,
+}
+
+/// One line per heated bearing.
+fn print_effective_temperatures(rows: &[EffectiveTemperatureRow]) {
+    for t in rows {
+        println!(
+            "  {} at {:.0} rpm: effective temperature {:.2} °C (supply {:.1} °C, ΔT {:.2} K), µ_eff {:.4} mPa·s, ε {:.3}, friction {:.1} W",
+            t.bearing,
+            t.at_speed_rpm,
+            t.effective_temperature_c,
+            t.supply_temperature_c,
+            t.temperature_rise_k,
+            t.viscosity_pa_s * 1e3,
+            t.eccentricity_ratio,
+            t.friction_power_w
+        );
+    }
+}
+
+/// With `oil_heating`, the films at their effective temperatures at the threshold speed found
+/// at those temperatures: a fixed point on the speed (to 1 rpm), from the rated speed; the
+/// rated speed's temperatures when the machine is stable over the range.
+fn heat_for_threshold(
+    rotor: &mut Rotor,
+    statics: &crate::rotor::StaticSolution,
+    (from, to, step): (f64, f64, f64),
+    rated_rpm: f64,
+) -> anyhow::Result<Vec<EffectiveTemperatureRow>> {
+    if !rotor.has_oil_heating() {
+        return Ok(Vec::new());
+    }
+    let mut rpm = rated_rpm;
+    for _ in 0..20 {
+        let temps = rotor
+            .heat_films(None, crate::units::rpm_to_rad_s(rpm), 1.0)
+            .map_err(anyhow::Error::msg)?;
+        let next = stability_threshold(rotor, statics, from, to, step)?.map(|t| t.speed_rpm);
+        if next.is_none_or(|n| (n - rpm).abs() < 1.0) {
+            let c = |k: f64| k - crate::film::ZERO_CELSIUS_K;
+            return Ok(temps
+                .into_iter()
+                .map(|t| EffectiveTemperatureRow {
+                    bearing: t.name,
+                    at_speed_rpm: rpm,
+                    supply_temperature_c: c(t.effective.supply_temperature_k),
+                    effective_temperature_c: c(t.effective.effective_temperature_k),
+                    temperature_rise_k: t.effective.temperature_rise_k,
+                    viscosity_pa_s: t.effective.viscosity_pa_s,
+                    eccentricity_ratio: t.effective.equilibrium.eccentricity_ratio,
+                    friction_power_w: t.effective.friction_power_w,
+                })
+                .collect());
+        }
+        rpm = next.unwrap_or(rpm);
+    }
+    anyhow::bail!("the threshold at the effective temperatures did not settle in 20 passes")
 }
 
 /// The speeds of the Campbell diagram and threshold search, checked: (speeds, from, to, step)
@@ -131,6 +204,8 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     }
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     let statics = static_solution(&rotor).context("static deflection")?;
+    let heated = heat_for_threshold(&mut rotor, &statics, (from, to, step), desc.rated_speed_rpm)
+        .context("effective temperatures")?;
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
@@ -173,6 +248,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
         campbell: points,
         mode_shapes: shapes,
+        effective_temperatures: heated,
     };
     if let Some(path) = &args.plot {
         crate::plot::campbell_svg(
@@ -188,6 +264,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print_tables(&report);
+        print_effective_temperatures(&report.effective_temperatures);
     }
     Ok(())
 }

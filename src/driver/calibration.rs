@@ -229,6 +229,10 @@ impl LiveEstimate {
                     m.correction_angles
                         .push(p.correction.angle_deg.to_radians());
                 }
+                // one field in the message: the first plane's (each mass is at its plane's own)
+                if let Some(p) = u.planes.first() {
+                    m.correction_radius = p.correction.radius_m;
+                }
                 m.unbalance_residual = u.residual_rms_m;
                 m.unbalance_relative_residual = u.relative_residual;
                 m.condition_number = u.condition_number;
@@ -266,13 +270,18 @@ pub struct Applied {
 impl super::Driver {
     /// Applies a calibration to the running twin and to every later start: the unbalance per
     /// plane (m·e kg·m, phase rad from the mark) and the viscosity scale (over the machine
-    /// file's; it then takes the place of the oil temperature's, which is kept for
-    /// [`Self::revert_calibration`]). Returns what changed, for the log.
+    /// file's). The viscosity is kept as a correction on the law, s_fit / s_law(T), T the oil
+    /// temperature in force when it is applied (the one it was fitted at; none: the machine
+    /// file's), so a later oil temperature T' gives s_law(T') × that correction; the oil
+    /// temperature's own scale is kept for [`Self::revert_calibration`]. Returns what changed,
+    /// for the log.
     pub fn apply_calibration(&mut self, applied: Applied) -> Result<String, String> {
         let mut said = Vec::new();
         if let Some(s) = applied.viscosity_scale {
             self.set_scale(s)?;
-            said.push(format!("viscosity × {s:.4}"));
+            let k = s / self.oil_scale.unwrap_or(1.0);
+            self.viscosity_correction = Some(k);
+            said.push(format!("viscosity × {s:.4} (× {k:.4} on the law)"));
         }
         if let Some(u) = &applied.unbalance {
             for (p, &(me, phase)) in u.iter().enumerate() {
@@ -300,6 +309,7 @@ impl super::Driver {
             return Ok(());
         };
         if applied.viscosity_scale.is_some() {
+            self.viscosity_correction = None;
             self.set_scale(self.oil_scale.unwrap_or(1.0))?;
         }
         if applied.unbalance.is_some() {

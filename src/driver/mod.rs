@@ -142,6 +142,10 @@ pub struct Driver {
     /// the viscosity scale of the last accepted oil temperature (kept while a calibrated
     /// viscosity is in force)
     oil_scale: Option<f64>,
+    /// an applied calibrated viscosity as a factor on the law: the fitted scale over the oil
+    /// temperature's scale when it was applied (1 without a temperature), so later temperatures
+    /// still move the viscosity
+    viscosity_correction: Option<f64>,
 }
 
 impl Driver {
@@ -169,6 +173,7 @@ impl Driver {
             signals: SignalState::default(),
             calibration: None,
             oil_scale: None,
+            viscosity_correction: None,
         }
     }
 
@@ -417,16 +422,19 @@ impl Driver {
             Ok(s) => s,
             Err(why) => return Fed::Refused(why),
         };
-        self.oil_scale = Some(scale);
+        // a calibrated viscosity in force is a factor on the law: it follows the temperature
+        let law_scale = scale;
+        let scale = match self.viscosity_correction {
+            Some(k) => match crate::film::check_viscosity_scale(scale * k) {
+                Ok(s) => s,
+                Err(e) => {
+                    return Fed::Refused(format!("oil temperature with the calibration: {e}"))
+                }
+            },
+            None => scale,
+        };
+        self.oil_scale = Some(law_scale);
         self.oil_temperature_k = Some(t_k);
-        if self
-            .calibration
-            .as_ref()
-            .is_some_and(|c| c.viscosity_scale.is_some())
-        {
-            // a calibrated viscosity is in force; this one comes back with revert_calibration
-            return Fed::Taken;
-        }
         if let Err(e) = self.rotor.set_viscosity_scale(scale) {
             return Fed::Refused(format!("oil temperature: {e}"));
         }

@@ -19,6 +19,7 @@ mod equilibrium;
 mod error;
 mod finite;
 mod geometry;
+mod heating;
 mod inertia;
 mod short;
 mod table;
@@ -32,6 +33,7 @@ pub use equilibrium::{
 pub use error::FilmError;
 pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
+pub use heating::{effective_temperature, EffectiveTemperature, OilHeating};
 pub use inertia::{FilmInertia, FluidInertia};
 pub use short::ShortFilm;
 pub use table::{

@@ -11,6 +11,7 @@ mod forces;
 mod machine;
 mod modal;
 pub mod mode_tracking;
+mod oil_heating;
 mod statics;
 mod unbalance_response;
 
@@ -19,9 +20,10 @@ pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
 pub use machine::{
     AlarmLevelsSpec, BearingModelSpec, BearingSpec, DiscSpec, FilmSpec, GroovesSpec, LubricantSpec,
-    MachineDescription, MachineDescriptionOf, MaterialSpec, ProbeSpec, ProximityProbeSpec,
-    RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec, UnbalanceSpec, ViscosityTemperatureSpec,
-    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML,
+    MachineDescription, MachineDescriptionOf, MaterialSpec, OilHeatingModel, OilHeatingSpec,
+    ProbeSpec, ProximityProbeSpec, RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec,
+    UnbalanceSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER, DEFAULT_MACHINE_NAME,
+    DEFAULT_MACHINE_YAML,
 };
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
@@ -30,6 +32,7 @@ pub use modal::{
     CampbellPoint, Constraint, CriticalSpeed, Mode, ModeShape, NaturalFrequencies, Threshold,
     WhirlDirection,
 };
+pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};
 pub use unbalance_response::{
     influence_coefficients, required_separation_margin_pct, response_peaks, response_stations,
@@ -66,6 +69,11 @@ pub struct FilmBearing {
     pub short: bool,
     /// The oil's viscosity–temperature law, if the machine file gives one.
     pub viscosity_law: Option<crate::film::WaltherLaw>,
+    /// The law's design supply temperature (K), with the law.
+    pub design_supply_temperature_k: Option<f64>,
+    /// The bearing's own heating by an effective temperature (`oil_heating` in the machine
+    /// file), if asked for: see [`Rotor::heat_films`].
+    pub heating: Option<crate::film::OilHeating>,
     /// The running oil's viscosity over `lubricant.viscosity_pa_s` (1: the machine file's).
     /// The films are solved (and tabulated) at `lubricant` and scaled: exact for the isoviscous
     /// film without supply pressure ([`crate::film::ViscosityScaledFilm`]).
@@ -206,6 +214,8 @@ pub struct Unbalance {
     pub magnitude_kg_m: f64,
     /// Angle of the heavy spot at rotor angle 0, from +x towards +y (rad).
     pub phase_rad: f64,
+    /// Radius of a balancing correction mass in this plane (m), if the machine file gives one.
+    pub correction_radius_m: Option<f64>,
 }
 
 /// A probe station: two probes at a node.
@@ -272,6 +282,7 @@ impl Rotor {
                     node: u.node,
                     magnitude_kg_m: u.magnitude_g_mm * 1e-6,
                     phase_rad: u.phase_deg.to_radians(),
+                    correction_radius_m: u.correction_radius_m,
                 })
                 .collect(),
             probes: desc
@@ -451,6 +462,8 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 grid: f.grid,
                 short: matches!(b.model, BearingModelSpec::Short(_)),
                 viscosity_law: f.viscosity_law,
+                design_supply_temperature_k: f.design_supply_temperature_k,
+                heating: f.heating,
                 viscosity_scale: 1.0,
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
             })

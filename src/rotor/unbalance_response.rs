@@ -151,6 +151,7 @@ pub fn influence_coefficients(
             node: u.node,
             magnitude_kg_m: 1.0,
             phase_rad: 0.0,
+            correction_radius_m: None,
         }];
         let q = harmonic_solution_for(rotor, omega, &coefs, &unit)?;
         let per_station = rotor

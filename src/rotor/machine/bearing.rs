@@ -124,6 +124,10 @@ pub struct FilmSpec {
     /// The oil's viscosity–temperature law, when the file gives one (checked against
     /// `lubricant` at the design supply temperature).
     pub viscosity_law: Option<WaltherLaw>,
+    /// The law's design supply temperature (K), with the law.
+    pub design_supply_temperature_k: Option<f64>,
+    /// The bearing's own heating by an effective temperature, if the file asks for it.
+    pub heating: Option<crate::film::OilHeating>,
     /// Finite-volume grid over the half bearing.
     pub grid: FilmGrid,
     /// Whether the film carries its fluid inertia (added mass).
@@ -269,10 +273,19 @@ impl RawBearingSpec {
             None => FilmGrid::default(),
         };
         let (lubricant, viscosity_law) = self.oil(i, rules)?;
+        let spec = self.lubricant.as_ref();
+        let heating = match spec.and_then(|l| l.oil_heating.map(|h| (l, h))) {
+            Some((l, h)) => Some(h.checked(l, &format!("bearings[{i}].lubricant"), rules)?),
+            None => None,
+        };
         Ok(FilmSpec {
             geometry,
             lubricant,
             viscosity_law,
+            design_supply_temperature_k: spec
+                .and_then(|l| l.viscosity_temperature)
+                .map(|v| v.design_supply_temperature_c + crate::film::ZERO_CELSIUS_K),
+            heating,
             grid,
             fluid_inertia: self.fluid_inertia,
         })

@@ -196,6 +196,16 @@ impl MachineDescription {
                 ));
             }
             rules.finite(field("phase_deg"), u.phase_deg)?;
+            if let Some(r) = u.correction_radius_m {
+                rules.positive(field("correction_radius_m"), r)?;
+                if r > 10.0 {
+                    return Err(rules.error(
+                        field("correction_radius_m"),
+                        r,
+                        "is absurd (more than 10 m): the radius is in metres",
+                    ));
+                }
+            }
         }
         Ok(())
     }

@@ -18,7 +18,9 @@ mod rules;
 pub use bearing::{
     BearingModelSpec, BearingSpec, FilmSpec, GroovesSpec, RawBearingSpec, SupportSpec,
 };
-pub use oil::{LubricantSpec, ViscosityTemperatureSpec};
+pub use oil::{
+    LubricantSpec, OilHeatingModel, OilHeatingSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER,
+};
 pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 
 use super::error::ConfigError;
@@ -162,6 +164,10 @@ pub struct UnbalanceSpec {
     /// Angle of the heavy spot at t = 0, from `+x` towards `+y` (deg).
     #[serde(default)]
     pub phase_deg: f64,
+    /// Radius at which a balancing correction mass is placed in this plane (m); the
+    /// calibration's default, 100 mm, when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correction_radius_m: Option<f64>,
 }
 
 impl MachineDescription {

@@ -23,6 +23,69 @@ pub struct LubricantSpec {
     /// viscosity of the running twin's films.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub viscosity_temperature: Option<ViscosityTemperatureSpec>,
+    /// Optional: the bearing's own heating by an effective temperature (`crate::film::OilHeating`;
+    /// needs `viscosity_temperature`). Absent: the film runs at the supply temperature.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oil_heating: Option<OilHeatingSpec>,
+}
+
+/// How the film's own heating is modelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OilHeatingModel {
+    /// Raimondi–Boyd's adiabatic effective temperature (`crate::film::effective_temperature`).
+    EffectiveTemperature,
+}
+
+/// `oil_heating: {model: effective_temperature, specific_heat_j_per_kg_k: …, carry_over: …}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OilHeatingSpec {
+    /// The model (one so far).
+    pub model: OilHeatingModel,
+    /// Specific heat capacity c_p of the oil (J/(kg·K)).
+    pub specific_heat_j_per_kg_k: f64,
+    /// Hot-oil carry-over factor k: T_eff = T_supply + k ΔT (0.5 when absent: the mean film
+    /// temperature of Raimondi–Boyd and Shigley).
+    #[serde(default = "default_carry_over")]
+    pub carry_over: f64,
+}
+
+/// k of T_eff = T_supply + k ΔT when the machine file gives none.
+pub const DEFAULT_CARRY_OVER: f64 = 0.5;
+
+fn default_carry_over() -> f64 {
+    DEFAULT_CARRY_OVER
+}
+
+impl OilHeatingSpec {
+    /// The checked option of lubricant `lub` written at `prefix` (it needs a viscosity law).
+    pub(super) fn checked(
+        &self,
+        lub: &LubricantSpec,
+        prefix: &str,
+        rules: &Rules,
+    ) -> Result<crate::film::OilHeating, ConfigError> {
+        if lub.viscosity_temperature.is_none() {
+            return Err(rules.error(
+                format!("{prefix}.oil_heating"),
+                "(given)",
+                "needs lubricant.viscosity_temperature: the effective temperature acts through the viscosity law",
+            ));
+        }
+        crate::film::OilHeating::new(self.specific_heat_j_per_kg_k, self.carry_over).map_err(
+            |rule| {
+                rules.error(
+                    format!("{prefix}.oil_heating"),
+                    format!(
+                        "c_p {} J/(kg·K), carry_over {}",
+                        self.specific_heat_j_per_kg_k, self.carry_over
+                    ),
+                    rule,
+                )
+            },
+        )
+    }
 }
 
 /// Walther's viscosity–temperature law (ASTM D341-09) through two kinematic viscosities, with
