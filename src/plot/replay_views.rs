@@ -132,7 +132,11 @@ pub fn one_x_bode_svg(
     let mut entries: Vec<Entry> = series
         .iter()
         .map(|(m, _, c, l)| {
-            let s = if *m { Swatch::Dot(*c) } else { Swatch::Ring(*c) };
+            let s = if *m {
+                Swatch::Dot(*c)
+            } else {
+                Swatch::Ring(*c)
+            };
             Entry::new(s, l.clone())
         })
         .collect();
@@ -224,10 +228,7 @@ pub fn one_x_polar_svg(
                 colour.mix(0.5),
             ))?;
         }
-        chart.draw_series(
-            pts.iter()
-                .map(|p| marker((p.0, p.1), *colour, *measured)),
-        )?;
+        chart.draw_series(pts.iter().map(|p| marker((p.0, p.1), *colour, *measured)))?;
         if *measured {
             chart.draw_series(pts.iter().step_by(every).map(|p| {
                 Text::new(
@@ -244,7 +245,11 @@ pub fn one_x_polar_svg(
     let mut entries: Vec<Entry> = series
         .iter()
         .map(|(m, _, c, l)| {
-            let s = if *m { Swatch::Dot(*c) } else { Swatch::Ring(*c) };
+            let s = if *m {
+                Swatch::Dot(*c)
+            } else {
+                Swatch::Ring(*c)
+            };
             Entry::new(s, l.clone())
         })
         .collect();
@@ -281,7 +286,12 @@ pub fn full_spectrum_cascade_svg(
     let n = picked.len().max(1) as f64;
     let peak = picked
         .iter()
-        .flat_map(|b| b.measured_full_m.iter().chain(&b.predicted_full_m).flatten())
+        .flat_map(|b| {
+            b.measured_full_m
+                .iter()
+                .chain(&b.predicted_full_m)
+                .flatten()
+        })
         .fold(1e-12_f64, |a, &v| a.max(v));
     let scale = 3.0 / peak;
     let labels: Vec<f64> = picked.iter().map(|b| b.speed_rpm).collect();
@@ -324,11 +334,17 @@ pub fn full_spectrum_cascade_svg(
             let y = k as f64;
             let pts = (0..2 * BLOCK_REVS)
                 .rev()
-                .map(|i| (-((i + 1) as f64) / BLOCK_REVS as f64, y + scale * full[1][i]))
+                .map(|i| {
+                    (
+                        -((i + 1) as f64) / BLOCK_REVS as f64,
+                        y + scale * full[1][i],
+                    )
+                })
                 .chain(std::iter::once((0.0, y)))
-                .chain((0..2 * BLOCK_REVS).map(|i| {
-                    ((i + 1) as f64 / BLOCK_REVS as f64, y + scale * full[0][i])
-                }));
+                .chain(
+                    (0..2 * BLOCK_REVS)
+                        .map(|i| ((i + 1) as f64 / BLOCK_REVS as f64, y + scale * full[0][i])),
+                );
             chart.draw_series(LineSeries::new(pts, colour))?;
         }
     }
@@ -428,12 +444,21 @@ pub fn replay_centerline_svg(
     ))?;
     // the ends of the locus labelled with their speeds (a short locus would crowd more)
     let ends = [static_locus.first(), static_locus.last()];
-    let ends = if static_locus.len() > 1 { &ends[..] } else { &ends[..1] };
-    chart.draw_series(ends.iter().flatten().zip([(8, -14), (8, 6)]).map(|((s, p), at)| {
-        EmptyElement::at(um(*p))
-            + Circle::new((0, 0), 3, BLACK.filled())
-            + Text::new(format!("{s:.0} rpm"), at, ("sans-serif", 12).into_font())
-    }))?;
+    let ends = if static_locus.len() > 1 {
+        &ends[..]
+    } else {
+        &ends[..1]
+    };
+    chart.draw_series(
+        ends.iter()
+            .flatten()
+            .zip([(8, -14), (8, 6)])
+            .map(|((s, p), at)| {
+                EmptyElement::at(um(*p))
+                    + Circle::new((0, 0), 3, BLACK.filled())
+                    + Text::new(format!("{s:.0} rpm"), at, ("sans-serif", 12).into_font())
+            }),
+    )?;
     entries.push(Entry::new(
         Swatch::Line(BLACK, 2),
         "static equilibrium, predicted",
@@ -444,14 +469,20 @@ pub fn replay_centerline_svg(
                 .iter()
                 .map(|b| marker(um(b.measured.mean_m), MEASURED, true)),
         )?;
-        entries.push(Entry::new(Swatch::Dot(MEASURED), "measured mean, per block"));
+        entries.push(Entry::new(
+            Swatch::Dot(MEASURED),
+            "measured mean, per block",
+        ));
     }
     chart.draw_series(
         blocks
             .iter()
             .map(|b| marker(um(b.predicted.mean_m), PREDICTED, false)),
     )?;
-    entries.push(Entry::new(Swatch::Ring(PREDICTED), "twin's mean, per block"));
+    entries.push(Entry::new(
+        Swatch::Ring(PREDICTED),
+        "twin's mean, per block",
+    ));
     entries.push(Entry::new(
         Swatch::Text,
         format!("one point per {BLOCK_REVS} revolutions"),
@@ -518,7 +549,11 @@ pub fn orbit_probe_frame_svg(
     let halves = panels.split_evenly((1, 2));
     let deg = axes_rad.map(f64::to_degrees);
     let descs = [
-        ("machine frame".to_string(), "x (µm)".to_string(), "y (µm)".to_string()),
+        (
+            "machine frame".to_string(),
+            "x (µm)".to_string(),
+            "y (µm)".to_string(),
+        ),
         (
             "probe frame".to_string(),
             format!("probe 1 at {:.0}° (µm)", deg[0]),
@@ -597,5 +632,39 @@ pub(crate) fn keyphasor_legend(samples: &[Sample]) -> Vec<Entry> {
             v.push(Entry::new(Swatch::Text, line));
             v
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A forward 1X circle of 3 µm lagging the keyphasor by 40°, sampled 37 times a revolution
+    /// (no sample at a revolution's start): the dots are where ψ passes 2πk, interpolated along
+    /// the chord, at (3 cos 40°, −3 sin 40°) µm within the chord's sagitta (r(1 − cos(π/37)),
+    /// 0.36 %); one a revolution. An unlocked sample leaves no dots.
+    #[test]
+    fn keyphasor_dots_sit_at_shaft_angle_zero() {
+        let (r, lag) = (3e-6, 40f64.to_radians());
+        let mut samples: Vec<Sample> = (0..5 * 37)
+            .map(|i| {
+                let psi = TAU * (i as f64 + 0.3) / 37.0;
+                Sample {
+                    angle_rad: psi,
+                    measured_m: [r * (psi - lag).cos(), r * (psi - lag).sin()],
+                    phase_reference: PhaseReference::Locked,
+                    ..Sample::default()
+                }
+            })
+            .collect();
+        let dots = keyphasor_dots(&samples, |s| s.measured_m).unwrap();
+        assert_eq!(dots.len(), 4);
+        let tol = r * (1.0 - (std::f64::consts::PI / 37.0).cos()) * 1.01;
+        for d in &dots {
+            assert!((d[0] - r * lag.cos()).abs() < tol, "{d:?}");
+            assert!((d[1] + r * lag.sin()).abs() < tol, "{d:?}");
+        }
+        samples[3].phase_reference = PhaseReference::NotLocked;
+        assert!(keyphasor_dots(&samples, |s| s.measured_m).is_none());
     }
 }

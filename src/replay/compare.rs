@@ -615,6 +615,74 @@ mod tests {
         assert!((t_on - steady.blocks[0].end_s).abs() < 1e-9);
     }
 
+    /// The full spectrum of x + iy (issue 16), known signals through the blocks: a forward
+    /// circle of 2 µm puts all of it in +1X; a backward one in −1X; a line (a degenerate
+    /// ellipse) x = 2 µm cos ψ splits equally, 1 µm each way; a forward 0.5X whirl shows at
+    /// +0.5X (bin 4 of the 1/8 orders). Exact orders over whole revolutions under the Hann
+    /// window: the bin to 1e-3 of the radius, its two neighbours half of it (the Hann window's
+    /// main lobe), every other bin below 1e-3 of the radius.
+    #[test]
+    fn the_full_spectrum_separates_forward_and_reverse_whirl() {
+        type Orbit = fn(f64) -> [f64; 2];
+        let r = 2e-6;
+        let cases: [(&str, Orbit, usize, [f64; 2]); 4] = [
+            (
+                "forward 1X",
+                |p| [2e-6 * p.cos(), 2e-6 * p.sin()],
+                7,
+                [r, 0.0],
+            ),
+            (
+                "backward 1X",
+                |p| [2e-6 * p.cos(), -2e-6 * p.sin()],
+                7,
+                [0.0, r],
+            ),
+            ("line", |p| [2e-6 * p.cos(), 0.0], 7, [r / 2.0, r / 2.0]),
+            (
+                "forward 0.5X",
+                |p| [2e-6 * (0.5 * p).cos(), 2e-6 * (0.5 * p).sin()],
+                3,
+                [r, 0.0],
+            ),
+        ];
+        for (name, orbit, bin, [fwd, bwd]) in cases {
+            let mut c = StationComparison::new("s", 40e-6);
+            for i in 0..=3 * BLOCK_REVS * 64 {
+                let psi = TAU * i as f64 / 64.0;
+                c.push(Sample {
+                    time_s: psi / (TAU * 150.0),
+                    angle_rad: psi,
+                    speed_rad_s: TAU * 150.0,
+                    measured_m: orbit(psi),
+                    predicted_m: orbit(psi),
+                    phase_reference: PhaseReference::Locked,
+                });
+            }
+            assert_eq!(c.block_spectra.len(), 3, "{name}");
+            for b in &c.block_spectra {
+                let full = b.measured_full_m;
+                assert!((full[0][bin] - fwd).abs() < 1e-3 * r, "{name}: {full:?}");
+                assert!((full[1][bin] - bwd).abs() < 1e-3 * r, "{name}: {full:?}");
+                for k in (0..2 * BLOCK_REVS).filter(|&k| k != bin) {
+                    // the Hann window's neighbouring bins hold half the component
+                    let share = if k + 1 == bin || k == bin + 1 {
+                        0.5
+                    } else {
+                        0.0
+                    };
+                    for (w, v) in [(0, fwd), (1, bwd)] {
+                        let e = (full[w][k] - share * v).abs();
+                        assert!(e < 1e-3 * r, "{name}: bin {k}: {full:?}");
+                    }
+                }
+                assert_eq!(b.predicted_full_m, full);
+                // the semi-major axis is forward + backward
+                assert!((b.measured_m[bin] - fwd - bwd).abs() < 1e-3 * r);
+            }
+        }
+    }
+
     #[test]
     fn phase_differences_wrap() {
         assert_eq!(phase_difference_deg(170.0, -170.0), -20.0);

@@ -2,7 +2,8 @@
 //! station, and when the instability set in. Serialized as the `--json` report.
 
 use super::compare::{
-    phase_difference_deg, BlockSpectra, StationComparison, TransientSpan, WindowComparison, ONSET_BLOCKS,
+    phase_difference_deg, BlockSpectra, StationComparison, TransientSpan, WindowComparison,
+    ONSET_BLOCKS,
 };
 use crate::bag::Bag;
 use crate::session::{Outgoing, Session};
@@ -412,10 +413,7 @@ impl ReplayReport {
     /// (films at their equilibrium under the static loads, the shaft statically deflected, as
     /// the twin starts) at 12 speeds over the range of its blocks (one speed for a constant
     /// one). Returns the loci per station of `self.stations`.
-    pub fn add_static_centerline(
-        &mut self,
-        rotor: &crate::rotor::Rotor,
-    ) -> anyhow::Result<()> {
+    pub fn add_static_centerline(&mut self, rotor: &crate::rotor::Rotor) -> anyhow::Result<()> {
         for st in &mut self.stations {
             let Some(k) = rotor.probes.iter().position(|p| p.name == st.station) else {
                 continue;
