@@ -213,8 +213,8 @@ fn check_views(out: &Path, station: &str, locked: bool) {
     frame.assert_texts(&[
         "machine frame",
         "probe frame",
-        "probe 1 at 45° (µm)",
-        "probe 2 at 135° (µm)",
+        "probe 1 at 45°, about its mean (µm)",
+        "probe 2 at 135°, about its mean (µm)",
         "legend",
     ]);
     frame.assert_legend_right_of_data();

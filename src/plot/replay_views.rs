@@ -331,28 +331,29 @@ pub fn full_spectrum_cascade_svg(
             } else {
                 &b.predicted_full_m
             };
-            let y = k as f64;
-            let pts = (0..2 * BLOCK_REVS)
-                .rev()
-                .map(|i| {
-                    (
-                        -((i + 1) as f64) / BLOCK_REVS as f64,
-                        y + scale * full[1][i],
-                    )
-                })
-                .chain(std::iter::once((0.0, y)))
-                .chain(
-                    (0..2 * BLOCK_REVS)
-                        .map(|i| ((i + 1) as f64 / BLOCK_REVS as f64, y + scale * full[0][i])),
-                );
-            chart.draw_series(LineSeries::new(pts, colour))?;
+            chart.draw_series(LineSeries::new(full_trace(full, k as f64, scale), colour))?;
         }
     }
     root.present()?;
     Ok(())
 }
 
-/// Dashed-looking guides at ±1X and ±0.5X, labelled.
+/// One cascade trace at height `y`: reverse orders −2 … −1/8 (the backward radii), 0, then
+/// forward orders 1/8 … 2, each radius (m) times `scale` above `y`.
+fn full_trace(
+    full: &[[f64; 2 * BLOCK_REVS]; 2],
+    y: f64,
+    scale: f64,
+) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let order = |i: usize| (i + 1) as f64 / BLOCK_REVS as f64;
+    (0..2 * BLOCK_REVS)
+        .rev()
+        .map(move |i| (-order(i), y + scale * full[1][i]))
+        .chain(std::iter::once((0.0, y)))
+        .chain((0..2 * BLOCK_REVS).map(move |i| (order(i), y + scale * full[0][i])))
+}
+
+/// Grey guides at ±1X and ±0.5X, labelled below the first trace.
 fn draw_order_lines(chart: &mut Chart<'_, '_>, n: f64) -> anyhow::Result<()> {
     for (o, l) in [(1.0, "+1X"), (-1.0, "−1X"), (0.5, "+½X"), (-0.5, "−½X")] {
         chart.draw_series(LineSeries::new(
@@ -438,27 +439,7 @@ pub fn replay_centerline_svg(
         format!("bearing clearance ({c:.0} µm)"),
     )];
     let um = |p: [f64; 2]| (p[0] * 1e6, p[1] * 1e6);
-    chart.draw_series(LineSeries::new(
-        static_locus.iter().map(|(_, p)| um(*p)),
-        BLACK.stroke_width(2),
-    ))?;
-    // the ends of the locus labelled with their speeds (a short locus would crowd more)
-    let ends = [static_locus.first(), static_locus.last()];
-    let ends = if static_locus.len() > 1 {
-        &ends[..]
-    } else {
-        &ends[..1]
-    };
-    chart.draw_series(
-        ends.iter()
-            .flatten()
-            .zip([(8, -14), (8, 6)])
-            .map(|((s, p), at)| {
-                EmptyElement::at(um(*p))
-                    + Circle::new((0, 0), 3, BLACK.filled())
-                    + Text::new(format!("{s:.0} rpm"), at, ("sans-serif", 12).into_font())
-            }),
-    )?;
+    draw_static_locus(&mut chart, static_locus)?;
     entries.push(Entry::new(
         Swatch::Line(BLACK, 2),
         "static equilibrium, predicted",
@@ -489,12 +470,46 @@ pub fn replay_centerline_svg(
     ));
     if let Some(why) = mean_not_measured {
         entries.push(Entry::new(Swatch::Text, "no measured centerline:"));
-        for l in why.split(": ") {
-            entries.push(Entry::new(Swatch::Text, l));
-        }
+        entries.extend(wrapped(why, 36));
     }
     draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
+    Ok(())
+}
+
+/// The static-equilibrium locus (µm), its two ends labelled with their speeds, each label on
+/// its own side (a short locus would crowd more labels).
+fn draw_static_locus(
+    chart: &mut Chart<'_, '_>,
+    static_locus: &[CenterlinePoint],
+) -> anyhow::Result<()> {
+    let um = |p: [f64; 2]| (p[0] * 1e6, p[1] * 1e6);
+    chart.draw_series(LineSeries::new(
+        static_locus.iter().map(|(_, p)| um(*p)),
+        BLACK.stroke_width(2),
+    ))?;
+    // the ends of the locus labelled with their speeds (a short locus would crowd more)
+    let ends = [static_locus.first(), static_locus.last()];
+    let ends = if static_locus.len() > 1 {
+        &ends[..]
+    } else {
+        &ends[..1]
+    };
+    // each end's label on its own side (pixels grow downwards)
+    let first_lower = match (static_locus.first(), static_locus.last()) {
+        (Some(a), Some(b)) => a.1[1] <= b.1[1],
+        _ => true,
+    };
+    let offsets = if first_lower {
+        [(8, 6), (8, -14)]
+    } else {
+        [(8, -14), (8, 6)]
+    };
+    chart.draw_series(ends.iter().flatten().zip(offsets).map(|((s, p), at)| {
+        EmptyElement::at(um(*p))
+            + Circle::new((0, 0), 3, BLACK.filled())
+            + Text::new(format!("{s:.0} rpm"), at, ("sans-serif", 12).into_font())
+    }))?;
     Ok(())
 }
 
@@ -528,7 +543,8 @@ pub fn keyphasor_dots(samples: &[Sample], pick: fn(&Sample) -> [f64; 2]) -> Opti
 /// The orbit in the probes' own frame beside the machine frame (µm, each 1:1): left, x and y of
 /// the machine with the two probes drawn at their angles; right, the readings along probe 1
 /// (horizontal) and probe 2 (vertical), d_j = x cos α_j + y sin α_j. Measured and predicted,
-/// last revolutions, with a keyphasor dot per revolution.
+/// last revolutions, each about its own mean (the motion, as an orbit display shows it), with a
+/// keyphasor dot per revolution.
 pub fn orbit_probe_frame_svg(
     path: &Path,
     title: &str,
@@ -536,10 +552,26 @@ pub fn orbit_probe_frame_svg(
     axes_rad: [f64; 2],
 ) -> anyhow::Result<()> {
     let to_probe = |p: [f64; 2]| axes_rad.map(|a| p[0] * a.cos() + p[1] * a.sin());
+    type Pick = fn(&Sample) -> [f64; 2];
+    let series: [(Pick, RGBColor); 2] =
+        [(|s| s.measured_m, MEASURED), (|s| s.predicted_m, PREDICTED)];
+    // each orbit about its own mean, as an orbit display shows the motion
+    let n = samples.len().max(1) as f64;
+    let means = series.map(|(pick, _)| {
+        let sum = samples.iter().fold([0.0, 0.0], |a, s| {
+            let p = pick(s);
+            [a[0] + p[0], a[1] + p[1]]
+        });
+        [sum[0] / n, sum[1] / n]
+    });
     let extent = samples
         .iter()
-        .flat_map(|s| [s.measured_m, s.predicted_m])
-        .map(|p| p[0].hypot(p[1]))
+        .flat_map(|s| {
+            series
+                .iter()
+                .zip(&means)
+                .map(|((pick, _), m)| (pick(s)[0] - m[0]).hypot(pick(s)[1] - m[1]))
+        })
         .fold(1e-9, f64::max);
     let lim = 1.15 * extent * 1e6;
     let root = SVGBackend::new(path, (1300, 700)).into_drawing_area();
@@ -556,8 +588,8 @@ pub fn orbit_probe_frame_svg(
         ),
         (
             "probe frame".to_string(),
-            format!("probe 1 at {:.0}° (µm)", deg[0]),
-            format!("probe 2 at {:.0}° (µm)", deg[1]),
+            format!("probe 1 at {:.0}°, about its mean (µm)", deg[0]),
+            format!("probe 2 at {:.0}°, about its mean (µm)", deg[1]),
         ),
     ];
     for (k, (area, (caption, xd, yd))) in halves.iter().zip(descs).enumerate() {
@@ -584,18 +616,16 @@ pub fn orbit_probe_frame_svg(
                 )))?;
             }
         }
-        type Pick = fn(&Sample) -> [f64; 2];
-        let series: [(Pick, RGBColor); 2] =
-            [(|s| s.measured_m, MEASURED), (|s| s.predicted_m, PREDICTED)];
-        for (pick, colour) in series {
+        for ((pick, colour), m) in series.iter().zip(&means) {
+            let about = |p: [f64; 2]| frame([p[0] - m[0], p[1] - m[1]]);
             chart.draw_series(LineSeries::new(
-                samples.iter().map(|s| frame(pick(s))),
+                samples.iter().map(|s| about(pick(s))),
                 colour,
             ))?;
-            if let Some(dots) = keyphasor_dots(samples, pick) {
+            if let Some(dots) = keyphasor_dots(samples, *pick) {
                 chart.draw_series(
                     dots.iter()
-                        .map(|d| Circle::new(frame(*d), 4, colour.filled())),
+                        .map(|d| Circle::new(about(*d), 4, colour.filled())),
                 )?;
             }
         }
@@ -619,20 +649,27 @@ pub(crate) fn keyphasor_legend(samples: &[Sample]) -> Vec<Entry> {
         )],
         Some(why) => {
             let mut v = vec![Entry::new(Swatch::Text, "no keyphasor dots:")];
-            let mut line = String::new();
-            for word in why.split_whitespace() {
-                if line.len() + word.len() > 30 {
-                    v.push(Entry::new(Swatch::Text, std::mem::take(&mut line)));
-                }
-                if !line.is_empty() {
-                    line.push(' ');
-                }
-                line.push_str(word);
-            }
-            v.push(Entry::new(Swatch::Text, line));
+            v.extend(wrapped(why, 30));
             v
         }
     }
+}
+
+/// `text` as legend lines of at most about `width` characters.
+fn wrapped(text: &str, width: usize) -> Vec<Entry> {
+    let mut v = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        if !line.is_empty() && line.chars().count() + word.chars().count() > width {
+            v.push(Entry::new(Swatch::Text, std::mem::take(&mut line)));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    v.push(Entry::new(Swatch::Text, line));
+    v
 }
 
 #[cfg(test)]
