@@ -213,6 +213,7 @@ fn check_views(out: &Path, station: &str, locked: bool) {
     frame.assert_texts(&[
         "machine frame",
         "probe frame",
+        "x − mean (µm)",
         "probe 1 at 45°, about its mean (µm)",
         "probe 2 at 135°, about its mean (µm)",
         "legend",

@@ -583,8 +583,8 @@ pub fn orbit_probe_frame_svg(
     let descs = [
         (
             "machine frame".to_string(),
-            "x (µm)".to_string(),
-            "y (µm)".to_string(),
+            "x − mean (µm)".to_string(),
+            "y − mean (µm)".to_string(),
         ),
         (
             "probe frame".to_string(),
