@@ -649,7 +649,7 @@ pub(crate) fn keyphasor_legend(samples: &[Sample]) -> Vec<Entry> {
         )],
         Some(why) => {
             let mut v = vec![Entry::new(Swatch::Text, "no keyphasor dots:")];
-            v.extend(wrapped(why, 30));
+            v.extend(wrapped(why, 24));
             v
         }
     }
