@@ -281,7 +281,8 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     if args.calibrate {
         return run_calibrated(args, &bag, &rotor, &options, &out_dir);
     }
-    let (report, comparisons) = replay_with_progress(&bag, &rotor, &options)?;
+    let (mut report, comparisons) = replay_with_progress(&bag, &rotor, &options)?;
+    report.add_static_centerline(&rotor)?;
     // chunks that could not be read back during the replay (the file changed under it)
     for n in report.notes.iter().skip(bag.notes.len()) {
         eprintln!("warning: {}: {n}", args.bag.display());
@@ -289,7 +290,19 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     let json = serde_json::to_string_pretty(&report)?;
     std::fs::write(out_dir.join("report.json"), &json)?;
     for c in comparisons.iter().filter(|c| c.samples > 0) {
+        let locus: Vec<crate::plot::CenterlinePoint> = report
+            .stations
+            .iter()
+            .find(|s| s.station == c.station)
+            .map(|s| {
+                s.centerline_static_predicted
+                    .iter()
+                    .map(|p| (p.speed_rpm, p.position_m))
+                    .collect()
+            })
+            .unwrap_or_default();
         write_station_plots(&out_dir, c)?;
+        write_station_views(&out_dir, c, &locus)?;
     }
     if let Some(why) = never_started(&report, &options) {
         anyhow::bail!(
@@ -450,6 +463,49 @@ fn write_station_plots(
     )
 }
 
+/// One probe station's engineering views from the measured data (issue 16): the 1X Bode and
+/// polar plots per probe axis, the shaft centerline with the static-equilibrium `locus`, the
+/// full-spectrum cascade and the orbit in the probes' frame.
+fn write_station_views(
+    out_dir: &Path,
+    c: &crate::replay::compare::StationComparison,
+    locus: &[crate::plot::CenterlinePoint],
+) -> anyhow::Result<()> {
+    let name = &c.station;
+    let axes_deg = c.axes_rad().map(f64::to_degrees);
+    crate::plot::one_x_bode_svg(
+        &out_dir.join(format!("bode_{name}.svg")),
+        &format!("{name}: 1X Bode plot, measured and predicted (blocks of 8 revolutions)"),
+        &c.blocks,
+        axes_deg,
+    )?;
+    crate::plot::one_x_polar_svg(
+        &out_dir.join(format!("polar_{name}.svg")),
+        &format!("{name}: 1X polar plot, measured and predicted"),
+        &c.blocks,
+        axes_deg,
+    )?;
+    crate::plot::replay_centerline_svg(
+        &out_dir.join(format!("centerline_{name}.svg")),
+        &format!("{name}: shaft centerline (mean position), measured and predicted"),
+        &c.blocks,
+        locus,
+        c.clearance_m(),
+        c.mean_not_measured.as_deref(),
+    )?;
+    crate::plot::full_spectrum_cascade_svg(
+        &out_dir.join(format!("full_spectrum_{name}.svg")),
+        &format!("{name}: full-spectrum cascade of x + iy (blocks of 8 revolutions)"),
+        &c.block_spectra,
+    )?;
+    crate::plot::orbit_probe_frame_svg(
+        &out_dir.join(format!("orbit_probe_frame_{name}.svg")),
+        &format!("{name}: orbit in the machine frame and in the probes' frame, last 4 revolutions"),
+        &c.recent_samples(4),
+        c.axes_rad(),
+    )
+}
+
 /// Refuses an output directory that is the input bag, lies inside it or holds it: the replay
 /// writes into `out` and replaces `out/bag`, and must never write into or over its input.
 fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
@@ -471,7 +527,16 @@ fn refuse_overlap(bag: &Path, out: &Path) -> anyhow::Result<()> {
 /// The files a replay writes beside `bag/`: its report, `--calibrate`'s calibration and the
 /// plots of each probe station.
 const OUTPUT_FILES: [&str; 2] = ["report.json", "calibration.json"];
-const PLOT_PREFIXES: [&str; 4] = ["orbit_", "spectrum_", "waterfall_", "amplitude_speed_"];
+const PLOT_PREFIXES: [&str; 8] = [
+    "orbit_",
+    "spectrum_",
+    "waterfall_",
+    "amplitude_speed_",
+    "bode_",
+    "polar_",
+    "centerline_",
+    "full_spectrum_",
+];
 
 /// Creates `dir`, or clears a previous replay's output in it (its bag, report or calibration and
 /// plots, so that no file of an earlier run is left beside the new ones; a directory holding

@@ -12,6 +12,10 @@ pub(crate) enum Swatch {
     Dot(RGBColor),
     /// A hollow diamond marker.
     Diamond(RGBColor),
+    /// A hollow ring marker.
+    Ring(RGBColor),
+    /// No swatch: a line of text (a note under the entries).
+    Text,
 }
 
 /// One entry: swatch and text.
@@ -54,6 +58,8 @@ pub(crate) fn draw_side_legend<DB: DrawingBackend>(
                 ))?;
             }
             Swatch::Dot(c) => area.draw(&Circle::new((x0 + 12, yc), 4, c.filled()))?,
+            Swatch::Ring(c) => area.draw(&Circle::new((x0 + 12, yc), 4, c.stroke_width(1)))?,
+            Swatch::Text => {}
             Swatch::Diamond(c) => {
                 area.draw(&PathElement::new(
                     [

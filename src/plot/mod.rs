@@ -5,6 +5,7 @@ mod campbell;
 mod legend;
 mod mode_shapes;
 mod replay;
+mod replay_views;
 mod response;
 mod rotor;
 mod transient;
@@ -14,6 +15,10 @@ pub use campbell::campbell_svg;
 pub use mode_shapes::{mode_shapes_svg, ShapeNode, ShapePanel, ShapeStation};
 pub use replay::{
     amplitude_speed_svg, orbit_comparison_svg, spectrum_comparison_svg, waterfall_svg,
+};
+pub use replay_views::{
+    full_spectrum_cascade_svg, keyphasor_dots, one_x_bode_svg, one_x_polar_svg,
+    orbit_probe_frame_svg, replay_centerline_svg, CenterlinePoint,
 };
 pub use response::{bode_svg, polar_svg, ResponseCurve};
 pub use rotor::{rotor_svg, BearingGlyph, DiscGlyph, RotorDrawing, SectionGlyph};

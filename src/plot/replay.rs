@@ -61,8 +61,16 @@ pub fn orbit_comparison_svg(
             samples.iter().map(|s| (pick(s)[0] * 1e6, pick(s)[1] * 1e6)),
             color,
         ))?;
+        // one dot per revolution where the keyphasor fires (Bently/ADRE)
+        if let Some(dots) = super::keyphasor_dots(samples, pick) {
+            chart.draw_series(
+                dots.iter()
+                    .map(|d| Circle::new((d[0] * 1e6, d[1] * 1e6), 4, color.filled())),
+            )?;
+        }
         entries.push(Entry::new(Swatch::Line(color, 1), label));
     }
+    entries.extend(super::replay_views::keyphasor_legend(samples));
     draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())

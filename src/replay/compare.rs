@@ -69,6 +69,9 @@ pub struct OrbitFeatures {
     /// The 1X vector along each probe axis of the station (the machine file's angles), its
     /// phase lag from the keyphasor (API 670); null without a keyphasor lock over the window.
     pub one_x_probe_axes: Option<[OneXVector; 2]>,
+    /// The 1X amplitude along each probe axis (m), given with or without a keyphasor (the
+    /// amplitude needs no phase reference).
+    pub one_x_probe_amplitudes_m: [f64; 2],
     /// Largest sub-synchronous semi-major axis (m), orders 2/R … (R−3)/R, corrected between
     /// bins ([`subsynchronous_peak`], the monitor's detector).
     pub subsync_amplitude_m: f64,
@@ -103,7 +106,7 @@ pub struct WindowComparison {
 }
 
 /// The order spectra of one block of [`BLOCK_REVS`] revolutions.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BlockSpectra {
     /// Mean speed (rpm).
     pub speed_rpm: f64,
@@ -113,6 +116,11 @@ pub struct BlockSpectra {
     pub measured_m: [f64; 2 * BLOCK_REVS],
     /// Predicted semi-major axes (m) at the same orders.
     pub predicted_m: [f64; 2 * BLOCK_REVS],
+    /// The full spectrum of the measured orbit x + iy: radii (m) of the forward (`[0]`) and
+    /// backward (`[1]`) circular components at orders k/8, k = 1 … 16.
+    pub measured_full_m: [[f64; 2 * BLOCK_REVS]; 2],
+    /// The same of the predicted orbit.
+    pub predicted_full_m: [[f64; 2 * BLOCK_REVS]; 2],
 }
 
 /// The streaming comparison at one station.
@@ -133,6 +141,9 @@ pub struct StationComparison {
     pub block_spectra: Vec<BlockSpectra>,
     /// Samples compared.
     pub samples: usize,
+    /// Why the measured mean position is not the plant's (None: it is, e.g. DC-coupled probes
+    /// or displacement pairs): an AC-coupled probe's mean is the twin's.
+    pub mean_not_measured: Option<String>,
 }
 
 impl StationComparison {
@@ -148,7 +159,13 @@ impl StationComparison {
             blocks: Vec::new(),
             block_spectra: Vec::new(),
             samples: 0,
+            mean_not_measured: None,
         }
+    }
+
+    /// The station's probe axes (rad from +x towards +y).
+    pub fn axes_rad(&self) -> [f64; 2] {
+        self.axes_rad
     }
 
     /// The station's probe axes (rad from +x towards +y), along which 1X phase lags are read
@@ -170,19 +187,7 @@ impl StationComparison {
             if s.angle_rad - first.angle_rad >= BLOCK_REVS as f64 * TAU || s.time_s < first.time_s {
                 let block = std::mem::take(&mut self.block);
                 if let Some(w) = self.compare(&block, BLOCK_REVS) {
-                    let semi = |spec: Vec<OrderComponent>| {
-                        let mut out = [0.0; 2 * BLOCK_REVS];
-                        for (o, c) in out.iter_mut().zip(spec) {
-                            *o = c.semi_major_m();
-                        }
-                        out
-                    };
-                    self.block_spectra.push(BlockSpectra {
-                        speed_rpm: w.speed_rpm,
-                        end_s: w.end_s,
-                        measured_m: semi(spectrum(&block, BLOCK_REVS, |s| s.measured_m)),
-                        predicted_m: semi(spectrum(&block, BLOCK_REVS, |s| s.predicted_m)),
-                    });
+                    self.block_spectra.push(block_spectra(&block, &w));
                     self.blocks.push(w);
                 }
             }
@@ -394,14 +399,41 @@ impl StationComparison {
             });
             one_x_vector(values, samples.len()).unwrap_or_default()
         };
+        let axes = [axis(self.axes_rad[0]), axis(self.axes_rad[1])];
         OrbitFeatures {
             one_x_amplitude_m: one_x.semi_major_m(),
             one_x_forward_phase_deg: one_x.forward_phase_rad.to_degrees(),
-            one_x_probe_axes: Some([axis(self.axes_rad[0]), axis(self.axes_rad[1])]),
+            one_x_probe_axes: Some(axes),
+            one_x_probe_amplitudes_m: axes.map(|v| v.amplitude_m),
             subsync_amplitude_m: abest,
             subsync_ratio: ratio,
             mean_m: mean,
         }
+    }
+}
+
+/// The order spectra of one block: semi-major axes and the full (forward and backward) spectra,
+/// measured and predicted.
+fn block_spectra(block: &[Sample], w: &WindowComparison) -> BlockSpectra {
+    let of = |pick: fn(&Sample) -> [f64; 2]| {
+        let spec = spectrum(block, BLOCK_REVS, pick);
+        let (mut semi, mut full) = ([0.0; 2 * BLOCK_REVS], [[0.0; 2 * BLOCK_REVS]; 2]);
+        for (k, c) in spec.iter().enumerate().take(2 * BLOCK_REVS) {
+            semi[k] = c.semi_major_m();
+            full[0][k] = c.forward_m;
+            full[1][k] = c.backward_m;
+        }
+        (semi, full)
+    };
+    let (measured_m, measured_full_m) = of(|s| s.measured_m);
+    let (predicted_m, predicted_full_m) = of(|s| s.predicted_m);
+    BlockSpectra {
+        speed_rpm: w.speed_rpm,
+        end_s: w.end_s,
+        measured_m,
+        predicted_m,
+        measured_full_m,
+        predicted_full_m,
     }
 }
 
@@ -581,6 +613,74 @@ mod tests {
         let steady = fed(60, |_| 3e-6);
         let (t_on, _) = steady.onset(false).expect("an onset");
         assert!((t_on - steady.blocks[0].end_s).abs() < 1e-9);
+    }
+
+    /// The full spectrum of x + iy (issue 16), known signals through the blocks: a forward
+    /// circle of 2 µm puts all of it in +1X; a backward one in −1X; a line (a degenerate
+    /// ellipse) x = 2 µm cos ψ splits equally, 1 µm each way; a forward 0.5X whirl shows at
+    /// +0.5X (bin 4 of the 1/8 orders). Exact orders over whole revolutions under the Hann
+    /// window: the bin to 1e-3 of the radius, its two neighbours half of it (the Hann window's
+    /// main lobe), every other bin below 1e-3 of the radius.
+    #[test]
+    fn the_full_spectrum_separates_forward_and_reverse_whirl() {
+        type Orbit = fn(f64) -> [f64; 2];
+        let r = 2e-6;
+        let cases: [(&str, Orbit, usize, [f64; 2]); 4] = [
+            (
+                "forward 1X",
+                |p| [2e-6 * p.cos(), 2e-6 * p.sin()],
+                7,
+                [r, 0.0],
+            ),
+            (
+                "backward 1X",
+                |p| [2e-6 * p.cos(), -2e-6 * p.sin()],
+                7,
+                [0.0, r],
+            ),
+            ("line", |p| [2e-6 * p.cos(), 0.0], 7, [r / 2.0, r / 2.0]),
+            (
+                "forward 0.5X",
+                |p| [2e-6 * (0.5 * p).cos(), 2e-6 * (0.5 * p).sin()],
+                3,
+                [r, 0.0],
+            ),
+        ];
+        for (name, orbit, bin, [fwd, bwd]) in cases {
+            let mut c = StationComparison::new("s", 40e-6);
+            for i in 0..=3 * BLOCK_REVS * 64 {
+                let psi = TAU * i as f64 / 64.0;
+                c.push(Sample {
+                    time_s: psi / (TAU * 150.0),
+                    angle_rad: psi,
+                    speed_rad_s: TAU * 150.0,
+                    measured_m: orbit(psi),
+                    predicted_m: orbit(psi),
+                    phase_reference: PhaseReference::Locked,
+                });
+            }
+            assert_eq!(c.block_spectra.len(), 3, "{name}");
+            for b in &c.block_spectra {
+                let full = b.measured_full_m;
+                assert!((full[0][bin] - fwd).abs() < 1e-3 * r, "{name}: {full:?}");
+                assert!((full[1][bin] - bwd).abs() < 1e-3 * r, "{name}: {full:?}");
+                for k in (0..2 * BLOCK_REVS).filter(|&k| k != bin) {
+                    // the Hann window's neighbouring bins hold half the component
+                    let share = if k + 1 == bin || k == bin + 1 {
+                        0.5
+                    } else {
+                        0.0
+                    };
+                    for (w, v) in [(0, fwd), (1, bwd)] {
+                        let e = (full[w][k] - share * v).abs();
+                        assert!(e < 1e-3 * r, "{name}: bin {k}: {full:?}");
+                    }
+                }
+                assert_eq!(b.predicted_full_m, full);
+                // the semi-major axis is forward + backward
+                assert!((b.measured_m[bin] - fwd - bwd).abs() < 1e-3 * r);
+            }
+        }
     }
 
     #[test]

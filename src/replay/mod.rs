@@ -12,7 +12,7 @@ mod report;
 
 pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
 
-pub use report::{OnsetReport, ReplayReport, StateChange, StationReport};
+pub use report::{CenterlineStatic, OnsetReport, ReplayReport, StateChange, StationReport};
 
 use crate::bag::{Bag, BagMessage};
 use crate::driver::{settings, Driver, DriverSettings, Fed, Input, SpeedUnit};
@@ -240,10 +240,25 @@ fn roles_and_comparisons(
             _ => None,
         })
         .fold(f64::INFINITY, f64::min);
+    let raw_read = roles
+        .iter()
+        .any(|r| matches!(r, Role::ProbeSignal | Role::ProbeValue(_)));
     let comparisons = stations
         .iter()
         .zip(&rotor.probes)
-        .map(|(s, p)| StationComparison::new(s, clearance).with_axes(p.angles_rad))
+        .enumerate()
+        .map(|(k, (s, p))| {
+            let mut c = StationComparison::new(s, clearance).with_axes(p.angles_rad);
+            let ac = rotor.proximity_probes.iter().any(|r| {
+                r.station == k && r.coupling == crate::signals::probes::ProbeCoupling::Ac
+            });
+            if raw_read && ac {
+                c.mean_not_measured = Some(
+                    "AC-coupled probes: the measured mean is the twin's, not the plant's (DC-coupled probes or displacement pairs keep it)".into(),
+                );
+            }
+            c
+        })
         .collect();
     Ok((roles, comparisons))
 }

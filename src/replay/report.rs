@@ -2,7 +2,8 @@
 //! station, and when the instability set in. Serialized as the `--json` report.
 
 use super::compare::{
-    phase_difference_deg, StationComparison, TransientSpan, WindowComparison, ONSET_BLOCKS,
+    phase_difference_deg, BlockSpectra, StationComparison, TransientSpan, WindowComparison,
+    ONSET_BLOCKS,
 };
 use crate::bag::Bag;
 use crate::session::{Outgoing, Session};
@@ -58,6 +59,26 @@ pub struct StationReport {
     pub mean_position_distance_m: Option<f64>,
     /// Blocks of 8 revolutions over the whole bag (amplitude against speed).
     pub blocks: Vec<WindowComparison>,
+    // --- views (issue 16) ---
+    /// Each block's order spectra at orders k/8, k = 1 … 16: semi-major axes (`measured_m`,
+    /// `predicted_m`) and the full spectrum of x + iy (`measured_full_m`, `predicted_full_m`:
+    /// `[forward radii, backward (reverse) radii]`, m), the cascade plot's numbers.
+    pub block_spectra: Vec<BlockSpectra>,
+    /// Why the blocks' measured `mean_m` is not the plant's mean position (null: it is, the
+    /// measured shaft centerline).
+    pub mean_position_null_reason: Option<String>,
+    /// The predicted static-equilibrium position of the station over the bag's speeds (the
+    /// centerline plot's locus; filled by `rotor-twin replay`, empty from the library call).
+    pub centerline_static_predicted: Vec<CenterlineStatic>,
+}
+
+/// The station's predicted static-equilibrium position at one speed.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct CenterlineStatic {
+    /// Speed (rpm).
+    pub speed_rpm: f64,
+    /// Position `[x, y]` (m), machine frame, relative to the bearing centres' line.
+    pub position_m: [f64; 2],
 }
 
 /// When the instability set in, predicted and observed (null where there is none).
@@ -378,5 +399,51 @@ fn station_report(c: &StationComparison) -> StationReport {
         orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
         mean_position_distance_m: get(|w| w.mean_position_distance_m),
         blocks: c.blocks.clone(),
+        block_spectra: c.block_spectra.clone(),
+        mean_position_null_reason: c.mean_not_measured.clone(),
+        centerline_static_predicted: Vec::new(),
+    }
+}
+
+/// Speeds of the static-equilibrium locus of the centerline plot over a bag's speed range.
+const CENTERLINE_SPEEDS: usize = 12;
+
+impl ReplayReport {
+    /// Fills each station's `centerline_static_predicted`: its static-equilibrium position
+    /// (films at their equilibrium under the static loads, the shaft statically deflected, as
+    /// the twin starts) at 12 speeds over the range of its blocks (one speed for a constant
+    /// one). Returns the loci per station of `self.stations`.
+    pub fn add_static_centerline(&mut self, rotor: &crate::rotor::Rotor) -> anyhow::Result<()> {
+        for st in &mut self.stations {
+            let Some(k) = rotor.probes.iter().position(|p| p.name == st.station) else {
+                continue;
+            };
+            let (lo, hi) = st
+                .blocks
+                .iter()
+                .map(|b| b.speed_rpm)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
+                    (a.0.min(v), a.1.max(v))
+                });
+            if !lo.is_finite() {
+                continue;
+            }
+            let n = if hi - lo > 1.0 { CENTERLINE_SPEEDS } else { 1 };
+            st.centerline_static_predicted = (0..n)
+                .map(|i| {
+                    let rpm = lo + (hi - lo) * i as f64 / (n.max(2) - 1) as f64;
+                    let p = crate::calibrate::static_probe_positions(
+                        rotor,
+                        1.0,
+                        crate::units::rpm_to_rad_s(rpm),
+                    )?;
+                    Ok(CenterlineStatic {
+                        speed_rpm: rpm,
+                        position_m: p[k],
+                    })
+                })
+                .collect::<anyhow::Result<_>>()?;
+        }
+        Ok(())
     }
 }
