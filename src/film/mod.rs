@@ -22,6 +22,7 @@ mod geometry;
 mod inertia;
 mod short;
 mod table;
+mod turbulence;
 mod viscosity;
 
 pub use coefficients::{matrix2, rows2, FilmCoefficients};
@@ -34,6 +35,7 @@ pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
 pub use inertia::{FilmInertia, FluidInertia};
 pub use short::ShortFilm;
+pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};
 pub use table::{
     disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,
     FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,

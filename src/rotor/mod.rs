@@ -72,6 +72,8 @@ pub struct FilmBearing {
     pub viscosity_scale: f64,
     /// The film's fluid inertia (added mass), if the bearing carries it.
     pub inertia: Option<crate::film::FilmInertia>,
+    /// Laminar, turbulent or auto (finite model; `src/film/turbulence.rs`).
+    pub flow: crate::film::FlowRegime,
 }
 
 // --- oil supply temperature (issue 12) ---
@@ -142,6 +144,17 @@ impl Rotor {
     /// Sets the viscosity scale (µ / µ_reference) of every film bearing (checked).
     pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), crate::film::FilmError> {
         let scale = crate::film::check_viscosity_scale(scale)?;
+        let turbulent = self.bearings.iter().any(|b| {
+            matches!(&b.model, BearingModel::Film(f) if f.flow != crate::film::FlowRegime::Laminar)
+        });
+        if turbulent && scale != 1.0 {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "viscosity scale (turbulent film)",
+                value: scale,
+                rule: "a viscosity change does not scale a turbulent film (Re = ρωRc/µ changes \
+                       with it); only 1 is accepted with flow: turbulent or auto",
+            });
+        }
         for b in &mut self.bearings {
             if let BearingModel::Film(f) = &mut b.model {
                 f.viscosity_scale = scale;
@@ -176,6 +189,13 @@ impl Rotor {
 impl FilmBearing {
     /// A film solver at the reference viscosity `lubricant` (unscaled).
     pub fn reference_solver(&self) -> Box<dyn FilmModel + Send> {
+        if !self.short {
+            return Box::new(
+                FiniteFilm::new(self.geometry.clone(), self.lubricant, self.grid)
+                    .expect("geometry checked when the machine was read")
+                    .with_flow(self.flow),
+            );
+        }
         if self.short {
             Box::new(
                 ShortFilm::new(self.geometry.clone(), self.lubricant)
@@ -201,6 +221,15 @@ impl FilmBearing {
     pub fn reference_tabulated_solver(
         &self,
     ) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        if self.flow != crate::film::FlowRegime::Laminar {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "flow (tabulated film)",
+                value: 0.0,
+                rule: "the table is laminar: a turbulent film is not homogeneous in the speed \
+                       (the flow factors depend on Re = ρωRc/µ, a third table dimension not built); \
+                       use the direct film (--film direct) with flow: turbulent or auto",
+            });
+        }
         if self.short {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "film model (tabulated film)",
@@ -484,6 +513,7 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 viscosity_law: f.viscosity_law,
                 viscosity_scale: 1.0,
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
+                flow: f.flow,
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),
