@@ -29,7 +29,10 @@ fn the_turbulent_film_at_vanishing_reynolds_number_is_the_laminar_film() {
     let grid = FilmGrid::new(60, 10).unwrap();
     let mut lam = film(0.03, 1e-9, grid, FlowRegime::Laminar);
     let mut tur = film(0.03, 1e-9, grid, FlowRegime::Turbulent);
-    for k in [kin(0.53, 0.93, 9000.0, [0.0; 2]), kin(0.8, -2.0, 5000.0, [3e-3, -2e-3])] {
+    for k in [
+        kin(0.53, 0.93, 9000.0, [0.0; 2]),
+        kin(0.8, -2.0, 5000.0, [3e-3, -2e-3]),
+    ] {
         let (a, ca) = lam.solve_with_coefficients(&k).unwrap();
         let (b, cb) = tur.solve_with_coefficients(&k).unwrap();
         let scale = a.force_n[0].hypot(a.force_n[1]);
@@ -39,7 +42,10 @@ fn the_turbulent_film_at_vanishing_reynolds_number_is_the_laminar_film() {
         assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < 1e-9);
         let close = |x: &[[f64; 2]; 2], y: &[[f64; 2]; 2]| {
             let s = x.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
-            x.iter().flatten().zip(y.iter().flatten()).all(|(p, q)| (p - q).abs() < 1e-9 * s)
+            x.iter()
+                .flatten()
+                .zip(y.iter().flatten())
+                .all(|(p, q)| (p - q).abs() < 1e-9 * s)
         };
         assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
         assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
@@ -55,7 +61,10 @@ fn turbulent_coefficients_are_the_slopes_of_the_turbulent_force() {
     let grid = FilmGrid::new(60, 10).unwrap();
     for density in [900.0, 1800.0] {
         let mut f = film(0.03, density, grid, FlowRegime::Turbulent);
-        for k in [kin(0.5, 0.9, 9000.0, [0.0; 2]), kin(0.7, 2.5, 9000.0, [2e-3, 1e-3])] {
+        for k in [
+            kin(0.5, 0.9, 9000.0, [0.0; 2]),
+            kin(0.7, 2.5, 9000.0, [2e-3, 1e-3]),
+        ] {
             let (_, c) = f.solve_with_coefficients(&k).unwrap();
             let fd = finite_difference(&mut f, k, 1e-9, 1e-5);
             for (m, n) in [
@@ -139,4 +148,33 @@ fn turbulent_short_limit_matches_the_ng_pan_short_bearing() {
         assert!(short_ratio > 1.05, "turbulence must show: {short_ratio}");
         assert!((finite_ratio / short_ratio - 1.0).abs() < 0.01);
     }
+}
+
+/// `flow: turbulent` in the machine file reaches the direct film; the table (laminar, no Re
+/// dimension) and a viscosity scale (Re changes with µ) are refused by name; a short-bearing
+/// entry with turbulent flow is refused.
+#[test]
+fn turbulent_machine_files_refuse_the_table_and_viscosity_scaling() {
+    use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor};
+    let text = std::fs::read_to_string("config/orc_microturbine_100kw.yaml").unwrap();
+    let turbulent = text.replace("    grid: 60x10", "    grid: 60x10\n    flow: turbulent");
+    let desc = MachineDescription::from_yaml(&turbulent, "t.yaml").unwrap();
+    let mut rotor = Rotor::from_description(&desc);
+    let BearingModel::Film(f) = &rotor.bearings[0].model else {
+        panic!("film bearing expected")
+    };
+    assert_eq!(f.flow, FlowRegime::Turbulent);
+    let err = f
+        .reference_tabulated_solver()
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("flow"), "{err}");
+    let err = rotor.set_viscosity_scale(1.1).unwrap_err().to_string();
+    assert!(err.contains("turbulent"), "{err}");
+    let short = turbulent.replacen("model: finite", "model: short", 1);
+    let err = MachineDescription::from_yaml(&short, "s.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("flow"), "{err}");
 }

@@ -209,8 +209,7 @@ fn the_convective_inertia_raises_the_threshold_and_the_twin_refuses_it() {
         film: FilmEvaluation::Direct,
     };
     let err = run_transient(&orc(FluidInertia::Full), &spec)
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(err.contains("fluid_inertia: full"), "{err}");
 }

@@ -209,7 +209,10 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
     if args.model == ModelKind::Short && args.flow != crate::film::FlowRegime::Laminar {
-        anyhow::bail!("--flow {:?} is built in the finite model only; use --model finite", args.flow);
+        anyhow::bail!(
+            "--flow {:?} is built in the finite model only; use --model finite",
+            args.flow
+        );
     }
     let model: Box<dyn FilmModel> = match args.model {
         ModelKind::Finite => {

@@ -28,9 +28,9 @@
 
 use super::banded::BandMatrix;
 use super::coefficients::FilmCoefficients;
-use super::turbulence::{FlowFactors, FlowRegime};
 use super::error::FilmError;
 use super::geometry::{BearingGeometry, FilmGrid, Lubricant};
+use super::turbulence::{FlowFactors, FlowRegime};
 use super::{FilmModel, FilmResult, JournalKinematics};
 use nalgebra::{Rotation2, Vector2};
 use std::f64::consts::TAU;
@@ -259,8 +259,8 @@ impl FiniteFilm {
         let (vx, vy) = (kin.velocity_m_s[0] / c, kin.velocity_m_s[1] / c);
         let nt = self.grid.n_theta;
         let r = self.geometry.radius_m();
-        let reynolds = self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c
-            / self.lubricant.viscosity_pa_s;
+        let reynolds =
+            self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / self.lubricant.viscosity_pa_s;
         self.factors = FlowFactors::new(self.flow, reynolds, r / c);
         for i in 0..nt {
             let hn = 1.0 - x * self.cos_node[i] - y * self.sin_node[i];

@@ -112,7 +112,11 @@ mod tests {
         let f = FlowFactors::new(FlowRegime::Turbulent, 1270.0, 750.0);
         for h in [0.3, 1.0, 1.7] {
             let d = 1e-6;
-            let (p, m, c) = (f.conductances(h + d), f.conductances(h - d), f.conductances(h));
+            let (p, m, c) = (
+                f.conductances(h + d),
+                f.conductances(h - d),
+                f.conductances(h),
+            );
             for (g, dg) in [(0, 1), (2, 3)] {
                 let fd = (p[g] - m[g]) / (2.0 * d);
                 assert!((fd / c[dg] - 1.0).abs() < 1e-7, "h {h}: {fd} vs {}", c[dg]);
@@ -131,6 +135,9 @@ mod tests {
         assert_eq!(hi.conductances(0.8), t.conductances(0.8));
         // k_x at Re_h 1,000: 12 + 0.0136·1000^0.9 = 12 + 6.82 (Taylor–Dowson fit)
         let k = 12.0 / FlowFactors::new(FlowRegime::Turbulent, 1000.0, 750.0).conductances(1.0)[0];
-        assert!((k - (12.0 + 0.0136 * 1000f64.powf(0.9))).abs() < 1e-12, "{k}");
+        assert!(
+            (k - (12.0 + 0.0136 * 1000f64.powf(0.9))).abs() < 1e-12,
+            "{k}"
+        );
     }
 }

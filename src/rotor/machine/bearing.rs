@@ -222,7 +222,9 @@ impl RawBearingSpec {
                 "is for linear bearings; a film bearing's comes from `fluid_inertia: temporal`",
             ));
         }
-        if self.flow.is_some_and(|f| f != crate::film::FlowRegime::Laminar)
+        if self
+            .flow
+            .is_some_and(|f| f != crate::film::FlowRegime::Laminar)
             && self.model != BearingModelName::Finite
         {
             return Err(rules.error(
