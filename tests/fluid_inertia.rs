@@ -180,3 +180,36 @@ fn the_time_step_and_the_eigenvalues_agree_on_the_films_inertia() {
         e1 - e0
     );
 }
+
+/// `fluid_inertia: full` (the convective inertia's stiffness and damping, and its steady force in
+/// the equilibrium) raises the seed rotor's linear threshold: 8,716 rpm against 8,471 without film
+/// inertia and 8,355 with the temporal added mass alone (README "Fluid-film inertia"; the
+/// coefficients checked against an independent quadrature in `src/film/inertia.rs`). The twin
+/// refuses it by name (its transient force is not built).
+#[test]
+fn the_convective_inertia_raises_the_threshold_and_the_twin_refuses_it() {
+    let threshold = |inertia| {
+        let r = orc(inertia);
+        let statics = static_solution(&r).unwrap();
+        rotor_twin::rotor::stability_threshold(&r, &statics, 8000.0, 9000.0, 500.0)
+            .unwrap()
+            .unwrap()
+            .speed_rpm
+    };
+    let (none, full) = (threshold(FluidInertia::None), threshold(FluidInertia::Full));
+    println!("threshold {none:.1} → {full:.1} rpm");
+    assert!((full / 8716.4 - 1.0).abs() < 0.002, "{full}");
+    assert!(full / none - 1.0 > 0.02, "{none} → {full}");
+    let spec = TransientSpec {
+        speed_rpm: 8000.0,
+        revolutions: 2,
+        coupling: Coupling::Nonlinear,
+        steps_per_rev: 64,
+        grid: None,
+        film: FilmEvaluation::Direct,
+    };
+    let err = run_transient(&orc(FluidInertia::Full), &spec)
+        .expect_err("refused")
+        .to_string();
+    assert!(err.contains("fluid_inertia: full"), "{err}");
+}

@@ -77,6 +77,10 @@ pub struct BearingArgs {
     /// Film model.
     #[arg(long, value_enum, default_value_t = ModelKind::Finite)]
     model: ModelKind,
+    /// Flow in the film (finite model): laminar, turbulent (Ng–Pan / Taylor–Dowson) or auto
+    /// (laminar below Taylor's onset 41.3·√(R/c)).
+    #[arg(long, default_value = "laminar", value_parser = parse_flow)]
+    flow: crate::film::FlowRegime,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -88,7 +92,7 @@ pub struct BearingArgs {
     /// are taken from it (with --speeds).
     #[arg(long, requires = "speeds", conflicts_with_all = [
         "diameter_m", "length_m", "clearance_m", "viscosity_pa_s", "density_kg_m3", "load_n",
-        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model",
+        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model", "flow",
     ])]
     config: Option<PathBuf>,
     /// The machine file's bearing, by name; default its first film bearing.
@@ -205,8 +209,16 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
     if args.model == ModelKind::Short && args.grooves != Grooves::None {
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
+    if args.model == ModelKind::Short && args.flow != crate::film::FlowRegime::Laminar {
+        anyhow::bail!(
+            "--flow {:?} is built in the finite model only; use --model finite",
+            args.flow
+        );
+    }
     let model: Box<dyn FilmModel> = match args.model {
-        ModelKind::Finite => Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?),
+        ModelKind::Finite => {
+            Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?.with_flow(args.flow))
+        }
         ModelKind::Short => Box::new(ShortFilm::new(geometry, lubricant)?),
     };
     Ok((model, lubricant))
@@ -369,4 +381,14 @@ fn print_table(r: &BearingReport) -> anyhow::Result<()> {
     );
     outln!("  frame: {}", r.frame);
     Ok(())
+}
+
+/// `--flow laminar | turbulent | auto`.
+fn parse_flow(s: &str) -> Result<crate::film::FlowRegime, String> {
+    match s {
+        "laminar" => Ok(crate::film::FlowRegime::Laminar),
+        "turbulent" => Ok(crate::film::FlowRegime::Turbulent),
+        "auto" => Ok(crate::film::FlowRegime::Auto),
+        _ => Err(format!("'{s}': must be laminar, turbulent or auto")),
+    }
 }

@@ -39,6 +39,10 @@ pub struct ModesArgs {
     /// whatever the machine file's `fluid_inertia` says.
     #[arg(long)]
     fluid_inertia: bool,
+    /// As --fluid-inertia, plus the convective inertia of the rotating film as stiffness and
+    /// damping (`fluid_inertia: full`; linear analyses only).
+    #[arg(long, conflicts_with = "fluid_inertia")]
+    fluid_inertia_full: bool,
     /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the
     /// lowest --modes modes (at most 6 drawn).
     #[arg(long)]
@@ -201,6 +205,9 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let mut rotor = Rotor::from_description(&desc);
     if args.fluid_inertia {
         rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
+    }
+    if args.fluid_inertia_full {
+        rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
     }
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     let statics = static_solution(&rotor).context("static deflection")?;

@@ -108,9 +108,10 @@ impl BearingLink {
         coef: FilmCoefficients,
         d: [f64; 2],
         film: &FilmResult,
+        speed_rad_s: f64,
     ) -> FilmCoefficients {
         match &self.inertia {
-            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity()),
+            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity(), speed_rad_s),
             None => coef,
         }
     }
@@ -151,7 +152,7 @@ impl BearingLink {
         };
         let (film, coef) = if with_coefficients {
             let (film, coef) = self.film.solve_with_coefficients(&kin)?;
-            (film, self.with_added_mass(coef, d_film, &film))
+            (film, self.with_added_mass(coef, d_film, &film, speed))
         } else {
             // the added mass of the iteration before (prehistory keeps its matrix for the step)
             let mass = self.last.added_mass_kg;

@@ -30,6 +30,7 @@ use super::banded::BandMatrix;
 use super::coefficients::FilmCoefficients;
 use super::error::FilmError;
 use super::geometry::{BearingGeometry, FilmGrid, Lubricant};
+use super::turbulence::{FlowFactors, FlowRegime};
 use super::{FilmModel, FilmResult, JournalKinematics};
 use nalgebra::{Rotation2, Vector2};
 use std::f64::consts::TAU;
@@ -65,8 +66,16 @@ pub struct FiniteFilm {
     groove_pi: Vec<f64>,
     h_node: Vec<f64>,
     h_face: Vec<f64>,
+    /// Per column: the axial / circumferential conductance H³·12/k_z,x (H³ laminar, eq. T1).
     h3_node: Vec<f64>,
     h3_face: Vec<f64>,
+    /// Their slopes dG/dH (3H² laminar), for the perturbation equations.
+    dg_node: Vec<f64>,
+    dg_face: Vec<f64>,
+    /// Laminar, turbulent or auto (`src/film/turbulence.rs`).
+    flow: FlowRegime,
+    /// The flow factors of the last film shape.
+    factors: FlowFactors,
     /// Per column: ω ∂H/∂θ + 2 ∂H/∂t (1/s).
     source: Vec<f64>,
     /// Per node: true where the film is pressurised (the free set of the complementarity problem).
@@ -145,6 +154,10 @@ impl FiniteFilm {
             h_face: vec![0.0; nt],
             h3_node: vec![0.0; nt],
             h3_face: vec![0.0; nt],
+            dg_node: vec![0.0; nt],
+            dg_face: vec![0.0; nt],
+            flow: FlowRegime::Laminar,
+            factors: FlowFactors::new(FlowRegime::Laminar, 0.0, 1.0),
             source: vec![0.0; nt],
             free: vec![false; nodes],
             pi: vec![0.0; nodes],
@@ -166,6 +179,18 @@ impl FiniteFilm {
             dz,
             pressure_scale,
         })
+    }
+
+    /// This solver with the flow regime `flow` (laminar by default; eq. T1–T3).
+    pub fn with_flow(mut self, flow: FlowRegime) -> Self {
+        self.flow = flow;
+        self.warm = false;
+        self
+    }
+
+    /// The flow regime.
+    pub fn flow(&self) -> FlowRegime {
+        self.flow
     }
 
     /// The grid this solver was built on.
@@ -237,13 +262,20 @@ impl FiniteFilm {
         let (x, y) = (kin.position_m[0] / c, kin.position_m[1] / c);
         let (vx, vy) = (kin.velocity_m_s[0] / c, kin.velocity_m_s[1] / c);
         let nt = self.grid.n_theta;
+        let r = self.geometry.radius_m();
+        let reynolds =
+            self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / self.lubricant.viscosity_pa_s;
+        self.factors = FlowFactors::new(self.flow, reynolds, r / c);
         for i in 0..nt {
             let hn = 1.0 - x * self.cos_node[i] - y * self.sin_node[i];
             let hf = 1.0 - x * self.cos_face[i] - y * self.sin_face[i];
             self.h_node[i] = hn;
             self.h_face[i] = hf;
-            self.h3_node[i] = hn * hn * hn;
-            self.h3_face[i] = hf * hf * hf;
+            // axial conductance at the node, circumferential at the face (eq. T1)
+            let [_, _, gz, dgz] = self.factors.conductances(hn);
+            let [gx, dgx, _, _] = self.factors.conductances(hf);
+            (self.h3_node[i], self.dg_node[i]) = (gz, dgz);
+            (self.h3_face[i], self.dg_face[i]) = (gx, dgx);
         }
         for i in 0..nt {
             let west = if i == 0 { nt - 1 } else { i - 1 };
@@ -473,7 +505,7 @@ impl FiniteFilm {
                 volume * speed_rad_s * (self.cos_face[i] - self.cos_face[west]) / self.dtheta;
             let mut by =
                 volume * speed_rad_s * (self.sin_face[i] - self.sin_face[west]) / self.dtheta;
-            // − (∂A/∂X) Π: each conductance ∝ H³ changes by 3H² ∂H/∂X
+            // − (∂A/∂X) Π: each conductance G(H) changes by G'(H) ∂H/∂X (3H² laminar)
             let pk = self.pi[k];
             let w = self.row_width(j) / self.dtheta;
             let (ce, se) = (self.cos_face[i], self.sin_face[i]);
@@ -481,8 +513,8 @@ impl FiniteFilm {
             let east = if i + 1 == self.grid.n_theta { 0 } else { i + 1 };
             let d_east = pk - self.pi[east * nz + j];
             let d_west = pk - self.pi[west * nz + j];
-            let g_east = 3.0 * w * self.h_face[i] * self.h_face[i];
-            let g_west = 3.0 * w * self.h_face[west] * self.h_face[west];
+            let g_east = w * self.dg_face[i];
+            let g_west = w * self.dg_face[west];
             let north = if j + 1 < nz {
                 self.pi[i * nz + j + 1]
             } else {
@@ -492,7 +524,7 @@ impl FiniteFilm {
             if j > 0 {
                 d_axial += pk - self.pi[i * nz + j - 1];
             }
-            let g_axial = 3.0 * self.dtheta * self.h_node[i] * self.h_node[i] / self.dz;
+            let g_axial = self.dtheta * self.dg_node[i] / self.dz;
             // ∂C/∂X = −3H² cos θ · (geometric factor)
             bx +=
                 g_east * ce * d_east + g_west * cw * d_west + g_axial * self.cos_node[i] * d_axial;

@@ -23,6 +23,7 @@ mod heating;
 mod inertia;
 mod short;
 mod table;
+mod turbulence;
 mod viscosity;
 
 pub use coefficients::{matrix2, rows2, FilmCoefficients};
@@ -41,6 +42,7 @@ pub use table::{
     FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,
 };
 pub use table::{FilmTable, TabulatedFilm};
+pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};
 pub use viscosity::{
     check_viscosity_scale, ViscosityScaledFilm, WaltherLaw, MAX_VISCOSITY_SCALE,
     MIN_VISCOSITY_SCALE, ZERO_CELSIUS_K,

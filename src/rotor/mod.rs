@@ -80,6 +80,8 @@ pub struct FilmBearing {
     pub viscosity_scale: f64,
     /// The film's fluid inertia (added mass), if the bearing carries it.
     pub inertia: Option<crate::film::FilmInertia>,
+    /// Laminar, turbulent or auto (finite model; `src/film/turbulence.rs`).
+    pub flow: crate::film::FlowRegime,
 }
 
 // --- oil supply temperature (issue 12) ---
@@ -89,18 +91,49 @@ impl FilmBearing {
         self.lubricant.viscosity_pa_s * self.viscosity_scale
     }
 
-    /// `coef` with the added mass of the film `film` at relative position `d` (m), if the
-    /// bearing carries its fluid inertia.
+    /// `coef` with the added mass of the film `film` at relative position `d` (m) and shaft
+    /// speed `speed_rad_s`, if the bearing carries its fluid inertia (and with `full` the
+    /// convective inertia's stiffness and damping).
     pub fn with_added_mass(
         &self,
         coef: FilmCoefficients,
         d: [f64; 2],
         film: &crate::film::FilmResult,
+        speed_rad_s: f64,
     ) -> FilmCoefficients {
         match &self.inertia {
-            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity_pa_s()),
+            Some(inertia) => inertia.add_to(coef, d, film, self.viscosity_pa_s(), speed_rad_s),
             None => coef,
         }
+    }
+
+    /// The static equilibrium under `load` (N) at `speed_rad_s` with the film solver `s`; with
+    /// `fluid_inertia: full` the film carries the load plus the steady convective inertia force
+    /// (fixed point: the force is ≈ 4 % of the load in the seed case, each pass shrinks the
+    /// change by about that ratio; stops at 1e-9 of the clearance).
+    pub fn equilibrium(
+        &self,
+        s: &mut dyn crate::film::FilmModel,
+        load: [f64; 2],
+        speed_rad_s: f64,
+    ) -> Result<crate::film::Equilibrium, crate::film::FilmError> {
+        let mu = self.viscosity_pa_s();
+        let mut eq = crate::film::equilibrium_under_load(s, mu, load, speed_rad_s)?;
+        let Some(inertia) = self.inertia.filter(|i| i.convective) else {
+            return Ok(eq);
+        };
+        for _ in 0..30 {
+            let f = inertia.convective_force_at(&eq, mu, speed_rad_s);
+            let carried = [load[0] + f[0], load[1] + f[1]];
+            let next = crate::film::equilibrium_under_load(s, mu, carried, speed_rad_s)?;
+            let moved = (next.position_m[0] - eq.position_m[0])
+                .hypot(next.position_m[1] - eq.position_m[1]);
+            eq = next;
+            if moved < 1e-9 * self.geometry.radial_clearance_m {
+                break;
+            }
+        }
+        Ok(eq)
     }
 
     /// A film solver at the running viscosity (each user owns one: it carries the warm start).
@@ -119,6 +152,17 @@ impl Rotor {
     /// Sets the viscosity scale (µ / µ_reference) of every film bearing (checked).
     pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), crate::film::FilmError> {
         let scale = crate::film::check_viscosity_scale(scale)?;
+        let turbulent = self.bearings.iter().any(|b| {
+            matches!(&b.model, BearingModel::Film(f) if f.flow != crate::film::FlowRegime::Laminar)
+        });
+        if turbulent && scale != 1.0 {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "viscosity scale (turbulent film)",
+                value: scale,
+                rule: "a viscosity change does not scale a turbulent film (Re = ρωRc/µ changes \
+                       with it); only 1 is accepted with flow: turbulent or auto",
+            });
+        }
         for b in &mut self.bearings {
             if let BearingModel::Film(f) = &mut b.model {
                 f.viscosity_scale = scale;
@@ -153,6 +197,13 @@ impl Rotor {
 impl FilmBearing {
     /// A film solver at the reference viscosity `lubricant` (unscaled).
     pub fn reference_solver(&self) -> Box<dyn FilmModel + Send> {
+        if !self.short {
+            return Box::new(
+                FiniteFilm::new(self.geometry.clone(), self.lubricant, self.grid)
+                    .expect("geometry checked when the machine was read")
+                    .with_flow(self.flow),
+            );
+        }
         if self.short {
             Box::new(
                 ShortFilm::new(self.geometry.clone(), self.lubricant)
@@ -178,6 +229,15 @@ impl FilmBearing {
     pub fn reference_tabulated_solver(
         &self,
     ) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        if self.flow != crate::film::FlowRegime::Laminar {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "flow (tabulated film)",
+                value: 0.0,
+                rule: "the table is laminar: a turbulent film is not homogeneous in the speed \
+                       (the flow factors depend on Re = ρωRc/µ, a third table dimension not built); \
+                       use the direct film (--film direct) with flow: turbulent or auto",
+            });
+        }
         if self.short {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "film model (tabulated film)",
@@ -466,6 +526,7 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 heating: f.heating,
                 viscosity_scale: 1.0,
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
+                flow: f.flow,
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),
@@ -485,6 +546,11 @@ fn fluid_inertia(
             geometry,
             lubricant.density_kg_m3,
         )),
+        crate::film::FluidInertia::Full => {
+            let mut i = crate::film::FilmInertia::new(geometry, lubricant.density_kg_m3);
+            i.convective = true;
+            Some(i)
+        }
     }
 }
 

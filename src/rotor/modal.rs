@@ -6,7 +6,7 @@ use super::mode_tracking::{
     assign_tracks, normalise, rotate_to_whirl_senses, sense, tilt_weight_m2, Shape,
 };
 use super::{BearingModel, Rotor, RotorError, StaticSolution};
-use crate::film::{equilibrium_under_load, FilmCoefficients, FilmModel, JournalKinematics};
+use crate::film::{FilmCoefficients, FilmModel, JournalKinematics};
 use crate::units::rad_s_to_rpm;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -537,15 +537,16 @@ impl BearingSolvers {
                             .map_err(fail)?;
                         (c, 0.0)
                     } else {
-                        let eq = equilibrium_under_load(
-                            s.as_mut(),
-                            f.viscosity_pa_s(),
-                            *load,
-                            speed_rad_s,
-                        )
-                        .map_err(fail)?;
+                        let eq = f
+                            .equilibrium(s.as_mut(), *load, speed_rad_s)
+                            .map_err(fail)?;
                         (
-                            f.with_added_mass(eq.coefficients, eq.position_m, &eq.film),
+                            f.with_added_mass(
+                                eq.coefficients,
+                                eq.position_m,
+                                &eq.film,
+                                speed_rad_s,
+                            ),
                             eq.eccentricity_ratio,
                         )
                     }

@@ -216,6 +216,14 @@ fn film_links(
         if let Some(p) = pedestal {
             b_dofs.extend(p);
         }
+        if f.inertia.is_some_and(|i| i.convective) {
+            return Err(TwinError::Setup(format!(
+                "bearing '{}': fluid_inertia: full (convective inertia) is built for the linear \
+                 analyses (modes, response) only; the twin and its transient take \
+                 fluid_inertia: temporal",
+                b.name
+            )));
+        }
         // the linear coupling evaluates films only to re-linearise: direct
         let film = match (config.film, config.coupling) {
             (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.reference_solver(),
@@ -312,7 +320,8 @@ impl BearingLink {
                     cause,
                 }
             })?;
-        let coefficients = self.with_added_mass(eq.coefficients, eq.position_m, &eq.film);
+        let coefficients =
+            self.with_added_mass(eq.coefficients, eq.position_m, &eq.film, speed_rad_s);
         self.linear_reference = Some(LinearReference {
             position_m: eq.position_m,
             force_n: eq.film.force_n,

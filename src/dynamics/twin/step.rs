@@ -100,7 +100,8 @@ impl Twin {
                 let load = [-r.force_n[0], -r.force_n[1]];
                 let mu = l.viscosity();
                 if let Ok(eq) = equilibrium_under_load(&mut l.film, mu, load, speed) {
-                    let coefficients = l.with_added_mass(eq.coefficients, eq.position_m, &eq.film);
+                    let coefficients =
+                        l.with_added_mass(eq.coefficients, eq.position_m, &eq.film, speed);
                     l.linear_reference = Some(LinearReference {
                         position_m: eq.position_m,
                         force_n: eq.film.force_n,

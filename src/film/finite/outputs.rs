@@ -117,7 +117,12 @@ impl FiniteFilm {
         let r = self.geometry.radius_m();
         let c = self.geometry.radial_clearance_m;
         let mu = self.lubricant.viscosity_pa_s;
-        let inverse_h: f64 = self.h_node.iter().map(|h| 1.0 / h).sum();
+        // with the turbulent Couette shear factor (eq. T3; 1 laminar)
+        let inverse_h: f64 = self
+            .h_node
+            .iter()
+            .map(|&h| self.factors.couette_shear(h) / h)
+            .sum();
         let couette =
             mu * speed_rad_s * r.powi(3) * self.geometry.length_m / c * inverse_h * self.dtheta;
         // (R/2) ∫∫ h ∂p/∂θ dθ dz over both halves = R² c ps Σ_j w_j Σ_i H_{i+½} (Π_{i+1} − Π_i)
@@ -155,7 +160,7 @@ impl FiniteFilm {
         let mut q = 0.0;
         for j in 0..nz {
             let dpi = self.pi[s * nz + j] - self.pi[west * nz + j];
-            q += self.row_width(j) * (speed_rad_s * h - h * h * h * dpi / self.dtheta);
+            q += self.row_width(j) * (speed_rad_s * h - self.h3_face[west] * dpi / self.dtheta);
         }
         r * r * c * q
     }

@@ -82,6 +82,9 @@ pub struct RawBearingSpec {
     /// fluid inertia as added-mass coefficients ([`crate::film::FilmInertia`]).
     #[serde(default)]
     fluid_inertia: FluidInertia,
+    /// Film bearings: `laminar` (default), `turbulent` or `auto` (`src/film/turbulence.rs`).
+    #[serde(default)]
+    flow: Option<crate::film::FlowRegime>,
     /// Flexible support under the bearing (the seed's C_mn, D_mn); rigid if absent.
     #[serde(default)]
     support: Option<SupportSpec>,
@@ -132,6 +135,8 @@ pub struct FilmSpec {
     pub grid: FilmGrid,
     /// Whether the film carries its fluid inertia (added mass).
     pub fluid_inertia: FluidInertia,
+    /// Laminar, turbulent or auto (finite model only).
+    pub flow: crate::film::FlowRegime,
 }
 
 /// A pedestal: a mass on a spring–damper to the ground, carrying the bearing.
@@ -221,6 +226,17 @@ impl RawBearingSpec {
                 "is for linear bearings; a film bearing's comes from `fluid_inertia: temporal`",
             ));
         }
+        if self
+            .flow
+            .is_some_and(|f| f != crate::film::FlowRegime::Laminar)
+            && self.model != BearingModelName::Finite
+        {
+            return Err(rules.error(
+                format!("bearings[{i}].flow"),
+                format!("{:?}", self.flow.unwrap_or_default()),
+                "turbulent flow is built in the finite film model only (model: finite)",
+            ));
+        }
         if !film && self.fluid_inertia != FluidInertia::None {
             return Err(rules.error(
                 format!("bearings[{i}].fluid_inertia"),
@@ -288,6 +304,7 @@ impl RawBearingSpec {
             heating,
             grid,
             fluid_inertia: self.fluid_inertia,
+            flow: self.flow.unwrap_or_default(),
         })
     }
 
