@@ -12,8 +12,8 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 if [ ! -f "$venv/.complete" ]; then
   "$venv/bin/pip" install --quiet --disable-pip-version-check \
-    'ros-jazzy-rclpy[fastrtps]' ros-jazzy-std-msgs ros-jazzy-geometry-msgs \
-    ros-jazzy-diagnostic-msgs ros-jazzy-rosgraph-msgs ros-jazzy-rcl-interfaces >&2
+    'ros-jazzy-rclpy[fastrtps]==7.1.6' ros-jazzy-std-msgs==5.3.6 ros-jazzy-geometry-msgs==5.3.6 \
+    ros-jazzy-diagnostic-msgs==5.3.6 ros-jazzy-rosgraph-msgs==2.0.3 ros-jazzy-rcl-interfaces==2.0.3 >&2
   touch "$venv/.complete"
 fi
 echo "$venv"
