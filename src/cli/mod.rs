@@ -135,3 +135,34 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
         None => replay::run_sample(),
     }
 }
+
+/// The speeds (rpm) of `[--from-rpm, --to-rpm, --step-rpm]`, checked: by default from 10 % of
+/// the rated speed `rated` (at least 100 rpm) to 150 % of it in `steps` steps; at most
+/// `max_steps` steps. Returns (speeds, from, to, step), the last speed capped at `to`.
+pub(crate) fn speed_grid_rpm(
+    [from, to, step]: [Option<f64>; 3],
+    rated: f64,
+    steps: f64,
+    max_steps: f64,
+) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
+    let from = from.unwrap_or((0.1 * rated).max(100.0));
+    let to = to.unwrap_or(1.5 * rated);
+    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
+        anyhow::ensure!(
+            v.is_finite() && v > 0.0,
+            "invalid {name} {v}: must be a finite speed above zero"
+        );
+    }
+    anyhow::ensure!(
+        to > from,
+        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
+    );
+    let step = step.unwrap_or((to - from) / steps);
+    anyhow::ensure!(
+        step.is_finite() && step > 0.0 && (to - from) / step <= max_steps,
+        "invalid --step-rpm {step}: must be above zero, at most {max_steps} speeds"
+    );
+    let n = ((to - from) / step).round() as usize;
+    let speeds = (0..=n).map(|k| (from + k as f64 * step).min(to)).collect();
+    Ok((speeds, from, to, step))
+}
