@@ -35,6 +35,7 @@ mod bearing_speeds;
 mod bench;
 mod mode_shapes;
 mod modes;
+#[cfg(feature = "ros")]
 mod node;
 mod replay;
 mod response;
@@ -60,7 +61,11 @@ impl Cli {
     /// A command that only computes and prints (every one but `node` and `param`, which talk to
     /// the bus): a closed standard output may end it by SIGPIPE, as it ends a Unix filter.
     pub fn is_filter(&self) -> bool {
-        !matches!(self.command, Some(Command::Node(_) | Command::Param(_)))
+        #[cfg(feature = "ros")]
+        let bus = matches!(self.command, Some(Command::Node(_) | Command::Param(_)));
+        #[cfg(not(feature = "ros"))]
+        let bus = false;
+        !bus
     }
 }
 
@@ -95,8 +100,10 @@ enum Command {
     /// Amplitude–speed characteristic: a transient at each speed, in parallel.
     Sweep(simulate::SweepArgs),
     /// The live ROS 2 node: the twin beside a plant or rig, recorded to MCAP.
+    #[cfg(feature = "ros")]
     Node(node::NodeArgs),
     /// A running node's parameters: get, or set where the node allows it at run time.
+    #[cfg(feature = "ros")]
     Param(node::ParamArgs),
     /// A recorded bag through the twin: predictions, warnings, predicted vs measured orbits.
     Replay(replay::ReplayArgs),
@@ -126,8 +133,10 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Response(args)) => response::run(&args),
         Some(Command::Simulate(args)) => simulate::run_simulate(&args),
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
+        #[cfg(feature = "ros")]
         Some(Command::Node(args)) => node::run(args),
         Some(Command::Replay(args)) => replay::run(&args),
+        #[cfg(feature = "ros")]
         Some(Command::Param(args)) => node::run_param(args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
