@@ -5,7 +5,7 @@
 //! runs, not from the built-in one.
 
 use rotor_twin::bag::Bag;
-use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind};
+use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind, StationRef};
 use rotor_twin::dynamics::FilmEvaluation;
 use rotor_twin::messages::{self, to_cdr, Header, Time};
 use rotor_twin::record::{Recorder, TopicQos};
@@ -449,4 +449,55 @@ fn input_limits_come_from_the_machine_that_runs() {
         (max - 10.0 * 3000.0 * std::f64::consts::PI / 30.0).abs() < 1e-6,
         "{max}"
     );
+}
+
+#[test]
+fn probes_stamped_an_hour_off_the_clock_are_warned_about() {
+    // issue 15, item 13: probe samples stamped ±1 h from their receive time were compared at the
+    // receive time without a word; the driver now says so (at most once a second)
+    let w = 8000.0 * std::f64::consts::PI / 30.0;
+    let hour_ns: i64 = 3_600_000_000_000;
+    let settings = DriverSettings::new(ModelKind::Nonlinear, FilmEvaluation::Table, 942.5);
+    let station = rotor().probes[0].name.clone();
+    for off_ns in [hour_ns, -hour_ns, 0] {
+        let mut driver = Driver::new(rotor(), settings);
+        let mut warnings = Vec::new();
+        for k in 0..40_i64 {
+            let t = T0_NS + k * 5_000_000;
+            let mut collect = |o: Outgoing| {
+                if let Outgoing::Warning(m) = o {
+                    warnings.push(m.evidence);
+                }
+            };
+            let speed = Input::Speed {
+                speed_rad_s: w,
+                accel_rad_s2: 0.0,
+                stamp_ns: t,
+            };
+            driver.feed(t, speed, &mut collect);
+            let probe = Input::Probe {
+                station: StationRef::Name(station.clone()),
+                x_m: 1e-6,
+                y_m: 0.0,
+                stamp_ns: t + off_ns,
+            };
+            driver.feed(t, probe, &mut collect);
+        }
+        let off_clock: Vec<_> = warnings
+            .iter()
+            .filter(|m| m.contains("from its receive time"))
+            .collect();
+        if off_ns == 0 {
+            assert!(off_clock.is_empty(), "{off_clock:?}");
+        } else {
+            // 40 samples over 0.2 s: one warning, naming the station and the offset in s
+            assert_eq!(off_clock.len(), 1, "{warnings:?}");
+            let sign = if off_ns > 0 { "+" } else { "-" };
+            assert!(
+                off_clock[0].contains(&format!("'{station}' stamped {sign}3600.000 s")),
+                "{}",
+                off_clock[0]
+            );
+        }
+    }
 }

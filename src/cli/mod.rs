@@ -35,6 +35,7 @@ mod bearing_speeds;
 mod bench;
 mod mode_shapes;
 mod modes;
+#[cfg(feature = "ros")]
 mod node;
 mod replay;
 mod response;
@@ -60,7 +61,11 @@ impl Cli {
     /// A command that only computes and prints (every one but `node` and `param`, which talk to
     /// the bus): a closed standard output may end it by SIGPIPE, as it ends a Unix filter.
     pub fn is_filter(&self) -> bool {
-        !matches!(self.command, Some(Command::Node(_) | Command::Param(_)))
+        #[cfg(feature = "ros")]
+        let bus = matches!(self.command, Some(Command::Node(_) | Command::Param(_)));
+        #[cfg(not(feature = "ros"))]
+        let bus = false;
+        !bus
     }
 }
 
@@ -95,8 +100,10 @@ enum Command {
     /// Amplitude–speed characteristic: a transient at each speed, in parallel.
     Sweep(simulate::SweepArgs),
     /// The live ROS 2 node: the twin beside a plant or rig, recorded to MCAP.
+    #[cfg(feature = "ros")]
     Node(node::NodeArgs),
     /// A running node's parameters: get, or set where the node allows it at run time.
+    #[cfg(feature = "ros")]
     Param(node::ParamArgs),
     /// A recorded bag through the twin: predictions, warnings, predicted vs measured orbits.
     Replay(replay::ReplayArgs),
@@ -126,12 +133,45 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Response(args)) => response::run(&args),
         Some(Command::Simulate(args)) => simulate::run_simulate(&args),
         Some(Command::Sweep(args)) => simulate::run_sweep(&args),
+        #[cfg(feature = "ros")]
         Some(Command::Node(args)) => node::run(args),
         Some(Command::Replay(args)) => replay::run(&args),
+        #[cfg(feature = "ros")]
         Some(Command::Param(args)) => node::run_param(args),
         Some(Command::SynthBag(args)) => synth::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Bag(args)) => bag::run(&args),
         None => replay::run_sample(),
     }
+}
+
+/// The speeds (rpm) of `[--from-rpm, --to-rpm, --step-rpm]`, checked: by default from 10 % of
+/// the rated speed `rated` (at least 100 rpm) to 150 % of it in `steps` steps; at most
+/// `max_steps` steps. Returns (speeds, from, to, step), the last speed capped at `to`.
+pub(crate) fn speed_grid_rpm(
+    [from, to, step]: [Option<f64>; 3],
+    rated: f64,
+    steps: f64,
+    max_steps: f64,
+) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
+    let from = from.unwrap_or((0.1 * rated).max(100.0));
+    let to = to.unwrap_or(1.5 * rated);
+    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
+        anyhow::ensure!(
+            v.is_finite() && v > 0.0,
+            "invalid {name} {v}: must be a finite speed above zero"
+        );
+    }
+    anyhow::ensure!(
+        to > from,
+        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
+    );
+    let step = step.unwrap_or((to - from) / steps);
+    anyhow::ensure!(
+        step.is_finite() && step > 0.0 && (to - from) / step <= max_steps,
+        "invalid --step-rpm {step}: must be above zero, at most {max_steps} speeds"
+    );
+    let n = ((to - from) / step).round() as usize;
+    let speeds = (0..=n).map(|k| (from + k as f64 * step).min(to)).collect();
+    Ok((speeds, from, to, step))
 }

@@ -167,37 +167,18 @@ fn heat_for_threshold(
 /// The speeds of the Campbell diagram and threshold search, checked: (speeds, from, to, step)
 /// in rpm; by default 10 % to 150 % of the rated speed `rated` in 40 steps.
 fn speed_range(args: &ModesArgs, rated: f64) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
-    let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));
-    let to = args.to_rpm.unwrap_or(1.5 * rated);
-    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
-        anyhow::ensure!(
-            v.is_finite() && v > 0.0,
-            "invalid {name} {v}: must be a finite speed above zero"
-        );
-    }
-    anyhow::ensure!(
-        to > from,
-        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
-    );
-    let step = args.step_rpm.unwrap_or((to - from) / 40.0);
-    anyhow::ensure!(
-        step.is_finite() && step > 0.0,
-        "invalid --step-rpm {step}: must be a finite speed above zero"
-    );
-    anyhow::ensure!(
-        (to - from) / step <= 2000.0,
-        "invalid --step-rpm {step}: more than 2,000 speeds"
-    );
+    let grid = super::speed_grid_rpm(
+        [args.from_rpm, args.to_rpm, args.step_rpm],
+        rated,
+        40.0,
+        2000.0,
+    )?;
     anyhow::ensure!(
         (1..=100).contains(&args.modes),
         "invalid --modes {}: must be 1 to 100",
         args.modes
     );
-    let n_speeds = ((to - from) / step).round() as usize;
-    let speeds = (0..=n_speeds)
-        .map(|k| (from + k as f64 * step).min(to))
-        .collect();
-    Ok((speeds, from, to, step))
+    Ok(grid)
 }
 
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {

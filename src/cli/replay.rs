@@ -164,11 +164,18 @@ fn parse_remap(s: &str) -> Result<(String, String), String> {
 }
 
 fn parse_probe_point(s: &str) -> Result<(String, String), String> {
-    let (station, topic) = s
-        .split_once('=')
-        .ok_or_else(|| format!("--probe-point '{s}': expected STATION=TOPIC"))?;
+    let (station, topic) = s.split_once('=').ok_or_else(|| {
+        format!(
+            "--probe-point {}: expected STATION=TOPIC",
+            crate::rotor::shown(s)
+        )
+    })?;
+    crate::rotor::mapping_name("--probe-point", station)?;
     if !topic.starts_with('/') {
-        return Err(format!("--probe-point '{s}': topic must be absolute (/…)"));
+        let topic = crate::rotor::shown(topic);
+        return Err(format!(
+            "--probe-point: topic {topic} must be absolute (/…)"
+        ));
     }
     // stored as (topic, station)
     Ok((topic.into(), station.into()))
@@ -176,11 +183,18 @@ fn parse_probe_point(s: &str) -> Result<(String, String), String> {
 
 /// `PROBE=TOPIC` of `--probe-signal`, stored as (topic, probe).
 fn parse_probe_signal(s: &str) -> Result<(String, String), String> {
-    let (probe, topic) = s
-        .split_once('=')
-        .ok_or_else(|| format!("--probe-signal '{s}': expected PROBE=TOPIC"))?;
+    let (probe, topic) = s.split_once('=').ok_or_else(|| {
+        format!(
+            "--probe-signal {}: expected PROBE=TOPIC",
+            crate::rotor::shown(s)
+        )
+    })?;
+    crate::rotor::mapping_name("--probe-signal", probe)?;
     if !topic.starts_with('/') {
-        return Err(format!("--probe-signal '{s}': topic must be absolute (/…)"));
+        let topic = crate::rotor::shown(topic);
+        return Err(format!(
+            "--probe-signal: topic {topic} must be absolute (/…)"
+        ));
     }
     Ok((topic.into(), probe.into()))
 }
@@ -706,3 +720,30 @@ fn calibration_summary(
     s
 }
 // --- end calibration from measurements ---
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mapping_names_are_bounded_and_refused_with_the_reason() {
+        // issue 15, item 13: an empty or 1 MB station name was taken, and echoed whole
+        let huge = format!("{}=/x", "s".repeat(1 << 20));
+        for s in [huge.as_str(), "=/x", " =/x"] {
+            let point = parse_probe_point(s).unwrap_err();
+            let signal = parse_probe_signal(s).unwrap_err();
+            assert!(
+                point.starts_with("--probe-point") && point.len() < 200,
+                "{point:.200}"
+            );
+            assert!(
+                signal.starts_with("--probe-signal") && signal.len() < 200,
+                "{signal:.200}"
+            );
+        }
+        assert_eq!(
+            parse_probe_point("a=/p"),
+            Ok(("/p".to_string(), "a".to_string()))
+        );
+    }
+}

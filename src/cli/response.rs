@@ -62,25 +62,8 @@ struct ResponseReport {
 }
 
 fn speed_grid(args: &ResponseArgs, rated: f64) -> anyhow::Result<Vec<f64>> {
-    let from = args.from_rpm.unwrap_or((0.1 * rated).max(100.0));
-    let to = args.to_rpm.unwrap_or(1.5 * rated);
-    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
-        anyhow::ensure!(
-            v.is_finite() && v > 0.0,
-            "invalid {name} {v}: must be a finite speed above zero"
-        );
-    }
-    anyhow::ensure!(
-        to > from,
-        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
-    );
-    let step = args.step_rpm.unwrap_or((to - from) / 200.0);
-    anyhow::ensure!(
-        step.is_finite() && step > 0.0 && (to - from) / step <= 5000.0,
-        "invalid --step-rpm {step}: must be above zero, at most 5,000 speeds"
-    );
-    let n = ((to - from) / step).round() as usize;
-    Ok((0..=n).map(|k| (from + k as f64 * step).min(to)).collect())
+    let range = [args.from_rpm, args.to_rpm, args.step_rpm];
+    Ok(super::speed_grid_rpm(range, rated, 200.0, 5000.0)?.0)
 }
 
 pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {

@@ -132,6 +132,8 @@ pub struct Driver {
     refused_unwarned: u64,
     last_refusal_warning_ns: Option<i64>,
     last_refusal: String,
+    /// when the last "probe stamped off the clock" warning went out (ns)
+    last_off_clock_warning_ns: Option<i64>,
     counts: DriverCounts,
     /// the last accepted oil supply temperature (K)
     oil_temperature_k: Option<f64>,
@@ -166,6 +168,7 @@ impl Driver {
             next_margin_ns: i64::MIN,
             last_stale_warning_ns: None,
             refused_unwarned: 0,
+            last_off_clock_warning_ns: None,
             last_refusal_warning_ns: None,
             last_refusal: String::new(),
             counts: DriverCounts::default(),
@@ -492,9 +495,13 @@ impl Driver {
         }
         // the sample's own stamp where it is on the driver's clock, else its receive time
         let tolerance = seconds_to_ns(self.settings.input_timeout_s);
-        let time_ns = if stamp_ns != 0 && (stamp_ns - now_ns).abs() <= tolerance {
+        let off_ns = stamp_ns.saturating_sub(now_ns);
+        let time_ns = if stamp_ns == 0 {
+            now_ns
+        } else if off_ns.abs() <= tolerance {
             stamp_ns
         } else {
+            self.warn_off_clock(now_ns, k, off_ns, emit);
             now_ns
         };
         let Some(s) = self.session.as_ref() else {
@@ -516,6 +523,38 @@ impl Driver {
         };
         emit(Outgoing::Residual(r));
         Fed::Compared(comparison)
+    }
+
+    /// A probe sample stamped further than the input timeout from its receive time is compared
+    /// at its receive time, and said so: at once, then at most once per
+    /// [`REFUSAL_WARNING_INTERVAL_S`] (issue 15, item 13: ±1 h stamps were compared silently).
+    fn warn_off_clock(
+        &mut self,
+        now_ns: i64,
+        k: usize,
+        off_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) {
+        let interval = seconds_to_ns(REFUSAL_WARNING_INTERVAL_S);
+        if self
+            .last_off_clock_warning_ns
+            .is_some_and(|t| now_ns < t.saturating_add(interval))
+        {
+            return;
+        }
+        self.last_off_clock_warning_ns = Some(now_ns);
+        let name = self.limits.stations.get(k).map_or("", String::as_str);
+        emit(warning(
+            now_ns,
+            InstabilityWarning::WARN,
+            WarningKind::StaleInput,
+            "",
+            format!(
+                "probe station '{name}' stamped {:+.3} s from its receive time (over {} s): compared at the receive time",
+                off_ns as f64 * 1e-9,
+                self.settings.input_timeout_s
+            ),
+        ));
     }
 
     /// Counts a refusal; the `bad_input` warning goes out at once, then at most once per

@@ -4,15 +4,19 @@
 //! (rcutils' logging clock, also under `use_sim_time`), only lines at or above `--log-level`.
 
 use super::params::LogLevel;
+#[cfg(feature = "ros")]
 use ros2_client::builtin_interfaces::Time;
+#[cfg(feature = "ros")]
 use ros2_client::rosout::{NodeLoggingHandle, RosoutRaw};
 use std::sync::OnceLock;
 
+#[cfg(feature = "ros")]
 struct Rosout {
     handle: NodeLoggingHandle,
     logger: String,
 }
 
+#[cfg(feature = "ros")]
 static ROSOUT: OnceLock<Rosout> = OnceLock::new();
 static LEVEL: OnceLock<LogLevel> = OnceLock::new();
 
@@ -27,6 +31,7 @@ pub fn set_level(level: LogLevel) {
 }
 
 /// From now on log lines also go to `/rosout` through `handle` (once per process).
+#[cfg(feature = "ros")]
 pub fn to_rosout(handle: NodeLoggingHandle, fqn: &str) {
     let _ = ROSOUT.set(Rosout {
         handle,
@@ -49,6 +54,7 @@ pub fn say(level: LogLevel, msg: &str) {
         LogLevel::Warn => eprintln!("rotor_twin: WARN: {msg}"),
         LogLevel::Error | LogLevel::Fatal => eprintln!("rotor_twin: ERROR: {msg}"),
     }
+    #[cfg(feature = "ros")]
     if let Some(r) = ROSOUT.get() {
         let ros_level = match level {
             LogLevel::Debug => ros2_client::ros2::LogLevel::Debug,

@@ -208,7 +208,8 @@ fn check_type(node: &Node, p: &Parameter) -> Result<String, String> {
             p.value.to_parameter_type()
         ));
     }
-    super::parameter_text(&p.value).ok_or_else(|| format!("parameter {}: unsupported type", p.name))
+    super::node::parameter_text(&p.value)
+        .ok_or_else(|| format!("parameter {}: unsupported type", p.name))
 }
 
 /// The descriptor of `name` with its current value (NOT_SET type for an unknown name).

@@ -75,15 +75,21 @@ impl fmt::Display for KeyphasorType {
 fn topic_pairs(parameter: &str, value: &str) -> Result<Vec<(String, String)>, String> {
     let mut pairs = Vec::new();
     for item in value.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let option = format!("parameter {parameter}");
         let (name, topic) = item
             .split_once('=')
-            .ok_or_else(|| format!("parameter {parameter}: '{item}' must be name=topic"))?;
-        if !topic.trim().starts_with('/') {
-            return Err(format!(
-                "parameter {parameter}: topic '{topic}' must be absolute (/…)"
-            ));
+            .ok_or_else(|| format!("{option}: {} must be name=topic", crate::rotor::shown(item)))?;
+        let (name, topic) = (name.trim(), topic.trim());
+        crate::rotor::mapping_name(&option, name)?;
+        if !topic.starts_with('/') {
+            let topic = crate::rotor::shown(topic);
+            return Err(format!("{option}: topic {topic} must be absolute (/…)"));
         }
-        pairs.push((name.trim().to_string(), topic.trim().to_string()));
+        if pairs.iter().any(|(n, _): &(String, String)| n == name) {
+            let name = crate::rotor::shown(name);
+            return Err(format!("{option}: name {name} is given twice"));
+        }
+        pairs.push((name.to_string(), topic.to_string()));
     }
     Ok(pairs)
 }
@@ -692,6 +698,20 @@ mod tests {
             ("probe_pulley_end".to_string(), "/plant/probe_b".to_string())
         );
         assert!(p.set("probe_point_topics", "x:/a").is_err());
+        // issue 15, item 13: duplicate, empty and megabyte names refused, the name shown cut
+        // (a 1 MB name was echoed whole into the latched warning before)
+        let twice = p.set("probe_point_topics", "a=/x, a=/y").unwrap_err();
+        assert!(twice.contains("given twice"), "{twice}");
+        let empty = p.set("probe_signal_topics", " =/x").unwrap_err();
+        assert!(empty.contains("must not be empty"), "{empty}");
+        let huge = format!("{}=/x", "n".repeat(1 << 20));
+        let why = p.set("probe_point_topics", &huge).unwrap_err();
+        assert!(
+            why.contains("at most 64") && why.len() < 200,
+            "{}",
+            why.len()
+        );
+        assert!(p.set("probe_point_topics", &huge[1..]).is_err());
         // issue 12: the keyphasor as std_msgs/Header, raw probes as std_msgs/Float64 topics
         p.set("keyphasor_type", "header").unwrap();
         assert_eq!(p.keyphasor_type, KeyphasorType::Header);

@@ -22,28 +22,6 @@ impl Rotor {
             .map(|i| (0..n).map(|j| self.mass[(i, j)] * field[j]).sum())
             .collect()
     }
-
-    /// Adds the unbalance forces (N) to `out` (length n_dof) for rotor angle `angle_rad` (rad),
-    /// speed `speed_rad_s` (rad/s) and angular acceleration `accel_rad_s2` (rad/s²)
-    /// ([`unbalance_force`]). Allocates nothing.
-    pub fn add_unbalance_force(
-        &self,
-        angle_rad: f64,
-        speed_rad_s: f64,
-        accel_rad_s2: f64,
-        out: &mut [f64],
-    ) {
-        for u in &self.unbalance {
-            let [fx, fy] = unbalance_force(
-                u.magnitude_kg_m,
-                angle_rad + u.phase_rad,
-                speed_rad_s,
-                accel_rad_s2,
-            );
-            out[4 * u.node] += fx;
-            out[4 * u.node + 1] += fy;
-        }
-    }
 }
 
 /// The force `[F_x, F_y]` (N) of an unbalance m·e = `magnitude_kg_m` (kg·m) at angle

@@ -18,6 +18,7 @@ mod unbalance_response;
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
+pub(crate) use machine::{mapping_name, shown};
 pub use machine::{
     AlarmLevelsSpec, BearingModelSpec, BearingSpec, DiscSpec, FilmSpec, GroovesSpec, LubricantSpec,
     MachineDescription, MachineDescriptionOf, MaterialSpec, OilHeatingModel, OilHeatingSpec,

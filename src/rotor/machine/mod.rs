@@ -26,6 +26,7 @@ pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 use super::error::ConfigError;
 use checks::MAX_MACHINE_FILE_BYTES;
 use rules::Rules;
+pub(crate) use rules::{mapping_name, shown};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;

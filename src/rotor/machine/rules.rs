@@ -98,6 +98,22 @@ impl Rules<'_> {
     }
 }
 
+/// A station or probe name given in a topic mapping (`--probe-point`, `--probe-signal`, the
+/// node's `probe_point_topics` / `probe_signal_topics`): the machine file's name rules, the
+/// error naming `option` and showing at most 40 characters of the name (issue 15, item 13).
+pub(crate) fn mapping_name(option: &str, name: &str) -> Result<(), String> {
+    let rule = if name.trim().is_empty() {
+        "must not be empty".to_string()
+    } else if name.chars().count() > MAX_NAME_CHARS {
+        format!("must be at most {MAX_NAME_CHARS} characters")
+    } else if name.chars().any(char::is_control) {
+        "must not contain control characters".to_string()
+    } else {
+        return Ok(());
+    };
+    Err(format!("{option}: name {} {rule}", shown(name)))
+}
+
 /// `value` as shown in an error: at most 40 characters, then its length.
 pub(crate) fn shown(value: &str) -> String {
     if value.chars().count() <= 40 {
