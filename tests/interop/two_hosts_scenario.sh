@@ -10,6 +10,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 ip link set lo up
 # host B: waits for its end of the veth pair, then runs the peers
 unshare -n bash -c '
+  : > "$3/b_ready"
   for i in $(seq 100); do ip link show vb >/dev/null 2>&1 && break; sleep 0.05; done
   ip link set lo up
   ip addr add 10.99.0.2/24 dev vb
@@ -21,6 +22,9 @@ unshare -n bash -c '
   ip -s -o link show vb > "$3/b_link.txt"
 ' host_b "$py" "$here" "$out" &
 b=$!
+# the child must have entered its own namespace before its end of the link is moved there (seen
+# once under load: the link moved before unshare, so host B never got it)
+for i in $(seq 200); do [ -e "$out/b_ready" ] && break; sleep 0.05; done
 ip link add va type veth peer name vb
 ip link set vb netns "$b"
 ip addr add 10.99.0.1/24 dev va
