@@ -300,7 +300,7 @@ fn simulate_text_gives_one_growth_rate_and_says_none() {
     let printed: Vec<&str> = text
         .split("growth ")
         .skip(1)
-        .map(|t| t.split(|c| c == ',' || c == '\n').next().unwrap())
+        .map(|t| t.split([',', '\n']).next().unwrap())
         .collect();
     assert!(!printed.is_empty(), "{text}");
     for p in &printed {

@@ -268,8 +268,8 @@ fn check_capacity(model: &mut dyn FilmModel, args: &BearingArgs, w: f64) -> anyh
 }
 
 fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
-    check_speed(args)?;
     let (mut model, lubricant) = film_from_flags(args)?;
+    check_speed(args)?;
     let omega = rpm_to_rad_s(args.speed_rpm);
     let eq: Equilibrium = match args.eccentricity_ratio {
         Some(e) => equilibrium_at_eccentricity(model.as_mut(), args.viscosity_pa_s, e, omega),
