@@ -1,14 +1,15 @@
 use clap::Parser;
 
 fn main() -> std::process::ExitCode {
-    let cli = rotor_twin::cli::Cli::parse();
+    let cli =
+        rotor_twin::cli::Cli::parse_from(rotor_twin::cli::numbers_as_values(std::env::args_os()));
     if cli.is_filter() {
         end_quietly_on_a_closed_stdout();
     }
     match rotor_twin::cli::run(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", rotor_twin::cli::error_text(&e));
             std::process::ExitCode::FAILURE
         }
     }

@@ -17,8 +17,10 @@ pub struct SweepPoint {
     pub speed_rpm: f64,
     /// The monitor's classification of the last revolutions.
     pub state: RotorState,
-    /// Growth of the rev-to-rev orbit difference per revolution (log slope).
-    pub growth_per_rev: f64,
+    /// The monitor's growth rate of the sub-synchronous amplitude (1/rev: the slope of its
+    /// logarithm per revolution), the largest of the bearings'; None before the monitor has
+    /// enough revolutions to tell (the same figure as `simulate`'s `subsync_growth_per_rev`).
+    pub subsync_growth_per_rev: Option<f64>,
     /// Largest eccentricity ratio of any bearing.
     pub max_eccentricity_ratio: f64,
     /// Largest sub-synchronous frequency ratio of any bearing (× running speed).
@@ -58,12 +60,13 @@ pub struct SweepError {
 }
 
 impl Sweep {
-    /// The onset: the first speed whose non-synchronous motion grows, or that is classified
-    /// unstable (rpm); None if stable over the range.
+    /// The onset: the first speed the monitor classifies other than stable (rpm); None if
+    /// stable over the range. The monitor's rule is the one rule (a growth above zero alone
+    /// made an onset before, beside rows the monitor called stable).
     pub fn onset_speed_rpm(&self) -> Option<f64> {
         self.points
             .iter()
-            .find(|p| p.state != RotorState::Stable || p.growth_per_rev > 0.0)
+            .find(|p| p.state != RotorState::Stable)
             .map(|p| p.speed_rpm)
     }
 
@@ -74,8 +77,9 @@ impl Sweep {
 
     /// The sweep as CSV: one row per speed, three columns per bearing.
     pub fn csv(&self) -> String {
-        let mut csv =
-            String::from("speed_rpm,state,growth_per_rev,max_eccentricity_ratio,subsync_ratio");
+        let mut csv = String::from(
+            "speed_rpm,state,subsync_growth_per_rev,max_eccentricity_ratio,subsync_ratio",
+        );
         for s in &self.series {
             let name = &s.name;
             csv.push_str(&format!(
@@ -89,7 +93,8 @@ impl Sweep {
                     "{},{:?},{},{},{}",
                     p.speed_rpm,
                     p.state,
-                    p.growth_per_rev,
+                    p.subsync_growth_per_rev
+                        .map_or(String::new(), |g| g.to_string()),
                     p.max_eccentricity_ratio,
                     p.subsync_ratio
                 )
@@ -177,7 +182,11 @@ impl Sweep {
         self.points.push(SweepPoint {
             speed_rpm,
             state: rep.state,
-            growth_per_rev: r.growth_per_rev(),
+            subsync_growth_per_rev: rep
+                .bearings
+                .iter()
+                .filter_map(|b| b.subsync_growth_per_rev)
+                .reduce(f64::max),
             max_eccentricity_ratio: largest(|b| b.max_eccentricity_ratio),
             subsync_ratio: largest(|b| b.subsync_ratio),
             bearings: rep
@@ -219,7 +228,10 @@ mod tests {
         assert_eq!(calls.load(Ordering::SeqCst), 2);
         assert_eq!(sweep.speeds_rpm(), vec![9000.0, 8000.0]);
         assert_eq!(sweep.points[1].state, RotorState::Stable);
-        assert!(sweep.points[1].growth_per_rev < 0.0);
+        let g = sweep.points[1]
+            .subsync_growth_per_rev
+            .expect("60 revolutions give a rate");
+        assert!(g < 0.0, "{g}");
         assert_eq!(sweep.onset_speed_rpm(), Some(9000.0));
         let csv = sweep.csv();
         let rows: Vec<&str> = csv.lines().collect();

@@ -146,15 +146,21 @@ fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
     (code, err)
 }
 
+/// A scratch directory holding a regular file, and the path `leaf` under that file: no
+/// directory can be made there.
+fn blocked_path(name: &str, leaf: &str) -> (PathBuf, PathBuf) {
+    let dir = scratch(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a-file");
+    std::fs::write(&file, "").unwrap();
+    (dir.clone(), file.join(leaf))
+}
+
 /// `sweep` refuses a speed beyond the twin's limit and an output it cannot make before computing
 /// any speed (issue 15, item 20): before, the progress bar ran through every speed first.
 #[test]
 fn sweep_checks_its_speeds_and_output_first() {
-    let dir = scratch("sweep-first");
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("a-file");
-    std::fs::write(&file, "").unwrap();
-    let blocked = file.join("sweep");
+    let (dir, blocked) = blocked_path("sweep-first", "sweep");
     for (args, expect) in [
         // 100,000 rpm: above 10× the built-in machine's rated 9,000 rpm
         (
@@ -474,4 +480,239 @@ fn a_replay_that_never_starts_the_twin_fails_and_says_why() {
         }
         assert!(out.join("report.json").is_file(), "{name}");
     }
+}
+
+/// Runs the CLI; asserts exit 1 (a refusal, not a panic and not a success) and an error of at
+/// most 300 characters that contains `expect` once, with no "-i"-style flag reading; returns it.
+fn refused(args: &[&str], expect: &str) -> String {
+    let (ok, _out, err) = run_cli(args);
+    assert!(!ok, "{args:?} succeeded: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    assert!(err.contains(expect), "{args:?}: {err}");
+    assert_eq!(err.matches(expect).count(), 1, "{args:?} twice: {err}");
+    assert!(err.len() < 300, "{args:?}: {} characters: {err}", err.len());
+    assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    err
+}
+
+/// A negative number, `-inf` among them, is the value of the option before it in every
+/// subcommand, and meets that option's own check (issue 15, item 21: `-inf` was read as the
+/// flags `-i -n -f` in `bearing`, `modes`, `response` and `simulate --revs`).
+#[test]
+fn negative_numbers_are_values_in_every_subcommand() {
+    for (args, expect) in [
+        (
+            &["bearing", "--speed-rpm", "-inf"][..],
+            "invalid --speed-rpm -inf",
+        ),
+        (&["bearing", "--speed-rpm", "-5"], "invalid --speed-rpm -5"),
+        (&["modes", "--from-rpm", "-inf"], "invalid --from-rpm -inf"),
+        (&["modes", "--to-rpm", "-inf"], "invalid --to-rpm -inf"),
+        (&["response", "--to-rpm", "-inf"], "invalid --to-rpm -inf"),
+        (
+            &["response", "--step-rpm", "-inf"],
+            "invalid --step-rpm -inf",
+        ),
+        (
+            &["simulate", "--speed-rpm", "3000", "--revs", "-inf"],
+            "invalid value '-inf' for '--revs",
+        ),
+        (
+            &["simulate", "--speed-rpm", "3000", "--revs", "-5"],
+            "invalid value '-5' for '--revs",
+        ),
+        (
+            &["simulate", "--speed-rpm", "-inf", "--revs", "2"],
+            "invalid speed -inf rpm",
+        ),
+        (
+            &[
+                "sweep",
+                "--from-rpm",
+                "-inf",
+                "--to-rpm",
+                "4000",
+                "--step-rpm",
+                "500",
+            ],
+            "invalid --from-rpm -inf",
+        ),
+        (
+            &[
+                "simulate",
+                "--revs",
+                "2",
+                "--speed-rpm",
+                "3000",
+                "--kick",
+                "-0.5:3:1:0",
+            ],
+            "invalid --kick \"-0.5:3:1:0\": T = -0.5 s must be at least 0",
+        ),
+    ] {
+        refused(args, expect);
+    }
+}
+
+/// `bearing --speed-rpm` is checked before the equilibrium is sought, the error naming the
+/// field, the value as given (rpm) and the valid range (issue 15, item 21: -5, 1 and 1e30 rpm
+/// said "static equilibrium not found"; `--speed-rpm=-inf` was reported in rad/s).
+#[test]
+fn bearing_names_a_speed_out_of_its_range() {
+    // Ø 60 mm: 500 m/s of surface speed is 500 / (π · 0.06) · 60 = 159,155 rpm
+    for speed in ["--speed-rpm=-inf", "--speed-rpm=-5", "--speed-rpm=1e30"] {
+        let err = refused(&["bearing", speed], "must lie in (0, 159155] rpm");
+        let given = speed.trim_start_matches("--speed-rpm=");
+        let shown = if given == "1e30" { "1.000e30" } else { given };
+        assert!(
+            err.contains(&format!("invalid --speed-rpm {shown}:")),
+            "{err}"
+        );
+        assert!(
+            !err.contains("rad/s") && !err.contains("equilibrium"),
+            "{err}"
+        );
+    }
+    // 1 rpm cannot carry 275 N: the lowest speed that can is named, and it is right: the finite
+    // film's force is proportional to the speed (laminar, isoviscous: Reynolds' equation is
+    // linear in ω), so 10 % above that speed the equilibrium is found at an ε just below the
+    // bound, and at 0.9 of it the same refusal comes back.
+    let err = refused(
+        &["bearing", "--speed-rpm", "1"],
+        "too slow for the load of 275 N",
+    );
+    let lowest: f64 = err
+        .split("lowest speed that carries it is about ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{err}"));
+    // 1 rpm: 11.79 N at ε 0.994, so 275 / 11.79 = 23.3 rpm
+    assert!((lowest - 23.4).abs() < 0.15, "{err}");
+    // just above it the equilibrium lies near the bound (at 24 rpm Newton's method still fails)
+    let above = 1.1 * lowest;
+    let (ok, out, err) = run_cli(&["bearing", "--speed-rpm", &above.to_string(), "--json"]);
+    assert!(ok, "{above} rpm: {err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let eps = v["eccentricity_ratio"].as_f64().unwrap();
+    assert!(eps > 0.98 && eps < 0.994, "ε {eps} at {above} rpm");
+    refused(
+        &["bearing", "--speed-rpm", &(0.9 * lowest).to_string()],
+        "too slow for the load of 275 N",
+    );
+}
+
+/// Numbers in errors are shown in a bounded format, never 300 digits (issue 15, item 21).
+#[test]
+fn huge_numbers_are_not_echoed_whole() {
+    refused(
+        &["modes", "--from-rpm", "1e300"],
+        "invalid --from-rpm 1.000e300",
+    );
+    refused(
+        &["response", "--to-rpm", "1e300"],
+        "invalid --to-rpm 1.000e300",
+    );
+    let e = refusal(&machine_with(
+        "gravity_m_s2: [0.0, -9.81]",
+        "gravity_m_s2: [0.0, -1e300]",
+    ));
+    assert!(
+        e.contains("gravity_m_s2[1] = -1.000e300") && e.len() < 300,
+        "{e}"
+    );
+}
+
+/// `rated_speed_rpm` is bounded by the shaft's surface speed (issue 15, item 21: 1e9 rpm was
+/// accepted and `simulate` at 5e8 rpm reported "stable").
+#[test]
+fn a_rated_speed_no_shaft_survives_is_refused() {
+    // the shipped machine's largest shaft diameter is 60 mm: 500 m/s is 159,155 rpm
+    let e = refusal(&machine_with(
+        "rated_speed_rpm: 9000",
+        "rated_speed_rpm: 1e9",
+    ));
+    assert!(
+        e.contains("rated_speed_rpm = 1000000000") && e.contains("at most 159155 rpm"),
+        "{e}"
+    );
+    MachineDescription::from_yaml(
+        &machine_with("rated_speed_rpm: 9000", "rated_speed_rpm: 150000"),
+        "m.yaml",
+    )
+    .expect("150,000 rpm: 471 m/s on Ø 60 mm");
+}
+
+/// Each field of `--kick` and `--speed-history` is checked before the run, the error naming it
+/// (issue 15, item 21: an impulse of 1e300 N·s and a speed of 1e300 rpm gave unrelated errors).
+#[test]
+fn kick_and_speed_history_fields_are_named() {
+    let base = ["simulate", "--revs", "2"];
+    for (extra, expect) in [
+        (
+            &["--speed-rpm", "3000", "--kick", "0.01:15:1e300:0"][..],
+            "invalid --kick \"0.01:15:1e300:0\": JX = 1.000e300 N·s must be at most",
+        ),
+        (
+            &["--speed-rpm", "3000", "--kick", "0.01:99:1:0"],
+            "NODE = 99 must be a shaft node, 0 to 30",
+        ),
+        (
+            &["--speed-history", "0:8000,1:1e300"],
+            "invalid --speed-history \"1:1e300\": RPM = 1.000e300 rpm: above 90000 rpm",
+        ),
+        (
+            &["--ramp", "3000:1e300:100"],
+            "invalid --ramp \"3000:1e300:100\": TO = 1.000e300 rpm: above 90000 rpm",
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        refused(&args, expect);
+    }
+}
+
+/// Output paths are checked before anything is computed, missing directories made, and an
+/// error reported once (issue 15, items 20 and 21: `simulate --plot`, `--history-csv`, `modes
+/// --plot` and `response --plot` failed only after the computation, the text doubled).
+#[test]
+fn outputs_are_checked_before_computing() {
+    let (dir, blocked) = blocked_path("outputs", "out");
+    let b = blocked.to_str().unwrap();
+    let simulate = |option| vec!["simulate", "--speed-rpm", "3000", "--revs", "2", option, b];
+    for (args, expect) in [
+        (simulate("--plot"), "--plot: creating"),
+        (
+            simulate("--history-csv"),
+            "--history-csv: cannot write into",
+        ),
+        (vec!["modes", "--plot", b], "--plot: cannot write into"),
+        (
+            vec!["modes", "--shapes-rpm", "9000", "--shapes-plot", b],
+            "--shapes-plot: cannot write into",
+        ),
+        (vec!["response", "--plot", b], "--plot: cannot write into"),
+    ] {
+        let err = refused(&args, expect);
+        assert!(
+            !err.contains("backend") && !err.contains("film tables"),
+            "{err}"
+        );
+    }
+    // a missing directory is made, as `sweep --out` does
+    let deep = dir.join("new/deeper/campbell.svg");
+    let (ok, _, err) = run_cli(&["modes", "--plot", deep.to_str().unwrap()]);
+    assert!(ok && deep.exists(), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The one format of numbers in errors: as written when short, else four significant digits.
+#[test]
+fn long_numbers_are_shown_in_scientific_notation() {
+    use rotor_twin::units::shown_value;
+    assert_eq!(shown_value(9000.0), "9000");
+    assert_eq!(shown_value(-5.0), "-5");
+    assert_eq!(shown_value(f64::NEG_INFINITY), "-inf");
+    assert_eq!(shown_value(1e300), "1.000e300");
+    assert_eq!(shown_value(-1.23456e-7), "-1.235e-7");
+    assert_eq!(shown_value(0.1 + 0.2), "3.000e-1");
 }

@@ -102,7 +102,7 @@ fn sweep_writes_csv_and_svg() {
     assert!(v.get("onset_speed_rpm").is_some());
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3);
-    assert!(csv.starts_with("speed_rpm,state,growth_per_rev"));
+    assert!(csv.starts_with("speed_rpm,state,subsync_growth_per_rev"));
     assert!(std::fs::read_to_string(dir.join("sweep.svg"))
         .unwrap()
         .starts_with("<svg"));
@@ -268,4 +268,78 @@ fn ramp_follows_its_rate_and_bad_drives_are_named() {
         assert!(err.contains(word), "{a:?}: '{err}' does not name {word}");
     }
     std::fs::remove_dir_all(dir).ok();
+}
+
+/// The text report of `simulate` gives one growth rate, the monitor's, named with its unit, and
+/// says "none" where no sub-synchronous component stands out (issue 15, item 21: the summary
+/// line printed a second growth rate, of the orbit difference, beside the monitor's; "at
+/// 0.000X" stood for no component). The JSON run of the same input gives the figures printed.
+#[test]
+fn simulate_text_gives_one_growth_rate_and_says_none() {
+    let args = ["simulate", "--speed-rpm", "6000", "--revs", "48"];
+    let (ok, text, err) = run_cli(&args);
+    assert!(ok, "{err}");
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let (ok, out, err) = run_cli(&json_args);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    assert!(v.get("growth_per_rev").is_none(), "a second growth figure");
+    let rates: Vec<String> = v["bearings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let g = b["subsync_growth_per_rev"]
+                .as_f64()
+                .expect("48 revolutions give a rate");
+            format!("{g:+.4} /rev")
+        })
+        .collect();
+    // every growth in the text is one of the monitor's, with its unit
+    let printed: Vec<&str> = text
+        .split("growth ")
+        .skip(1)
+        .map(|t| t.split([',', '\n']).next().unwrap())
+        .collect();
+    assert!(!printed.is_empty(), "{text}");
+    for p in &printed {
+        assert!(
+            rates.iter().any(|r| r == p),
+            "growth {p:?} is not the monitor's {rates:?}: {text}"
+        );
+    }
+    // 6,000 rpm is far below the threshold (8,471 rpm): no sub-synchronous component
+    assert_eq!(v["bearings"][0]["subsync_ratio"], 0.0);
+    assert!(
+        text.contains("sub-sync none") && !text.contains("0.000X"),
+        "{text}"
+    );
+}
+
+/// `sweep`'s onset is the monitor's: a row the monitor calls stable is no onset whatever the
+/// sign of its growth (issue 15, item 21: any growth above 0 made an onset before, beside a
+/// "Stable" row), and the first row it calls otherwise is.
+#[test]
+fn the_sweep_onset_is_the_monitors_rule() {
+    use rotor_twin::monitor::RotorState;
+    use rotor_twin::sweep::{Sweep, SweepPoint};
+    let point = |speed_rpm, state, g: f64| SweepPoint {
+        speed_rpm,
+        state,
+        subsync_growth_per_rev: Some(g),
+        max_eccentricity_ratio: 0.3,
+        subsync_ratio: 0.0,
+        bearings: Vec::new(),
+    };
+    let mut sweep = Sweep {
+        points: vec![
+            point(8000.0, RotorState::Stable, -0.01),
+            point(8400.0, RotorState::Stable, 0.001),
+        ],
+        series: Vec::new(),
+    };
+    assert_eq!(sweep.onset_speed_rpm(), None);
+    sweep.points.push(point(8800.0, RotorState::Growing, 0.004));
+    assert_eq!(sweep.onset_speed_rpm(), Some(8800.0));
 }

@@ -145,6 +145,43 @@ fn run_command(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// The command line with every negative number that follows a long option joined to it
+/// (`--speed-rpm -inf` → `--speed-rpm=-inf`): the one home of the rule that a word starting
+/// with `-` which reads as a number (`-5`, `-1e3`, `-inf`, `-NaN`) or starts as one
+/// (`--kick -0.1:15:1:0`) is that option's value, not a
+/// flag, in every subcommand (clap's `allow_negative_numbers` knows digits only and read `-inf`
+/// as the flags `-i -n -f`). The value then meets the option's own check, which names it. Stops at
+/// `--` and `--ros-args` (what follows is not ours to parse).
+pub fn numbers_as_values(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    let mut joinable = false;
+    let mut ours = true;
+    for arg in args {
+        let text = arg.to_str().unwrap_or("");
+        let number = text.strip_prefix('-').is_some_and(|rest| {
+            text.parse::<f64>().is_ok()
+                || rest.starts_with(|c: char| c.is_ascii_digit() || c == '.')
+        });
+        match out.last_mut() {
+            Some(option) if ours && joinable && number => {
+                option.push("=");
+                option.push(&arg);
+                joinable = false;
+                continue;
+            }
+            _ => {}
+        }
+        if text == "--" || text == "--ros-args" {
+            ours = false;
+        }
+        joinable = text.starts_with("--") && text.len() > 2 && !text.contains('=');
+        out.push(arg);
+    }
+    out
+}
+
 /// The speeds (rpm) of `[--from-rpm, --to-rpm, --step-rpm]`, checked: by default from 10 % of
 /// the rated speed `rated` (at least 100 rpm) to 150 % of it in `steps` steps; at most
 /// `max_steps` steps. Returns (speeds, from, to, step), the last speed capped at `to`.
@@ -154,24 +191,104 @@ pub(crate) fn speed_grid_rpm(
     steps: f64,
     max_steps: f64,
 ) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
+    use crate::units::shown_value as v;
     let from = from.unwrap_or((0.1 * rated).max(100.0));
     let to = to.unwrap_or(1.5 * rated);
-    for (name, v) in [("--from-rpm", from), ("--to-rpm", to)] {
+    let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rated;
+    for (name, n) in [("--from-rpm", from), ("--to-rpm", to)] {
         anyhow::ensure!(
-            v.is_finite() && v > 0.0,
-            "invalid {name} {v}: must be a finite speed above zero"
+            n.is_finite() && n > 0.0 && n <= max_rpm,
+            "invalid {name} {}: must lie in (0, {max_rpm:.0}] rpm, above zero and at most {}× \
+             the rated speed",
+            v(n),
+            crate::dynamics::MAX_SPEED_OVER_RATED
         );
     }
     anyhow::ensure!(
         to > from,
-        "invalid --to-rpm {to}: must exceed --from-rpm {from}"
+        "invalid --to-rpm {}: must exceed --from-rpm {}",
+        v(to),
+        v(from)
     );
     let step = step.unwrap_or((to - from) / steps);
     anyhow::ensure!(
         step.is_finite() && step > 0.0 && (to - from) / step <= max_steps,
-        "invalid --step-rpm {step}: must be above zero, at most {max_steps} speeds"
+        "invalid --step-rpm {}: must be above zero, at most {max_steps} speeds",
+        v(step)
     );
     let n = ((to - from) / step).round() as usize;
     let speeds = (0..=n).map(|k| (from + k as f64 * step).min(to)).collect();
     Ok((speeds, from, to, step))
+}
+
+/// Where a command writes: a directory of files, or one file (a plot prefix is a file whose
+/// name the command extends).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Output {
+    Directory,
+    File,
+}
+
+/// An output of `option`, checked before anything is computed (issue 15, item 20: `simulate
+/// --plot`, `modes --plot`, … found an unwritable path only after the computation): the missing
+/// directories are made (as `sweep --out` always did) and a file is created and removed where the
+/// output will go; an existing output file must open for writing. The error names the option and
+/// the path, once.
+pub(crate) fn check_output(
+    option: &str,
+    path: &std::path::Path,
+    kind: Output,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let dir = match kind {
+        Output::Directory => path,
+        Output::File => {
+            anyhow::ensure!(
+                !path.is_dir(),
+                "{option} {}: is a directory, not a file",
+                path.display()
+            );
+            match path.parent() {
+                Some(p) if !p.as_os_str().is_empty() => p,
+                _ => std::path::Path::new("."),
+            }
+        }
+    };
+    anyhow::ensure!(
+        !dir.exists() || dir.is_dir(),
+        "{option}: cannot write into {}: not a directory",
+        dir.display()
+    );
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{option}: creating {}", dir.display()))?;
+    if kind == Output::File && path.exists() {
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .with_context(|| format!("{option}: cannot write {}", path.display()))?;
+        return Ok(());
+    }
+    let probe = dir.join(format!(".rotor-twin-write-check-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .with_context(|| format!("{option}: cannot write into {}", dir.display()))?;
+    std::fs::remove_file(&probe).ok();
+    Ok(())
+}
+
+/// The error as the command line prints it: each cause after the context that names it, a
+/// cause whose text the line already holds left out (issue 15, item 21: plotters' "backend
+/// error" wraps the I/O error and repeats its text, so `{:#}` printed it twice).
+pub fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
 }

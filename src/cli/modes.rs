@@ -12,7 +12,6 @@ use std::path::PathBuf;
 
 /// Linear rotordynamics of a machine: modes, Campbell diagram, threshold of stability.
 #[derive(Debug, Clone, Args)]
-#[command(allow_negative_numbers = true)]
 pub struct ModesArgs {
     /// Machine description (YAML); the built-in ORC microturbine if absent.
     #[arg(long)]
@@ -181,6 +180,20 @@ fn speed_range(args: &ModesArgs, rated: f64) -> anyhow::Result<(Vec<f64>, f64, f
     Ok(grid)
 }
 
+/// The plot files, checked before anything is computed.
+fn check_outputs(args: &ModesArgs) -> anyhow::Result<()> {
+    for (option, path) in [
+        ("--plot", &args.plot),
+        ("--shapes-plot", &args.shapes_plot),
+        ("--rotor-plot", &args.rotor_plot),
+    ] {
+        if let Some(path) = path {
+            super::check_output(option, path, super::Output::File)?;
+        }
+    }
+    Ok(())
+}
+
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let desc = MachineDescription::load(args.config.as_deref())?;
     let mut rotor = Rotor::from_description(&desc);
@@ -191,6 +204,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
     }
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
+    check_outputs(args)?;
     let statics = static_solution(&rotor).context("static deflection")?;
     let heated = heat_for_threshold(&mut rotor, &statics, (from, to, step), desc.rated_speed_rpm)
         .context("effective temperatures")?;

@@ -8,11 +8,10 @@ use crate::rotor::{
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Unbalance response of the linear model: 1X amplitude and phase lag against speed.
 #[derive(Debug, Clone, Args)]
-#[command(allow_negative_numbers = true)]
 pub struct ResponseArgs {
     /// Machine description (YAML); the built-in ORC microturbine if absent.
     #[arg(long)]
@@ -66,17 +65,38 @@ fn speed_grid(args: &ResponseArgs, rated: f64) -> anyhow::Result<Vec<f64>> {
     Ok(super::speed_grid_rpm(range, rated, 200.0, 5000.0)?.0)
 }
 
+/// The file `--plot PREFIX` writes for `suffix` (`_bode.svg`, `_polar.svg`).
+fn plot_path(prefix: &Path, suffix: &str) -> PathBuf {
+    let mut p = prefix.as_os_str().to_owned();
+    p.push(suffix);
+    PathBuf::from(p)
+}
+
+/// The operating speed range (rpm; default the rated speed) and the plot files, checked before
+/// anything is computed.
+fn operating_range(args: &ResponseArgs, rated: f64) -> anyhow::Result<(f64, f64)> {
+    let n_min = args.min_operating_rpm.unwrap_or(rated);
+    let n_max = args.max_continuous_rpm.unwrap_or(rated);
+    anyhow::ensure!(
+        n_min.is_finite() && n_min > 0.0 && n_max >= n_min,
+        "invalid --min-operating-rpm {} / --max-continuous-rpm {}: need 0 < min ≤ max",
+        crate::units::shown_value(n_min),
+        crate::units::shown_value(n_max)
+    );
+    if let Some(prefix) = &args.plot {
+        for suffix in ["_bode.svg", "_polar.svg"] {
+            super::check_output("--plot", &plot_path(prefix, suffix), super::Output::File)?;
+        }
+    }
+    Ok((n_min, n_max))
+}
+
 pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
     let desc = MachineDescription::load(args.config.as_deref())?;
     let rotor = Rotor::from_description(&desc);
     let rated = desc.rated_speed_rpm;
     let speeds = speed_grid(args, rated)?;
-    let n_min = args.min_operating_rpm.unwrap_or(rated);
-    let n_max = args.max_continuous_rpm.unwrap_or(rated);
-    anyhow::ensure!(
-        n_min.is_finite() && n_min > 0.0 && n_max >= n_min,
-        "invalid --min-operating-rpm {n_min} / --max-continuous-rpm {n_max}: need 0 < min ≤ max"
-    );
+    let (n_min, n_max) = operating_range(args, rated)?;
     anyhow::ensure!(
         !rotor.unbalance.is_empty(),
         "the machine has no unbalance: add one under `unbalance:` in the machine file"
@@ -109,11 +129,7 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
         stations,
     };
     if let Some(prefix) = &args.plot {
-        let with = |suffix: &str| {
-            let mut p = prefix.clone().into_os_string();
-            p.push(suffix);
-            PathBuf::from(p)
-        };
+        let with = |suffix: &str| plot_path(prefix, suffix);
         let curves: Vec<crate::plot::ResponseCurve> = report
             .stations
             .iter()

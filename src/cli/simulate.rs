@@ -3,8 +3,9 @@
 use crate::dynamics::Coupling;
 use crate::film::FilmGrid;
 use crate::monitor::RotorState;
-use crate::rotor::{MachineDescription, Rotor};
+use crate::rotor::{shown, MachineDescription, Rotor};
 use crate::transient::{run_driven, Drive, Kick, SpeedHistory, TransientResult, TransientSpec};
+use crate::units::shown_value;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -96,35 +97,40 @@ impl RunOptions {
         Ok((desc, rotor))
     }
 
+    /// Why the twin cannot run at `speed_rpm` (issue 15, item 21), if it cannot: the one rule of
+    /// `--speed-rpm`, the speeds of `--ramp` and `--speed-history`, and `sweep`'s speeds.
+    fn speed_rule(&self, speed_rpm: f64, rotor: &Rotor) -> Result<(), String> {
+        if !(speed_rpm.is_finite() && speed_rpm > 0.0) {
+            return Err("must be finite and above zero".into());
+        }
+        let rpm = 30.0 / std::f64::consts::PI;
+        let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * rpm;
+        if speed_rpm > max_rpm {
+            return Err(format!(
+                "above {max_rpm:.0} rpm, {}× the rated speed of {}",
+                crate::dynamics::MAX_SPEED_OVER_RATED,
+                rotor.name
+            ));
+        }
+        // one revolution in steps_per_rev steps of at most MAX_TIME_STEP_S
+        let min_rpm = 60.0 / (self.steps_per_rev as f64 * crate::dynamics::MAX_TIME_STEP_S);
+        if speed_rpm <= min_rpm {
+            return Err(format!(
+                "at or below {min_rpm:.2} rpm, where {} steps a revolution make the time step {} s or longer (raise --steps-per-rev)",
+                self.steps_per_rev,
+                crate::dynamics::MAX_TIME_STEP_S
+            ));
+        }
+        Ok(())
+    }
+
     /// The transient at `speed_rpm`, refused with the reason when the twin cannot run there
     /// (issue 15, item 21: a negative speed said "equilibrium not found", 1 rpm "invalid time
     /// step 0.46875", a 300-digit speed was tried and echoed whole).
     fn spec(&self, speed_rpm: f64, rotor: &Rotor) -> anyhow::Result<TransientSpec> {
-        let shown = if speed_rpm.abs() < 1e9 {
-            format!("{speed_rpm}")
-        } else {
-            format!("{speed_rpm:.3e}")
-        };
-        anyhow::ensure!(
-            speed_rpm.is_finite() && speed_rpm > 0.0,
-            "invalid speed {shown} rpm: must be finite and above zero"
-        );
-        let rpm = 30.0 / std::f64::consts::PI;
-        let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * rpm;
-        anyhow::ensure!(
-            speed_rpm <= max_rpm,
-            "invalid speed {shown} rpm: above {max_rpm:.0} rpm, {}× the rated speed of {}",
-            crate::dynamics::MAX_SPEED_OVER_RATED,
-            rotor.name
-        );
-        // one revolution in steps_per_rev steps of at most MAX_TIME_STEP_S
-        let min_rpm = 60.0 / (self.steps_per_rev as f64 * crate::dynamics::MAX_TIME_STEP_S);
-        anyhow::ensure!(
-            speed_rpm > min_rpm,
-            "invalid speed {shown} rpm: at or below {min_rpm:.2} rpm, where {} steps a revolution make the time step {} s or longer (raise --steps-per-rev)",
-            self.steps_per_rev,
-            crate::dynamics::MAX_TIME_STEP_S
-        );
+        self.speed_rule(speed_rpm, rotor).map_err(|rule| {
+            anyhow::anyhow!("invalid speed {} rpm: {rule}", shown_value(speed_rpm))
+        })?;
         Ok(TransientSpec {
             speed_rpm,
             revolutions: self.revs,
@@ -139,10 +145,9 @@ impl RunOptions {
 /// A nonlinear transient at constant speed or along a speed history, with kicks: orbits,
 /// spectrum, classification.
 #[derive(Debug, Clone, Args)]
-#[command(allow_negative_numbers = true)]
 pub struct SimulateArgs {
     /// Speed (rpm); not with --ramp or --speed-history.
-    #[arg(long, allow_hyphen_values = true,
+    #[arg(long,
           required_unless_present_any = ["ramp", "speed_history"],
           conflicts_with_all = ["ramp", "speed_history"])]
     speed_rpm: Option<f64>,
@@ -174,7 +179,8 @@ fn numbers(option: &str, text: &str, fields: &[&str]) -> anyhow::Result<Vec<f64>
     let parts: Vec<&str> = text.split(':').collect();
     anyhow::ensure!(
         parts.len() == fields.len(),
-        "invalid {option} '{text}': expected {}",
+        "invalid {option} {}: expected {}",
+        shown(text),
         fields.join(":")
     );
     parts
@@ -186,24 +192,78 @@ fn numbers(option: &str, text: &str, fields: &[&str]) -> anyhow::Result<Vec<f64>
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
-                    anyhow::anyhow!("invalid {option} '{text}': {f} = '{p}' is not a finite number")
+                    anyhow::anyhow!(
+                        "invalid {option} {}: {f} = {} is not a finite number",
+                        shown(text),
+                        shown(p)
+                    )
                 })
         })
         .collect()
 }
 
+/// Largest velocity (m/s) a `--kick` may give the whole rotor, J / M: 1 m/s crosses a 0.1 mm
+/// clearance in 0.1 ms, about two time steps at 9,000 rpm and 128 steps a revolution; a larger
+/// impulse is no disturbance the film model can follow, and 1e300 N·s is a typing slip.
+const MAX_KICK_VELOCITY_M_S: f64 = 1.0;
+
+/// `--kick T:NODE:JX:JY`, each field checked and named: T at least 0, NODE a shaft node, the
+/// impulse within [`MAX_KICK_VELOCITY_M_S`] times the rotor's mass.
+fn kick(text: &str, rotor: &Rotor) -> anyhow::Result<Kick> {
+    let v = numbers("--kick", text, &["T", "NODE", "JX", "JY"])?;
+    let shown = shown(text);
+    anyhow::ensure!(
+        v[0] >= 0.0,
+        "invalid --kick {shown}: T = {} s must be at least 0",
+        shown_value(v[0])
+    );
+    let nodes = rotor.node_z_m.len();
+    anyhow::ensure!(
+        v[1] >= 0.0 && v[1].fract() == 0.0 && v[1] < nodes as f64,
+        "invalid --kick {shown}: NODE = {} must be a shaft node, 0 to {}",
+        shown_value(v[1]),
+        nodes - 1
+    );
+    let mass_kg: f64 = rotor.elements.iter().map(|e| e.mass_kg()).sum::<f64>()
+        + rotor.discs.iter().map(|d| d.mass_kg).sum::<f64>();
+    let max_n_s = MAX_KICK_VELOCITY_M_S * mass_kg;
+    for (field, j) in [("JX", v[2]), ("JY", v[3])] {
+        anyhow::ensure!(
+            j.abs() <= max_n_s,
+            "invalid --kick {shown}: {field} = {} N·s must be at most {} N·s in size, the \
+             impulse that gives the whole rotor ({mass_kg:.1} kg) {MAX_KICK_VELOCITY_M_S} m/s",
+            shown_value(j),
+            shown_value((max_n_s * 1e3).round() / 1e3)
+        );
+    }
+    Ok(Kick {
+        time_s: v[0],
+        node: v[1] as usize,
+        impulse_n_s: [v[2], v[3]],
+    })
+}
+
 impl SimulateArgs {
-    /// The speed history and kicks the options ask for, checked.
-    fn drive(&self) -> anyhow::Result<Drive> {
+    /// The speed history and kicks the options ask for, checked field by field before anything
+    /// is computed (issue 15, item 21: `--speed-history 0:8000,1:1e300` and `--kick
+    /// 0.01:15:1e300:0` gave errors unrelated to the field).
+    fn drive(&self, rotor: &Rotor) -> anyhow::Result<Drive> {
         let speed = match (&self.ramp, &self.speed_history) {
             (Some(r), _) => {
                 let v = numbers("--ramp", r, &["FROM", "TO", "RATE"])?;
+                for (field, rpm) in [("FROM", v[0]), ("TO", v[1])] {
+                    self.check_field_speed("--ramp", r, field, rpm, rotor)?;
+                }
                 Some(SpeedHistory::ramp(v[0], v[1], v[2]).context("--ramp")?)
             }
             (None, Some(h)) => {
                 let points = h
                     .split(',')
-                    .map(|p| numbers("--speed-history", p, &["T", "RPM"]).map(|v| (v[0], v[1])))
+                    .map(|p| {
+                        let v = numbers("--speed-history", p, &["T", "RPM"])?;
+                        self.check_field_speed("--speed-history", p, "RPM", v[1], rotor)?;
+                        Ok((v[0], v[1]))
+                    })
                     .collect::<anyhow::Result<Vec<_>>>()?;
                 Some(SpeedHistory::new(points).context("--speed-history")?)
             }
@@ -212,20 +272,27 @@ impl SimulateArgs {
         let kicks = self
             .kick
             .iter()
-            .map(|k| {
-                let v = numbers("--kick", k, &["T", "NODE", "JX", "JY"])?;
-                anyhow::ensure!(
-                    v[0] >= 0.0 && v[1] >= 0.0 && v[1].fract() == 0.0,
-                    "invalid --kick '{k}': T must be at least 0 and NODE a shaft node number"
-                );
-                Ok(Kick {
-                    time_s: v[0],
-                    node: v[1] as usize,
-                    impulse_n_s: [v[2], v[3]],
-                })
-            })
+            .map(|k| kick(k, rotor))
             .collect::<anyhow::Result<Vec<_>>>()?;
         Ok(Drive { speed, kicks })
+    }
+
+    /// A speed field of `option` ('text'), under the one speed rule.
+    fn check_field_speed(
+        &self,
+        option: &str,
+        text: &str,
+        field: &str,
+        rpm: f64,
+        rotor: &Rotor,
+    ) -> anyhow::Result<()> {
+        self.options.speed_rule(rpm, rotor).map_err(|rule| {
+            anyhow::anyhow!(
+                "invalid {option} {}: {field} = {} rpm: {rule}",
+                shown(text),
+                shown_value(rpm)
+            )
+        })
     }
 
     /// The speed the run starts at (rpm).
@@ -282,7 +349,6 @@ struct SimulateReport {
     evidence: String,
     rev_to_rev_orbit_diff: f64,
     rev_to_rev_pressure_diff: f64,
-    growth_per_rev: f64,
     wall_time_s: f64,
     simulated_time_s: f64,
     real_time_factor: f64,
@@ -392,7 +458,6 @@ fn summarise(
         evidence: rep.evidence(),
         rev_to_rev_orbit_diff: rep.rev_to_rev_orbit_diff,
         rev_to_rev_pressure_diff: rep.rev_to_rev_pressure_diff,
-        growth_per_rev: r.growth_per_rev(),
         wall_time_s: r.wall_time_s,
         simulated_time_s: r.simulated_s,
         real_time_factor: r.real_time_factor(),
@@ -440,8 +505,14 @@ fn summarise(
 
 pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     let (desc, rotor) = args.options.machine()?;
-    let drive = args.drive()?;
+    let drive = args.drive(&rotor)?;
     let spec = args.options.spec(args.start_speed_rpm(&drive), &rotor)?;
+    if let Some(dir) = &args.plot {
+        super::check_output("--plot", dir, super::Output::Directory)?;
+    }
+    if let Some(path) = &args.history_csv {
+        super::check_output("--history-csv", path, super::Output::File)?;
+    }
     let result = run_driven(&rotor, &spec, None, &drive).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
@@ -479,20 +550,20 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             );
         }
         println!(
-            "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}; growth {:+.4}/rev",
-            report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff, report.growth_per_rev
+            "  last two revolutions: orbit difference {:.2e} of the clearance, pressure-field difference {:.2e}",
+            report.rev_to_rev_orbit_diff, report.rev_to_rev_pressure_diff
         );
         for b in &report.bearings {
             println!(
-                "  {:<22} orbit p-p {:6.2} × {:6.2} µm, max ε {:.3}, 1X {:6.2} µm @ {:6.1}°, sub-sync {:6.2} µm @ {:.3}X, p_max {:.3} MPa",
+                "  {:<22} orbit p-p {:6.2} × {:6.2} µm, max ε {:.3}, 1X {:6.2} µm @ {:6.1}°, sub-sync {}, growth {}, p_max {:.3} MPa",
                 b.name,
                 b.orbit_pp_x_m * 1e6,
                 b.orbit_pp_y_m * 1e6,
                 b.max_eccentricity_ratio,
                 b.one_x_amplitude_m * 1e6,
                 b.one_x_phase_deg,
-                b.subsync_amplitude_m * 1e6,
-                b.subsync_ratio,
+                crate::monitor::subsync_words(b.subsync_ratio, b.subsync_amplitude_m),
+                crate::monitor::growth_words_per_rev(b.subsync_growth_per_rev),
                 b.max_pressure_pa * 1e-6
             );
         }
@@ -560,16 +631,15 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
 
 /// Amplitude–speed characteristic: a transient at each speed, in parallel.
 #[derive(Debug, Clone, Args)]
-#[command(allow_negative_numbers = true)]
 pub struct SweepArgs {
     /// Lowest speed (rpm).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     from_rpm: f64,
     /// Highest speed (rpm).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     to_rpm: f64,
     /// Speed step (rpm).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long)]
     step_rpm: f64,
     #[command(flatten)]
     options: RunOptions,
@@ -594,17 +664,12 @@ struct SweepReport {
 /// What a sweep can check before computing any speed (issue 15, item 20): every speed within
 /// the twin's limit for this machine, and an output directory that can be made.
 fn check_sweep_first(args: &SweepArgs, rotor: &Rotor) -> anyhow::Result<()> {
-    let max_rpm = crate::dynamics::MAX_SPEED_OVER_RATED * rotor.rated_speed_rad_s * 30.0
-        / std::f64::consts::PI;
-    anyhow::ensure!(
-        args.to_rpm <= max_rpm,
-        "invalid --to-rpm {}: above {max_rpm:.0} rpm, {}× the rated speed of {}",
-        args.to_rpm,
-        crate::dynamics::MAX_SPEED_OVER_RATED,
-        rotor.name
-    );
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("--out: creating {}", args.out.display()))
+    for (option, rpm) in [("--from-rpm", args.from_rpm), ("--to-rpm", args.to_rpm)] {
+        args.options
+            .speed_rule(rpm, rotor)
+            .map_err(|rule| anyhow::anyhow!("invalid {option} {}: {rule}", shown_value(rpm)))?;
+    }
+    super::check_output("--out", &args.out, super::Output::Directory)
 }
 
 /// The sweep's speeds (rpm), checked: finite, positive, ascending, at most 500.
@@ -616,20 +681,21 @@ fn sweep_speeds(args: &SweepArgs) -> anyhow::Result<Vec<f64>> {
     ] {
         anyhow::ensure!(
             v.is_finite() && v > 0.0,
-            "invalid {name} {v}: must be a finite speed above zero"
+            "invalid {name} {}: must be a finite speed above zero",
+            shown_value(v)
         );
     }
     anyhow::ensure!(
         args.to_rpm >= args.from_rpm,
         "invalid --to-rpm {}: below --from-rpm {}",
-        args.to_rpm,
-        args.from_rpm
+        shown_value(args.to_rpm),
+        shown_value(args.from_rpm)
     );
     let count = ((args.to_rpm - args.from_rpm) / args.step_rpm).round() as usize + 1;
     anyhow::ensure!(
         count <= 500,
         "invalid --step-rpm {}: more than 500 speeds",
-        args.step_rpm
+        shown_value(args.step_rpm)
     );
     Ok((0..count)
         .map(|k| (args.from_rpm + k as f64 * args.step_rpm).min(args.to_rpm))
@@ -696,12 +762,16 @@ fn print_sweep(report: &SweepReport, json: bool) -> anyhow::Result<()> {
     );
     for p in &report.points {
         println!(
-            "  {:>8.0} rpm  {:<8}  growth {:+.4}/rev  max ε {:.3}  sub-sync {:.3}X",
+            "  {:>8.0} rpm  {:<8}  sub-sync growth {}  max ε {:.3}  sub-sync {}",
             p.speed_rpm,
             format!("{:?}", p.state),
-            p.growth_per_rev,
+            crate::monitor::growth_words_per_rev(p.subsync_growth_per_rev),
             p.max_eccentricity_ratio,
-            p.subsync_ratio
+            if p.subsync_ratio > 0.0 {
+                format!("{:.3}X", p.subsync_ratio)
+            } else {
+                "none".into()
+            }
         );
     }
     match report.onset_speed_rpm {

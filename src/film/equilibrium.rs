@@ -8,6 +8,9 @@ use std::f64::consts::PI;
 
 /// Newton iterations allowed for an equilibrium.
 const MAX_ITERATIONS: usize = 60;
+/// Largest eccentricity ratio the static equilibrium is sought at (a margin below the film
+/// models' [`MAX_ECCENTRICITY_RATIO`]): a load the film cannot carry there has no equilibrium.
+pub const MAX_EQUILIBRIUM_ECCENTRICITY: f64 = 0.995 * MAX_ECCENTRICITY_RATIO;
 
 /// A static equilibrium and the film there.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -132,7 +135,7 @@ pub fn equilibrium_under_load(
         let mut accepted = false;
         for _ in 0..30 {
             let trial = [q[0] + dq[0], q[1] + dq[1]];
-            if trial[0].hypot(trial[1]) < 0.995 * MAX_ECCENTRICITY_RATIO * c {
+            if trial[0].hypot(trial[1]) < MAX_EQUILIBRIUM_ECCENTRICITY * c {
                 let tk = JournalKinematics::at_position(trial, speed_rad_s);
                 if let Ok((f, cf)) = model.solve_with_coefficients(&tk) {
                     let tr = residual(&f);

@@ -29,7 +29,7 @@ mod viscosity;
 pub use coefficients::{matrix2, rows2, FilmCoefficients};
 pub use equilibrium::{
     equilibrium_at_eccentricity, equilibrium_under_load, short_bearing_eccentricity,
-    sommerfeld_number, Equilibrium,
+    sommerfeld_number, Equilibrium, MAX_EQUILIBRIUM_ECCENTRICITY,
 };
 pub use error::FilmError;
 pub use finite::FiniteFilm;

@@ -154,9 +154,8 @@ impl RevolutionReport {
             .collect();
         let text = match worst {
             Some((i, b)) => format!(
-                "bearing {i}: sub-synchronous {:.2} µm at {:.3}X vs 1X {:.2} µm, max eccentricity {:.3}, rev-to-rev orbit diff {:.2e}, pressure diff {:.2e}{}",
-                b.subsync_amplitude_m * 1e6,
-                b.subsync_ratio,
+                "bearing {i}: sub-synchronous {} vs 1X {:.2} µm, max eccentricity {:.3}, rev-to-rev orbit diff {:.2e}, pressure diff {:.2e}{}",
+                subsync_words(b.subsync_ratio, b.subsync_amplitude_m),
                 b.one_x_amplitude_m * 1e6,
                 b.max_eccentricity_ratio,
                 b.orbit_diff,
@@ -169,10 +168,30 @@ impl RevolutionReport {
     }
 }
 
+/// The sub-synchronous component as reports show it: its size (µm) and order, or "none" when
+/// no component stands above the monitor's floor (`subsync_ratio` 0: "at 0.000X" said before).
+/// The one wording for `simulate`, `sweep` and the evidence.
+pub fn subsync_words(subsync_ratio: f64, subsync_amplitude_m: f64) -> String {
+    if subsync_ratio > 0.0 {
+        format!("{:.2} µm at {subsync_ratio:.3}X", subsync_amplitude_m * 1e6)
+    } else {
+        "none".into()
+    }
+}
+
+/// A growth rate of the sub-synchronous amplitude as reports show it, with its unit: the slope
+/// of its logarithm per revolution, or "not yet known" before the monitor has the revolutions.
+pub fn growth_words_per_rev(growth_per_rev: Option<f64>) -> String {
+    match growth_per_rev {
+        Some(g) => format!("{g:+.4} /rev"),
+        None => "not yet known".into(),
+    }
+}
+
 /// The growth, contact and validity clauses of the evidence (allocates).
 fn growth_words(b: &BearingRevolution) -> String {
     let mut s = match b.subsync_growth_per_rev {
-        Some(g) => format!(", growth {g:+.4}/rev"),
+        Some(g) => format!(", sub-synchronous growth {g:+.4} /rev"),
         None => String::new(),
     };
     if let Some(t) = b.time_to_alert_s {

@@ -97,7 +97,10 @@ pub struct WindowComparison {
     pub measured: OrbitFeatures,
     /// The predicted orbit.
     pub predicted: OrbitFeatures,
-    /// RMS distance between the two orbits with their means removed (m): the shape difference.
+    /// RMS distance between the two orbits with their means removed (m), sample by sample at
+    /// equal times: it mixes a phase difference with a shape difference (two equal ellipses a
+    /// quarter turn apart in phase differ by √2 × their radius), so it is no measure of shape
+    /// alone; the 1X vectors and the sub-synchronous figures are.
     pub orbit_rms_distance_m: f64,
     /// Distance between the two mean positions (m).
     pub mean_position_distance_m: f64,

@@ -53,7 +53,8 @@ pub struct StationReport {
     pub subsync_ratio_predicted: Option<f64>,
     /// Measured sub-synchronous order, null unless it counts.
     pub subsync_ratio_measured: Option<f64>,
-    /// RMS distance between the predicted and measured orbits, means removed (m).
+    /// RMS distance between the predicted and measured orbits, means removed, sample by sample
+    /// at equal times (m): phase and shape differences together, not a shape measure.
     pub orbit_rms_distance_m: Option<f64>,
     /// Distance between the mean positions (m).
     pub mean_position_distance_m: Option<f64>,
@@ -298,7 +299,7 @@ impl ReplayReport {
         let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
         for st in &self.stations {
             s += &format!(
-                "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit shape RMS distance {}\n",
+                "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit RMS distance at equal times {}\n",
                 st.station,
                 um(st.one_x_amplitude_predicted_m),
                 um(st.one_x_amplitude_measured_m),

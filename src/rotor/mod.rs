@@ -24,7 +24,7 @@ pub use machine::{
     MachineDescription, MachineDescriptionOf, MaterialSpec, OilHeatingModel, OilHeatingSpec,
     ProbeSpec, ProximityProbeSpec, RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec,
     UnbalanceSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER, DEFAULT_MACHINE_NAME,
-    DEFAULT_MACHINE_YAML,
+    DEFAULT_MACHINE_YAML, MAX_SURFACE_SPEED_M_S,
 };
 pub(crate) use modal::BearingSolvers;
 pub use modal::{

@@ -15,6 +15,13 @@ pub const MAX_SHAFT_ELEMENTS: usize = 200;
 const MAX_SECTION_ELEMENTS: usize = 200;
 /// Largest stiffness-proportional damping coefficient β (s): beyond it the shaft is a dashpot.
 const MAX_SHAFT_DAMPING_BETA_S: f64 = 1e-2;
+/// Largest surface speed of a shaft (m/s), π·D·n at the rated speed n over its largest outer
+/// diameter D: the centrifugal stress at the centre of a spinning solid cylinder,
+/// (3 + ν)/8 · ρ · v² (Timoshenko & Goodier, rotating disc), is 0.81 GPa for steel (ρ 7850 kg/m³,
+/// ν 0.3) at 500 m/s, the yield strength of a quenched-and-tempered alloy steel (34CrNiMo6:
+/// 0.8–0.9 GPa): no shaft runs faster, so a rated speed beyond it is a unit slip, not a machine.
+/// The `bearing` command bounds the journal speed by the same figure.
+pub const MAX_SURFACE_SPEED_M_S: f64 = 500.0;
 /// Largest gravity component (m/s²).
 const MAX_GRAVITY_M_S2: f64 = 100.0;
 
@@ -35,6 +42,23 @@ impl MachineDescription {
     /// Rated speed, alarm levels, shaft damping, gravity.
     fn check_general(&self, rules: &Rules) -> Result<(), ConfigError> {
         rules.positive("rated_speed_rpm", self.rated_speed_rpm)?;
+        let diameter_m = self
+            .shaft
+            .iter()
+            .map(|s| s.outer_diameter_m)
+            .fold(0.0, f64::max);
+        let max_rpm = MAX_SURFACE_SPEED_M_S / (std::f64::consts::PI * diameter_m) * 60.0;
+        if self.rated_speed_rpm > max_rpm {
+            return Err(rules.error(
+                "rated_speed_rpm",
+                crate::units::shown_value(self.rated_speed_rpm),
+                format!(
+                    "must be at most {max_rpm:.0} rpm: the shaft's surface speed (Ø {diameter_m} m) \
+                     would exceed {MAX_SURFACE_SPEED_M_S} m/s, where the centrifugal stress reaches \
+                     the yield strength of steel"
+                ),
+            ));
+        }
         if let Some(a) = &self.alarm_levels {
             rules.positive("alarm_levels.alert_amplitude_m", a.alert_amplitude_m)?;
             rules.positive("alarm_levels.danger_amplitude_m", a.danger_amplitude_m)?;
@@ -58,7 +82,7 @@ impl MachineDescription {
             if !g.is_finite() || g.abs() > MAX_GRAVITY_M_S2 {
                 return Err(rules.error(
                     format!("gravity_m_s2[{i}]"),
-                    g,
+                    crate::units::shown_value(*g),
                     format!("must be finite and at most {MAX_GRAVITY_M_S2} m/s² in size"),
                 ));
             }

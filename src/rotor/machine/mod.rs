@@ -25,6 +25,7 @@ pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 
 use super::error::ConfigError;
 use checks::MAX_MACHINE_FILE_BYTES;
+pub use checks::MAX_SURFACE_SPEED_M_S;
 use rules::Rules;
 pub(crate) use rules::{mapping_name, shown};
 use serde::{Deserialize, Serialize};
@@ -50,7 +51,10 @@ pub struct MachineDescriptionOf<B> {
     /// Free text: what the machine is and where its figures come from.
     #[serde(default)]
     pub description: String,
-    /// Rated speed (rpm).
+    /// Rated speed (rpm). At most the speed at which the shaft's largest outer diameter turns at
+    /// [`MAX_SURFACE_SPEED_M_S`] (500 m/s, where a steel shaft's centrifugal stress reaches its
+    /// yield strength): the twin runs to 10× this speed, so an unbounded rated speed would let it
+    /// report as "stable" speeds no rotor survives.
     pub rated_speed_rpm: f64,
     /// Gravity `[g_x, g_y]` in the machine frame (m/s²); `[0, -9.81]` for y up.
     #[serde(default = "default_gravity")]

@@ -34,7 +34,11 @@ impl Rules<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(self.error(field, v, "must be a finite number greater than zero"))
+            Err(self.error(
+                field,
+                crate::units::shown_value(v),
+                "must be a finite number greater than zero",
+            ))
         }
     }
 
@@ -43,7 +47,11 @@ impl Rules<'_> {
         if v.is_finite() && v >= 0.0 {
             Ok(())
         } else {
-            Err(self.error(field, v, "must be a finite number, zero or more"))
+            Err(self.error(
+                field,
+                crate::units::shown_value(v),
+                "must be a finite number, zero or more",
+            ))
         }
     }
 
@@ -52,7 +60,7 @@ impl Rules<'_> {
         if v.is_finite() {
             Ok(())
         } else {
-            Err(self.error(field, v, "must be finite"))
+            Err(self.error(field, crate::units::shown_value(v), "must be finite"))
         }
     }
 
