@@ -79,7 +79,7 @@ def main():
                     o = out[ns]
                     o["reports"] += 1
                     o["rtf"].append(float(v["real_time_factor"]))
-                    o.setdefault("raw", []).append((round(time.time() - start, 2), v["real_time_factor"], v["lag_s"], v["step_overruns"], v["worst_step_us"]))
+                    o.setdefault("raw", []).append((round(time.time() - start, 2), v["real_time_factor"], v["lag_s"], v["step_overruns"], v["worst_step_us"], v.get("wakes")))
                     o["lag_s"].append(float(v["lag_s"]))
                     if "wakes" in v:
                         o.setdefault("wakes", []).append(int(v["wakes"]))
