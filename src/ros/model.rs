@@ -100,45 +100,50 @@ pub struct NodeCounters {
 pub struct Audience {
     /// the node follows its writers' matched readers
     watched: AtomicBool,
-    /// bit k ([`Audience::bit`]): that output has at least one matched reader
+    /// bit k: [`Gated`] output k has at least one matched reader
     matched: AtomicU64,
     /// outputs not made because no reader wanted them
     pub skipped: AtomicU64,
 }
 
-impl Audience {
-    /// The bits of the gated outputs: journal states, film states, orbits, residuals.
-    pub const JOURNAL: u32 = 0;
+/// The outputs published only to a reader (each a bit of [`Audience`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Gated {
+    /// Journal states.
+    Journal,
     /// Film states.
-    pub const FILM: u32 = 1;
+    Film,
     /// Orbits.
-    pub const ORBIT: u32 = 2;
+    Orbit,
     /// Residuals.
-    pub const RESIDUAL: u32 = 3;
+    Residual,
+}
 
+impl Audience {
     /// From now on only the outputs with a matched reader are wanted.
     pub fn watch(&self) {
         self.watched.store(true, Ordering::Relaxed);
     }
 
-    /// The bit of a gated output; None for the outputs that are always published (the latched
+    /// Which gated output `o` is; None for the outputs that are always published (the latched
     /// warning and margin, the diagnostics, the forecast).
-    pub fn bit(o: &Outgoing) -> Option<u32> {
+    pub fn gated(o: &Outgoing) -> Option<Gated> {
         match o {
-            Outgoing::Journal(_) => Some(Self::JOURNAL),
-            Outgoing::Film(_) => Some(Self::FILM),
-            Outgoing::Orbit(_) => Some(Self::ORBIT),
-            Outgoing::Residual(_) => Some(Self::RESIDUAL),
+            Outgoing::Journal(_) => Some(Gated::Journal),
+            Outgoing::Film(_) => Some(Gated::Film),
+            Outgoing::Orbit(_) => Some(Gated::Orbit),
+            Outgoing::Residual(_) => Some(Gated::Residual),
             _ => None,
         }
     }
 
-    /// Says whether output `bit` has a matched reader now.
-    pub fn set(&self, bit: u32, has_reader: bool) {
+    /// Says whether output `g` has a matched reader now.
+    pub fn set(&self, g: Gated, has_reader: bool) {
+        let bit = 1u64 << (g as u32);
         if has_reader {
-            self.matched.fetch_or(1 << bit, Ordering::Relaxed);
+            self.matched.fetch_or(bit, Ordering::Relaxed);
         } else {
-            self.matched.fetch_and(!(1 << bit), Ordering::Relaxed);
+            self.matched.fetch_and(!bit, Ordering::Relaxed);
         }
     }
 
@@ -147,8 +152,8 @@ impl Audience {
         if !self.watched.load(Ordering::Relaxed) {
             return true;
         }
-        let wanted =
-            Self::bit(o).is_none_or(|b| self.matched.load(Ordering::Relaxed) & (1 << b) != 0);
+        let matched = self.matched.load(Ordering::Relaxed);
+        let wanted = Self::gated(o).is_none_or(|g| matched & (1 << (g as u32)) != 0);
         if !wanted {
             self.skipped.fetch_add(1, Ordering::Relaxed);
         }

@@ -593,11 +593,11 @@ fn follow_readers(
 }
 
 /// Follows which readers on the bus are matched to the writers of the gated outputs (`gated`:
-/// writer and [`model::Audience::bit`]) from the participant's status events (the node runs no
+/// writer and output) from the participant's status events (the node runs no
 /// ros2-client Spinner, which would keep this count), and tells the model thread.
 async fn watch_readers(
     participant: ros2_client::dds::rustdds::DomainParticipant,
-    gated: Vec<(ros2_client::dds::rustdds::GUID, u32)>,
+    gated: Vec<(ros2_client::dds::rustdds::GUID, model::Gated)>,
     counters: Arc<model::NodeCounters>,
 ) {
     use ros2_client::dds::rustdds::{DomainParticipantStatusEvent as Event, StatusEvented};
@@ -619,21 +619,21 @@ async fn watch_readers(
             }),
             _ => continue,
         }
-        for ((_, bit), r) in gated.iter().zip(&readers) {
-            counters.audience.set(*bit, !r.is_empty());
+        for ((_, g), r) in gated.iter().zip(&readers) {
+            counters.audience.set(*g, !r.is_empty());
         }
     }
 }
 
 impl Publishers {
-    /// The writers of the outputs published only to a reader, with their [`model::Audience`] bit.
-    fn gated(&self) -> Vec<(ros2_client::dds::rustdds::GUID, u32)> {
-        use model::Audience;
+    /// The writers of the outputs published only to a reader.
+    fn gated(&self) -> Vec<(ros2_client::dds::rustdds::GUID, model::Gated)> {
+        use model::Gated;
         vec![
-            (self.journal.guid(), Audience::JOURNAL),
-            (self.film.guid(), Audience::FILM),
-            (self.orbit.guid(), Audience::ORBIT),
-            (self.residual.guid(), Audience::RESIDUAL),
+            (self.journal.guid(), Gated::Journal),
+            (self.film.guid(), Gated::Film),
+            (self.orbit.guid(), Gated::Orbit),
+            (self.residual.guid(), Gated::Residual),
         ]
     }
 
@@ -754,13 +754,7 @@ fn subscribe_inputs(
     // --- end oil supply temperature ---
     // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
     let stations = rotor.probes.iter().map(|p| p.name.as_str());
-    let mapped = mapped_topics(
-        &params.probe_point_topics,
-        stations,
-        "probe_point_topics",
-        "station",
-        "the machine description",
-    )?;
+    let mapped = mapped_topics(&params.probe_point_topics, stations, &POINT_TOPICS)?;
     for (i, k, name) in mapped {
         route.subscribe::<messages::PointStamped>(
             node,
@@ -814,13 +808,7 @@ fn subscribe_plant_signals(
         ToRecord::ProbeSignal,
     )?;
     let probes = rotor.proximity_probes.iter().map(|p| p.name.as_str());
-    let mapped = mapped_topics(
-        &params.probe_signal_topics,
-        probes,
-        "probe_signal_topics",
-        "probe",
-        "the machine description's proximity_probes",
-    )?;
+    let mapped = mapped_topics(&params.probe_signal_topics, probes, &SIGNAL_TOPICS)?;
     for (i, k, name) in mapped {
         route.subscribe::<messages::Float64>(
             node,
@@ -833,16 +821,25 @@ fn subscribe_plant_signals(
     Ok(())
 }
 
+/// A topic-mapping parameter, for its errors: its name, what it maps, where those are listed.
+struct Mapping(&'static str, &'static str, &'static str);
+
+const POINT_TOPICS: Mapping = Mapping("probe_point_topics", "station", "the machine description");
+const SIGNAL_TOPICS: Mapping = Mapping(
+    "probe_signal_topics",
+    "probe",
+    "the machine description's proximity_probes",
+);
+
 /// The `name=/topic` pairs of a topic-mapping parameter (`probe_point_topics`,
 /// `probe_signal_topics`) as (pair index, index of the name among `known`, topic); a name not
 /// known or a topic that does not parse is an error naming the parameter and the value.
 fn mapped_topics<'a>(
     pairs: &[(String, String)],
     known: impl Iterator<Item = &'a str> + Clone,
-    parameter: &str,
-    what: &str,
-    where_known: &str,
+    mapping: &Mapping,
 ) -> anyhow::Result<Vec<(usize, usize, Name)>> {
+    let Mapping(parameter, what, where_known) = mapping;
     let mut mapped = Vec::with_capacity(pairs.len());
     for (i, (entry, topic_text)) in pairs.iter().enumerate() {
         let k = known.clone().position(|n| n == entry).ok_or_else(|| {
