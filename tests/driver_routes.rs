@@ -501,3 +501,26 @@ fn probes_stamped_an_hour_off_the_clock_are_warned_about() {
         }
     }
 }
+
+/// The node's outputs without a reader (issue 17): until the node watches its readers (tests, a
+/// recording) every output is wanted; then the journal and film states, orbits and residuals
+/// only while a reader is matched, each counted when not made; the warning, margin and
+/// diagnostics always.
+#[test]
+fn states_without_a_reader_are_not_published_once_watched() {
+    use rotor_twin::ros::model::{Audience, Gated};
+    let a = Audience::default();
+    let journal = || Outgoing::Journal(messages::JournalState::default());
+    let orbit = || Outgoing::Orbit(messages::Orbit::default());
+    let warning = || Outgoing::Warning(messages::InstabilityWarning::default());
+    assert!(a.wants(&journal()) && a.wants(&orbit()) && a.wants(&warning()));
+    a.watch();
+    assert!(!a.wants(&journal()) && !a.wants(&orbit()));
+    assert!(a.wants(&warning()));
+    a.set(Gated::Journal, true);
+    assert!(a.wants(&journal()) && !a.wants(&orbit()));
+    a.set(Gated::Journal, false);
+    assert!(!a.wants(&journal()));
+    // journal, orbit, orbit, journal refused above
+    assert_eq!(a.skipped.load(std::sync::atomic::Ordering::Relaxed), 4);
+}

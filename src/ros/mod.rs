@@ -13,6 +13,8 @@
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
 //!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
 //!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz;
+//!   the journal and film states, orbits and residuals only while a reader is matched (all of
+//!   them when recording: [`model::Audience`]);
 //!
 //! Every QoS is in [`crate::topics`]. The subscriptions only decode and queue, stamped with the
 //! receive time on the node's clock; the model thread feeds the queue to the shared

@@ -37,6 +37,13 @@ pub const INBOX_CAPACITY: usize = 65_536;
 /// and 64 steps a revolution, 256 steps are 27 ms of model time).
 pub const MAX_STEPS_PER_WAKE: usize = 256;
 
+/// How often the model thread wakes at most when nothing else wakes it (issue 17): each wake runs
+/// every step then due, so a twin at 9,000 rpm and 64 steps a revolution takes about 19 steps a
+/// wake instead of waking once or twice a step. A speed or unbalance input wakes it at once
+/// (the subscription unparks the model thread), so the latency from a speed to the first output that reflects it stays
+/// within this period plus the state interval.
+pub const WAKE_PERIOD: Duration = Duration::from_millis(2);
+
 /// An input waiting for the model thread.
 #[derive(Debug)]
 pub struct Queued {
@@ -81,6 +88,77 @@ pub struct NodeCounters {
     pub lost_inputs: Mutex<Vec<(String, u64)>>,
     /// `lost_inputs` in all at the last diagnostics.
     pub lost_reported: AtomicU64,
+    /// Which high-rate outputs have a reader on the bus.
+    pub audience: Audience,
+}
+
+/// Which of the twin's high-rate outputs (journal and film states, orbits, residuals) have a
+/// matched reader on the bus (issue 17: a twin nobody watches publishes its diagnostics,
+/// warnings, margin and the node's own messages, not its states). Until [`Audience::watch`]
+/// (tests, a node that records) every output is wanted.
+#[derive(Debug, Default)]
+pub struct Audience {
+    /// the node follows its writers' matched readers
+    watched: AtomicBool,
+    /// bit k: [`Gated`] output k has at least one matched reader
+    matched: AtomicU64,
+    /// outputs not made because no reader wanted them
+    pub skipped: AtomicU64,
+}
+
+/// The outputs published only to a reader (each a bit of [`Audience`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Gated {
+    /// Journal states.
+    Journal,
+    /// Film states.
+    Film,
+    /// Orbits.
+    Orbit,
+    /// Residuals.
+    Residual,
+}
+
+impl Audience {
+    /// From now on only the outputs with a matched reader are wanted.
+    pub fn watch(&self) {
+        self.watched.store(true, Ordering::Relaxed);
+    }
+
+    /// Which gated output `o` is; None for the outputs that are always published (the latched
+    /// warning and margin, the diagnostics, the forecast).
+    pub fn gated(o: &Outgoing) -> Option<Gated> {
+        match o {
+            Outgoing::Journal(_) => Some(Gated::Journal),
+            Outgoing::Film(_) => Some(Gated::Film),
+            Outgoing::Orbit(_) => Some(Gated::Orbit),
+            Outgoing::Residual(_) => Some(Gated::Residual),
+            _ => None,
+        }
+    }
+
+    /// Says whether output `g` has a matched reader now.
+    pub fn set(&self, g: Gated, has_reader: bool) {
+        let bit = 1u64 << (g as u32);
+        if has_reader {
+            self.matched.fetch_or(bit, Ordering::Relaxed);
+        } else {
+            self.matched.fetch_and(!bit, Ordering::Relaxed);
+        }
+    }
+
+    /// True if `o` is to be published (and counts it when not).
+    pub fn wants(&self, o: &Outgoing) -> bool {
+        if !self.watched.load(Ordering::Relaxed) {
+            return true;
+        }
+        let matched = self.matched.load(Ordering::Relaxed);
+        let wanted = Self::gated(o).is_none_or(|g| matched & (1 << (g as u32)) != 0);
+        if !wanted {
+            self.skipped.fetch_add(1, Ordering::Relaxed);
+        }
+        wanted
+    }
 }
 
 impl NodeCounters {
@@ -190,12 +268,17 @@ struct Timing {
     worst_step_us: f64,
     lag_s: f64,
     last_behind_warning: Option<Instant>,
+    wakes: u64,
+    /// the last wake stopped at [`MAX_STEPS_PER_WAKE`] with steps still due
+    behind: bool,
 }
 
 impl Timing {
     fn new() -> Self {
         Self {
             since: Instant::now(),
+            wakes: 0,
+            behind: false,
             steps: 0,
             overruns: 0,
             worst_step_us: 0.0,
@@ -292,25 +375,34 @@ impl ModelLoop {
 
     /// Runs until `stop` is set. Messages go to `out`; when `out` is full a message is dropped
     /// and counted (the model never waits for the bus).
+    ///
+    /// It wakes every [`WAKE_PERIOD`] (or at once when the thread is unparked: a speed or
+    /// unbalance input), runs every step due, and wakes again at once only while it is
+    /// behind by more than [`MAX_STEPS_PER_WAKE`] steps. Outputs without a reader are not
+    /// published ([`Audience`]).
     pub fn run(mut self, out: SyncSender<Published>, stop: Arc<AtomicBool>) {
         self.start_forecast(&out);
         let mut dropped = 0u64;
+        let counters = self.counters.clone();
+        let mut next = Instant::now();
         while !stop.load(Ordering::Relaxed) {
             let mut emit = |m: Outgoing| {
-                if out.try_send(Published::Twin(m)).is_err() {
+                if counters.audience.wants(&m) && out.try_send(Published::Twin(m)).is_err() {
                     dropped += 1;
                 }
             };
-            let busy = self.wake(&mut emit);
+            self.wake(&mut emit);
             for m in self.pending.drain(..) {
                 if out.try_send(m).is_err() {
                     dropped += 1;
                 }
             }
-            if !busy {
-                std::thread::sleep(Duration::from_millis(1));
-            }
             self.dropped_out = dropped;
+            let now = Instant::now();
+            next = (next + WAKE_PERIOD).max(now);
+            if !self.timing.behind {
+                std::thread::park_timeout(next - now);
+            }
         }
     }
 
@@ -323,6 +415,7 @@ impl ModelLoop {
     /// One wake: parameter changes, the queued inputs, the steps now due, the reports. False
     /// when there was nothing to do (the caller sleeps).
     pub fn wake(&mut self, emit: &mut impl FnMut(Outgoing)) -> bool {
+        self.timing.wakes += 1;
         self.take_parameters();
         if let Some(found) = *self.threshold.lock().unwrap_or_else(|e| e.into_inner()) {
             self.driver.set_threshold(found);
@@ -558,6 +651,7 @@ impl ModelLoop {
             steps += 1;
         }
         self.timing.steps += steps as u64;
+        self.timing.behind = steps == MAX_STEPS_PER_WAKE;
         if let Some(s) = self.driver.session() {
             self.timing.lag_s = ((now - s.stamp_ns()) as f64 * 1e-9).max(0.0);
         }
@@ -653,6 +747,15 @@ impl ModelLoop {
                 self.driver.counts().step_failures.to_string(),
             ),
             kv("time_step_us", format!("{:.2}", h * 1e6)),
+            kv("wakes", t.wakes.to_string()),
+            kv(
+                "outputs_without_reader",
+                self.counters
+                    .audience
+                    .skipped
+                    .load(Ordering::Relaxed)
+                    .to_string(),
+            ),
         ];
         let (level, message) = if self.counters.recording_failed.load(Ordering::Relaxed) {
             (

@@ -224,6 +224,8 @@ async fn run_async(
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
     let publishers = Publishers::create(&mut node, &ros)?;
+    let counters = Arc::new(model::NodeCounters::default());
+    follow_readers(&setup, &context, &publishers, &counters);
 
     let stop = Arc::new(AtomicBool::new(false));
     let (recorder_thread, rec) = start_recorder(&setup, &params, &stop)?;
@@ -235,7 +237,6 @@ async fn run_async(
         ..NodeClock::default()
     });
     let (out_tx, out_rx) = mpsc::sync_channel::<model::Published>(4096);
-    let counters = Arc::new(model::NodeCounters::default());
     let mut model = model::ModelLoop::new(
         rotor.clone(),
         params.clone(),
@@ -256,6 +257,7 @@ async fn run_async(
         clock,
         rec,
         counters: counters.clone(),
+        model: model_thread.thread().clone(),
     };
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
@@ -571,7 +573,70 @@ fn publisher<M: RosMessage>(
         .map_err(|e| anyhow::anyhow!("publisher {name}: {e:?}"))
 }
 
+/// Without a recording (which wants every output), only the outputs with a reader are published
+/// from now on ([`model::Audience`]), followed by [`watch_readers`].
+fn follow_readers(
+    setup: &NodeSetup,
+    context: &Context,
+    publishers: &Publishers,
+    counters: &Arc<model::NodeCounters>,
+) {
+    if setup.record.is_some() {
+        return;
+    }
+    counters.audience.watch();
+    tokio::spawn(watch_readers(
+        context.domain_participant(),
+        publishers.gated(),
+        counters.clone(),
+    ));
+}
+
+/// Follows which readers on the bus are matched to the writers of the gated outputs (`gated`:
+/// writer and output) from the participant's status events (the node runs no
+/// ros2-client Spinner, which would keep this count), and tells the model thread.
+async fn watch_readers(
+    participant: ros2_client::dds::rustdds::DomainParticipant,
+    gated: Vec<(ros2_client::dds::rustdds::GUID, model::Gated)>,
+    counters: Arc<model::NodeCounters>,
+) {
+    use ros2_client::dds::rustdds::{DomainParticipantStatusEvent as Event, StatusEvented};
+    let listener = participant.status_listener();
+    let mut events = listener.as_async_status_stream();
+    let mut readers = vec![std::collections::BTreeSet::new(); gated.len()];
+    while let Some(event) = events.next().await {
+        match event {
+            Event::RemoteReaderMatched {
+                local_writer,
+                remote_reader,
+            } => {
+                if let Some(k) = gated.iter().position(|g| g.0 == local_writer) {
+                    readers[k].insert(remote_reader);
+                }
+            }
+            Event::ReaderLost { guid, .. } => readers.iter_mut().for_each(|r| {
+                r.remove(&guid);
+            }),
+            _ => continue,
+        }
+        for ((_, g), r) in gated.iter().zip(&readers) {
+            counters.audience.set(*g, !r.is_empty());
+        }
+    }
+}
+
 impl Publishers {
+    /// The writers of the outputs published only to a reader.
+    fn gated(&self) -> Vec<(ros2_client::dds::rustdds::GUID, model::Gated)> {
+        use model::Gated;
+        vec![
+            (self.journal.guid(), Gated::Journal),
+            (self.film.guid(), Gated::Film),
+            (self.orbit.guid(), Gated::Orbit),
+            (self.residual.guid(), Gated::Residual),
+        ]
+    }
+
     fn create(node: &mut ros2_client::Node, ros: &RosArgs) -> anyhow::Result<Self> {
         use crate::topics as qos;
         Ok(Self {
@@ -688,14 +753,9 @@ fn subscribe_inputs(
     )?;
     // --- end oil supply temperature ---
     // probe pairs as geometry_msgs/PointStamped (x, y in m), one topic per station
-    for (i, (station, topic_text)) in params.probe_point_topics.iter().enumerate() {
-        let k = rotor
-            .probes
-            .iter()
-            .position(|p| p.name == *station)
-            .ok_or_else(|| anyhow::anyhow!("parameter probe_point_topics: station '{station}' is not in the machine description"))?;
-        let name = Name::parse(topic_text)
-            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+    let stations = rotor.probes.iter().map(|p| p.name.as_str());
+    let mapped = mapped_topics(&params.probe_point_topics, stations, &POINT_TOPICS)?;
+    for (i, k, name) in mapped {
         route.subscribe::<messages::PointStamped>(
             node,
             &name,
@@ -747,14 +807,9 @@ fn subscribe_plant_signals(
         |m| Ok(Input::from(m)),
         ToRecord::ProbeSignal,
     )?;
-    for (i, (probe, topic_text)) in params.probe_signal_topics.iter().enumerate() {
-        let k = rotor
-            .proximity_probes
-            .iter()
-            .position(|p| p.name == *probe)
-            .ok_or_else(|| anyhow::anyhow!("parameter probe_signal_topics: probe '{probe}' is not in the machine description's proximity_probes"))?;
-        let name = Name::parse(topic_text)
-            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+    let probes = rotor.proximity_probes.iter().map(|p| p.name.as_str());
+    let mapped = mapped_topics(&params.probe_signal_topics, probes, &SIGNAL_TOPICS)?;
+    for (i, k, name) in mapped {
         route.subscribe::<messages::Float64>(
             node,
             &name,
@@ -764,6 +819,37 @@ fn subscribe_plant_signals(
         )?;
     }
     Ok(())
+}
+
+/// A topic-mapping parameter, for its errors: its name, what it maps, where those are listed.
+struct Mapping(&'static str, &'static str, &'static str);
+
+const POINT_TOPICS: Mapping = Mapping("probe_point_topics", "station", "the machine description");
+const SIGNAL_TOPICS: Mapping = Mapping(
+    "probe_signal_topics",
+    "probe",
+    "the machine description's proximity_probes",
+);
+
+/// The `name=/topic` pairs of a topic-mapping parameter (`probe_point_topics`,
+/// `probe_signal_topics`) as (pair index, index of the name among `known`, topic); a name not
+/// known or a topic that does not parse is an error naming the parameter and the value.
+fn mapped_topics<'a>(
+    pairs: &[(String, String)],
+    known: impl Iterator<Item = &'a str> + Clone,
+    mapping: &Mapping,
+) -> anyhow::Result<Vec<(usize, usize, Name)>> {
+    let Mapping(parameter, what, where_known) = mapping;
+    let mut mapped = Vec::with_capacity(pairs.len());
+    for (i, (entry, topic_text)) in pairs.iter().enumerate() {
+        let k = known.clone().position(|n| n == entry).ok_or_else(|| {
+            anyhow::anyhow!("parameter {parameter}: {what} '{entry}' is not in {where_known}")
+        })?;
+        let name = Name::parse(topic_text)
+            .map_err(|e| anyhow::anyhow!("topic name '{topic_text}': {e:?}"))?;
+        mapped.push((i, k, name));
+    }
+    Ok(mapped)
 }
 
 fn speed_topic_label(ros: &RosArgs) -> String {
@@ -778,6 +864,9 @@ struct InputRoute {
     clock: Arc<NodeClock>,
     rec: Option<mpsc::SyncSender<ToRecord>>,
     counters: Arc<model::NodeCounters>,
+    /// the model thread, woken at once by a speed or unbalance (issue 17: it otherwise wakes
+    /// every [`model::WAKE_PERIOD`])
+    model: std::thread::Thread,
 }
 
 impl InputRoute {
@@ -800,6 +889,7 @@ impl InputRoute {
             .map_err(|e| anyhow::anyhow!("subscription {name:?}: {e:?}"))?;
         let (inbox, clock, rec) = (self.inbox.clone(), self.clock.clone(), self.rec.clone());
         let counters = self.counters.clone();
+        let model = self.model.clone();
         let label = name.to_string();
         let topic_index = counters.add_topic(&label);
         tokio::spawn(async move {
@@ -822,6 +912,7 @@ impl InputRoute {
                         Err(format!("{label}: a sample that does not decode ({e:?})"))
                     }
                 };
+                let command = matches!(queued, Ok(Input::Speed { .. } | Input::Unbalance { .. }));
                 inbox
                     .lock()
                     .unwrap_or_else(|e| e.into_inner())
@@ -829,6 +920,9 @@ impl InputRoute {
                         received_ns: at,
                         input: queued,
                     });
+                if command {
+                    model.unpark();
+                }
             }
         });
         Ok(())

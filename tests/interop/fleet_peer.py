@@ -79,8 +79,10 @@ def main():
                     o = out[ns]
                     o["reports"] += 1
                     o["rtf"].append(float(v["real_time_factor"]))
-                    o.setdefault("raw", []).append((round(time.time() - start, 2), v["real_time_factor"], v["lag_s"], v["step_overruns"], v["worst_step_us"]))
+                    o.setdefault("raw", []).append((round(time.time() - start, 2), v["real_time_factor"], v["lag_s"], v["step_overruns"], v["worst_step_us"], v.get("wakes")))
                     o["lag_s"].append(float(v["lag_s"]))
+                    if "wakes" in v:
+                        o.setdefault("wakes", []).append(int(v["wakes"]))
                     o["warn_levels"] += int(s.level != 0)
         for ns, r in zip(names, warnings):
             for m in r.take(N=100):
@@ -98,6 +100,7 @@ def main():
             "rtf_median": sorted(rtf)[len(rtf) // 2] if rtf else None,
             "rtf_below_0_99": sum(r < 0.99 for r in rtf),
             "lag_max_s": max(lag) if lag else None,
+            "wakes_median": sorted(o["wakes"])[len(o["wakes"]) // 2] if o.get("wakes") else None,
             "non_ok_reports": o["warn_levels"], "falling_behind": o["falling_behind"],
             "warnings": o.get("warnings", {}),
             "raw": o.get("raw", []) if os.environ.get("FLEET_RAW") else None,
