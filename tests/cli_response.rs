@@ -51,9 +51,27 @@ fn response_json_and_plots_for_the_builtin_machine() {
         "phase lag of x (deg)",
         "legend",
         "bearing_pulley_end",
-        "probe_outboard",
+        "bearing_outboard",
     ]);
     bode.assert_legend_right_of_data();
+    // the probes stand at the bearings' nodes: their curves are the bearings', drawn once and
+    // named as coinciding (the legend used to list four curves of which two were hidden)
+    for probe in ["probe_pulley_end", "probe_outboard"] {
+        assert!(
+            bode.text(&format!("= {probe} (coincide)")).is_some(),
+            "{probe} not said to coincide"
+        );
+    }
+    let amplitude_curves = bode.polylines.iter().filter(|l| l.len() > 100).count();
+    assert_eq!(amplitude_curves, 2, "amplitude curves drawn");
+    // the peaks' labels clear of one another
+    let peaks: Vec<_> = bode
+        .texts
+        .iter()
+        .filter(|t| t.text.contains(", AF "))
+        .collect();
+    assert_eq!(peaks.len(), 2, "{peaks:?}");
+    svg_check::assert_no_overlap(&peaks);
     let polar_path = prefix.with_file_name(format!(
         "{}_polar.svg",
         prefix.file_name().unwrap().to_str().unwrap()
@@ -64,6 +82,15 @@ fn response_json_and_plots_for_the_builtin_machine() {
         "Im X (µm)",
         "legend",
     ]);
+    // the speed labels (whole rpm; tick labels have a decimal point) clear of one another:
+    // they overprinted where two stations' curves start together (900 and 2979 twice)
+    let speeds: Vec<_> = polar
+        .texts
+        .iter()
+        .filter(|t| t.text.parse::<u32>().is_ok())
+        .collect();
+    assert!(speeds.len() >= 6, "{speeds:?}");
+    svg_check::assert_no_overlap(&speeds);
     let (px_x, px_y) = polar.px_per_unit();
     assert!(
         (px_x / px_y - 1.0).abs() < 0.01,

@@ -343,3 +343,31 @@ fn the_sweep_onset_is_the_monitors_rule() {
     sweep.points.push(point(8800.0, RotorState::Growing, 0.004));
     assert_eq!(sweep.onset_speed_rpm(), Some(8800.0));
 }
+
+/// The pressure map carries the run's validity in its title: a map whose pressures are not
+/// physical (grazing) is titled "PRESSURES NOT VALID — …" with the reason under it in red; a
+/// valid one has neither (before, the flag was only in the text output).
+#[test]
+fn pressure_map_title_carries_the_validity_flag() {
+    let dir = std::env::temp_dir().join(format!("rotor-twin-pmap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let map: Vec<Vec<f64>> = (0..40)
+        .map(|t| (0..36).map(|k| 1e5 * ((t + k) % 7) as f64).collect())
+        .collect();
+    let why = "grazing: film 0.40 µm, below the full-film limit";
+    for (name, flag) in [("bad", Some(why)), ("good", None)] {
+        let path = dir.join(format!("{name}.svg"));
+        rotor_twin::plot::pressure_map_svg(&path, "mid-plane pressure: b", &map, flag).unwrap();
+        let svg = svg_check::read(&path);
+        let flagged = svg
+            .texts
+            .iter()
+            .any(|t| t.text == "PRESSURES NOT VALID — mid-plane pressure: b");
+        assert_eq!(flagged, flag.is_some(), "{name}");
+        assert_eq!(svg.text(why).is_some(), flag.is_some(), "{name}");
+        if flag.is_none() {
+            svg.assert_texts(&["mid-plane pressure: b"]);
+        }
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

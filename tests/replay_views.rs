@@ -198,6 +198,14 @@ fn check_views(out: &Path, station: &str, locked: bool) {
         (px / py - 1.0).abs() < 0.01,
         "centerline {px} vs {py} px/µm"
     );
+    // the static locus (3 px line) is drawn after, so over, every block's mean (4 px rings, half
+    // transparent): it used to be hidden under them
+    let raw = std::fs::read_to_string(out.join(format!("centerline_{station}.svg"))).unwrap();
+    let locus_at = raw.find("stroke-width=\"3\"").expect("the static locus");
+    let last_ring = raw
+        .rfind("r=\"4\" opacity=\"0.5\"")
+        .expect("the twin's means");
+    assert!(last_ring < locus_at, "the locus is under the markers");
 
     let cascade = svg("full_spectrum");
     cascade.assert_texts(&[

@@ -182,6 +182,47 @@ pub fn numbers_as_values(
     out
 }
 
+/// A machine and a range of speeds: the arguments `modes` and `response` share.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MachineSpeedRange {
+    /// Machine description (YAML); the built-in ORC microturbine if absent.
+    #[arg(long)]
+    pub config: Option<std::path::PathBuf>,
+    /// Lowest speed (rpm); default 10 % of rated.
+    #[arg(long)]
+    pub from_rpm: Option<f64>,
+    /// Highest speed (rpm); default 150 % of rated.
+    #[arg(long)]
+    pub to_rpm: Option<f64>,
+    /// Speed step (rpm); default a fraction of the range (`modes` 1/40, `response` 1/200).
+    #[arg(long)]
+    pub step_rpm: Option<f64>,
+}
+
+impl MachineSpeedRange {
+    /// The machine description (`--config`, or the built-in one).
+    pub(crate) fn machine(&self) -> anyhow::Result<crate::rotor::MachineDescription> {
+        Ok(crate::rotor::MachineDescription::load(
+            self.config.as_deref(),
+        )?)
+    }
+
+    /// [`speed_grid_rpm`] of these flags.
+    pub(crate) fn grid(
+        &self,
+        rated: f64,
+        steps: f64,
+        max_steps: f64,
+    ) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
+        speed_grid_rpm(
+            [self.from_rpm, self.to_rpm, self.step_rpm],
+            rated,
+            steps,
+            max_steps,
+        )
+    }
+}
+
 /// The speeds (rpm) of `[--from-rpm, --to-rpm, --step-rpm]`, checked: by default from 10 % of
 /// the rated speed `rated` (at least 100 rpm) to 150 % of it in `steps` steps; at most
 /// `max_steps` steps. Returns (speeds, from, to, step), the last speed capped at `to`.

@@ -2,7 +2,7 @@
 
 use crate::rotor::{
     campbell, critical_speeds, natural_frequencies, stability_threshold, static_solution,
-    CampbellPoint, Constraint, CriticalSpeed, MachineDescription, Rotor,
+    CampbellPoint, Constraint, CriticalSpeed, Rotor,
 };
 use crate::units::rad_s_to_rpm;
 use anyhow::Context;
@@ -13,18 +13,9 @@ use std::path::PathBuf;
 /// Linear rotordynamics of a machine: modes, Campbell diagram, threshold of stability.
 #[derive(Debug, Clone, Args)]
 pub struct ModesArgs {
-    /// Machine description (YAML); the built-in ORC microturbine if absent.
-    #[arg(long)]
-    config: Option<PathBuf>,
-    /// Lowest speed of the Campbell diagram (rpm); default 10 % of rated.
-    #[arg(long)]
-    from_rpm: Option<f64>,
-    /// Highest speed (rpm); default 150 % of rated.
-    #[arg(long)]
-    to_rpm: Option<f64>,
-    /// Speed step (rpm); default 1/40 of the range.
-    #[arg(long)]
-    step_rpm: Option<f64>,
+    /// Machine and speeds of the Campbell diagram.
+    #[command(flatten)]
+    range: super::MachineSpeedRange,
     /// Modes listed per speed.
     #[arg(long, default_value_t = 6)]
     modes: usize,
@@ -78,9 +69,13 @@ struct ModesReport {
     /// Modes of a massless-shaft idealisation's own negligible mass (Hz), free–free and pinned:
     /// not modes of the modelled machine, left out of the lists above and of the Campbell diagram.
     massless_shaft_modes_hz: MasslessShaftModes,
+    /// The critical speeds: forward modes crossing 1X with an amplification factor ≥ 2.5.
     critical_speeds_rpm: Vec<f64>,
-    /// Each forward critical speed with the track id of its mode and its log decrement there.
+    /// Each critical speed with the track id of its mode, its damping and amplification factor.
     critical_speeds: Vec<CriticalSpeed>,
+    /// Forward modes crossing 1X too damped to be critical speeds (API 684: AF < 2.5,
+    /// critically damped).
+    critically_damped_crossings: Vec<CriticalSpeed>,
     threshold_speed_rpm: Option<f64>,
     whirl_ratio_at_threshold: Option<f64>,
     threshold_frequency_hz: Option<f64>,
@@ -166,12 +161,7 @@ fn heat_for_threshold(
 /// The speeds of the Campbell diagram and threshold search, checked: (speeds, from, to, step)
 /// in rpm; by default 10 % to 150 % of the rated speed `rated` in 40 steps.
 fn speed_range(args: &ModesArgs, rated: f64) -> anyhow::Result<(Vec<f64>, f64, f64, f64)> {
-    let grid = super::speed_grid_rpm(
-        [args.from_rpm, args.to_rpm, args.step_rpm],
-        rated,
-        40.0,
-        2000.0,
-    )?;
+    let grid = args.range.grid(rated, 40.0, 2000.0)?;
     anyhow::ensure!(
         (1..=100).contains(&args.modes),
         "invalid --modes {}: must be 1 to 100",
@@ -195,7 +185,7 @@ fn check_outputs(args: &ModesArgs) -> anyhow::Result<()> {
 }
 
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
-    let desc = MachineDescription::load(args.config.as_deref())?;
+    let desc = args.range.machine()?;
     let mut rotor = Rotor::from_description(&desc);
     if args.fluid_inertia {
         rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
@@ -213,7 +203,11 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
     let threshold =
         stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
-    let criticals = critical_speeds(&points);
+    let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) =
+        critical_speeds(&rotor, &statics, &points)
+            .context("critical speeds")?
+            .into_iter()
+            .partition(|c| c.critical);
     let shapes = args
         .shapes_rpm
         .map(|rpm| super::mode_shapes::mode_shapes(&rotor, &statics, rpm, args.modes))
@@ -245,6 +239,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         },
         critical_speeds_rpm: criticals.iter().map(|c| c.speed_rpm).collect(),
         critical_speeds: criticals,
+        critically_damped_crossings: damped,
         threshold_speed_rpm: threshold.map(|t| t.speed_rpm),
         whirl_ratio_at_threshold: threshold.map(|t| t.whirl_ratio),
         threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
@@ -252,6 +247,18 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         mode_shapes: shapes,
         effective_temperatures: heated,
     };
+    write_campbell(args, &report)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_tables(&report);
+        print_effective_temperatures(&report.effective_temperatures);
+    }
+    Ok(())
+}
+
+/// The `--plot` Campbell diagram.
+fn write_campbell(args: &ModesArgs, report: &ModesReport) -> anyhow::Result<()> {
     if let Some(path) = &args.plot {
         crate::plot::campbell_svg(
             path,
@@ -259,14 +266,9 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
             &report.campbell,
             report.threshold_speed_rpm,
             &report.critical_speeds,
+            &report.critically_damped_crossings,
         )
         .with_context(|| format!("writing {}", path.display()))?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print_tables(&report);
-        print_effective_temperatures(&report.effective_temperatures);
     }
     Ok(())
 }
@@ -425,26 +427,38 @@ fn print_campbell(r: &ModesReport) {
     }
 }
 
-/// Forward critical speeds and the stability threshold.
+/// Critical speeds, critically damped crossings and the stability threshold.
 fn print_criticals(r: &ModesReport) {
-    let criticals: Vec<String> = r
-        .critical_speeds
-        .iter()
-        .map(|c| {
-            format!(
-                "{:.1} (mode {}, log dec {:.3})",
-                c.speed_rpm, c.track, c.log_dec
-            )
-        })
-        .collect();
+    let list = |v: &[CriticalSpeed]| {
+        v.iter()
+            .map(|c| {
+                let af = if c.amplification_factor > 100.0 {
+                    "> 100".to_string()
+                } else {
+                    format!("{:.2}", c.amplification_factor)
+                };
+                format!(
+                    "{:.1} (mode {}, log dec {:.3}, AF {af})",
+                    c.speed_rpm, c.track, c.log_dec
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     println!(
-        "  forward critical speeds (rpm): {}",
-        if criticals.is_empty() {
+        "  forward critical speeds (rpm; API 684: AF = 1/(2ζ) ≥ 2.5): {}",
+        if r.critical_speeds.is_empty() {
             "none in the range".to_string()
         } else {
-            criticals.join(", ")
+            list(&r.critical_speeds)
         }
     );
+    if !r.critically_damped_crossings.is_empty() {
+        println!(
+            "  forward modes crossing 1X critically damped (AF < 2.5), not critical speeds (rpm): {}",
+            list(&r.critically_damped_crossings)
+        );
+    }
     match (r.threshold_speed_rpm, r.whirl_ratio_at_threshold) {
         (Some(t), Some(w)) => {
             println!("  stability threshold {t:.0} rpm, whirl frequency ratio {w:.3} there")

@@ -2,8 +2,8 @@
 //! plots at the bearings and probe stations, peaks, amplification factors, separation margins.
 
 use crate::rotor::{
-    response_peaks, static_solution, unbalance_response, MachineDescription, ResponsePeak, Rotor,
-    Station, StationResponse,
+    response_peaks, static_solution, unbalance_response, ResponsePeak, Rotor, Station,
+    StationResponse,
 };
 use anyhow::Context;
 use clap::Args;
@@ -13,18 +13,9 @@ use std::path::{Path, PathBuf};
 /// Unbalance response of the linear model: 1X amplitude and phase lag against speed.
 #[derive(Debug, Clone, Args)]
 pub struct ResponseArgs {
-    /// Machine description (YAML); the built-in ORC microturbine if absent.
-    #[arg(long)]
-    config: Option<PathBuf>,
-    /// Lowest speed (rpm); default 10 % of rated.
-    #[arg(long)]
-    from_rpm: Option<f64>,
-    /// Highest speed (rpm); default 150 % of rated.
-    #[arg(long)]
-    to_rpm: Option<f64>,
-    /// Speed step (rpm); default 1/200 of the range.
-    #[arg(long)]
-    step_rpm: Option<f64>,
+    /// Machine and speeds.
+    #[command(flatten)]
+    range: super::MachineSpeedRange,
     /// Minimum operating speed for the separation margins (rpm); default the rated speed.
     #[arg(long)]
     min_operating_rpm: Option<f64>,
@@ -61,8 +52,7 @@ struct ResponseReport {
 }
 
 fn speed_grid(args: &ResponseArgs, rated: f64) -> anyhow::Result<Vec<f64>> {
-    let range = [args.from_rpm, args.to_rpm, args.step_rpm];
-    Ok(super::speed_grid_rpm(range, rated, 200.0, 5000.0)?.0)
+    Ok(args.range.grid(rated, 200.0, 5000.0)?.0)
 }
 
 /// The file `--plot PREFIX` writes for `suffix` (`_bode.svg`, `_polar.svg`).
@@ -92,7 +82,7 @@ fn operating_range(args: &ResponseArgs, rated: f64) -> anyhow::Result<(f64, f64)
 }
 
 pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
-    let desc = MachineDescription::load(args.config.as_deref())?;
+    let desc = args.range.machine()?;
     let rotor = Rotor::from_description(&desc);
     let rated = desc.rated_speed_rpm;
     let speeds = speed_grid(args, rated)?;

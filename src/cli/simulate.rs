@@ -620,10 +620,24 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
             &format!("full spectrum: {name}"),
             &r.spectra[i],
         )?;
+        let not_valid = r
+            .report
+            .bearings
+            .get(i)
+            .filter(|b| !b.pressure_valid)
+            .map(|b| {
+                format!(
+                    "grazing: film {:.2} µm, below the full-film limit (Λ = h/σ < 3); p_max {:.1} MPa \
+                     is not a physical pressure",
+                    b.min_film_thickness_m * 1e6,
+                    b.max_pressure_pa * 1e-6
+                )
+            });
         crate::plot::pressure_map_svg(
             &dir.join(format!("pressure_{name}.svg")),
             &format!("mid-plane pressure: {name}"),
             &r.pressure_maps[i],
+            not_valid.as_deref(),
         )?;
     }
     Ok(())

@@ -167,28 +167,15 @@ pub fn bearing_coefficients_svg(path: &Path, b: &BearingCurves) -> anyhow::Resul
 /// frame, µm, 1:1), speeds marked along it, the load direction drawn from the centre.
 pub fn centerline_svg(path: &Path, b: &BearingCurves) -> anyhow::Result<()> {
     let c = b.clearance_m * 1e6;
-    let lim = 1.1 * c;
-    let root = SVGBackend::new(path, (1000, 760)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let root = root.titled(&format!("Shaft centerline: {}", b.name), ("sans-serif", 22))?;
-    let (plot_area, legend_area) = root.split_horizontally(730);
-    let plot_area = super::square_chart_area(plot_area, 15, 40, 70);
-    let mut chart = ChartBuilder::on(&plot_area)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(-lim..lim, -lim..lim)?;
-    chart
-        .configure_mesh()
-        .x_desc("x, journal centre (µm)")
-        .y_desc("y, journal centre (µm)")
-        .draw()?;
+    let (root, mut chart, legend_area) = super::square_plot(
+        path,
+        &super::SQUARE_1000,
+        &format!("Shaft centerline: {}", b.name),
+        1.1 * c,
+        ("x, journal centre (µm)", "y, journal centre (µm)"),
+    )?;
     let grey = RGBColor(120, 120, 120);
-    let circle = (0..=360).map(|d| {
-        let a = f64::from(d).to_radians();
-        (c * a.cos(), c * a.sin())
-    });
-    chart.draw_series(LineSeries::new(circle, grey.stroke_width(2)))?;
+    chart.draw_series(LineSeries::new(super::circle(c), grey.stroke_width(2)))?;
     let red = RGBColor(200, 30, 30);
     let la = b.load_direction_deg.to_radians();
     chart.draw_series(std::iter::once(PathElement::new(

@@ -1,5 +1,6 @@
 //! The Campbell diagram.
 
+use super::labels::{placed_text, LabelPlacer};
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::rotor::{CampbellPoint, CriticalSpeed, Mode, WhirlDirection};
 use plotters::coord::types::RangedCoordf64;
@@ -10,6 +11,7 @@ use std::path::Path;
 const FORWARD: RGBColor = RGBColor(31, 90, 200);
 const BACKWARD: RGBColor = RGBColor(20, 150, 60);
 const UNSTABLE: RGBColor = RGBColor(220, 30, 30);
+const DAMPED_CROSSING: RGBColor = RGBColor(120, 120, 120);
 
 /// Log decrement below which a point is drawn unstable: below the round-off of an undamped
 /// model's zero (the threshold search uses the same, `rotor::stability_threshold`).
@@ -78,14 +80,18 @@ impl Extent {
 /// Writes a Campbell diagram to `path`: damped natural frequencies against speed, each mode a line
 /// (followed by shape) with its points, forward whirl in blue, backward in green, unstable points
 /// (negative log decrement) in red; the running frequency 1X and 0.5X as labelled lines; the
-/// forward critical speeds as diamonds on 1X; the stability threshold (rpm) as a vertical line.
-/// The lower panel shows the logarithmic decrements, unclipped. The legend has its own panel.
+/// forward critical speeds as diamonds on 1X, each labelled with its speed where the label finds
+/// room clear of the others; the forward modes that cross 1X critically damped (API 684:
+/// AF < 2.5, `damped_crossings`) as grey rings, unlabelled; the stability threshold (rpm) as a
+/// vertical line. The lower panel shows the logarithmic decrements, unclipped. The legend has
+/// its own panel.
 pub fn campbell_svg(
     path: &Path,
     title: &str,
     points: &[CampbellPoint],
     threshold_rpm: Option<f64>,
     critical_speeds: &[CriticalSpeed],
+    damped_crossings: &[CriticalSpeed],
 ) -> anyhow::Result<()> {
     let e = Extent::of(points);
     let root = SVGBackend::new(path, (1100, 900)).into_drawing_area();
@@ -93,7 +99,13 @@ pub fn campbell_svg(
     let root = root.titled(title, ("sans-serif", 22))?;
     let (plots, legend_area) = root.split_horizontally(860);
     let (upper, lower) = plots.split_vertically(560);
-    frequency_panel(&upper, &e, points, threshold_rpm, critical_speeds)?;
+    frequency_panel(
+        &upper,
+        &e,
+        points,
+        threshold_rpm,
+        [critical_speeds, damped_crossings],
+    )?;
     log_dec_panel(&lower, &e, points, threshold_rpm)?;
     let mut entries = vec![
         Entry::new(Swatch::Dot(FORWARD), "forward whirl"),
@@ -102,7 +114,15 @@ pub fn campbell_svg(
         Entry::new(Swatch::Line(BLACK, 2), "1X running speed"),
         Entry::new(Swatch::Line(RGBColor(140, 140, 140), 1), "0.5X"),
         Entry::new(Swatch::Diamond(BLACK), "forward critical speed"),
+        Entry::new(Swatch::Text, "(API 684: AF = 1/(2ζ) ≥ 2.5)"),
     ];
+    if !damped_crossings.is_empty() {
+        entries.push(Entry::new(
+            Swatch::Ring(DAMPED_CROSSING),
+            "crossing of 1X, critically damped",
+        ));
+        entries.push(Entry::new(Swatch::Text, "(AF < 2.5: not a critical speed)"));
+    }
     if let Some(t) = threshold_rpm {
         entries.push(Entry::new(
             Swatch::Line(UNSTABLE, 2),
@@ -116,13 +136,14 @@ pub fn campbell_svg(
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
 
-/// The upper panel: frequencies, the 1X and 0.5X lines, critical speeds, the threshold.
+/// The upper panel: frequencies, the 1X and 0.5X lines, critical speeds and critically damped
+/// crossings (`crossings`), the threshold.
 fn frequency_panel(
     area: &Area,
     e: &Extent,
     points: &[CampbellPoint],
     threshold_rpm: Option<f64>,
-    critical_speeds: &[CriticalSpeed],
+    crossings: [&[CriticalSpeed]; 2],
 ) -> anyhow::Result<()> {
     let mut chart = ChartBuilder::on(area)
         .margin(15)
@@ -134,6 +155,7 @@ fn frequency_panel(
         .x_desc("speed (rpm)")
         .y_desc("damped natural frequency (Hz)")
         .draw()?;
+    let mut placer = LabelPlacer::in_chart(&chart);
     for (ratio, label, shade) in [(1.0, "1X", 0.9), (0.5, "0.5X", 0.45)] {
         // the line ends where it leaves the frame; its label sits at its end
         let x_end = e.x1.min(e.f_max * 60.0 / ratio);
@@ -143,9 +165,13 @@ fn frequency_panel(
                 .mix(shade)
                 .stroke_width(if ratio == 1.0 { 2 } else { 1 }),
         ))?;
+        let at = (0.97 * x_end, 0.97 * x_end * ratio / 60.0);
+        let px = chart.backend_coord(&at);
+        let (x, y) = (px.0 as f64, px.1 as f64);
+        placer.reserve([x - 40.0, y - 16.0, x, y]);
         chart.draw_series(std::iter::once(Text::new(
             label,
-            (0.97 * x_end, 0.97 * x_end * ratio / 60.0),
+            at,
             ("sans-serif", 16)
                 .into_font()
                 .color(&BLACK)
@@ -153,20 +179,33 @@ fn frequency_panel(
         )))?;
     }
     draw_tracks(&mut chart, &e.ids, points, |m| m.frequency_hz)?;
-    for c in critical_speeds {
-        let (x, y) = (c.speed_rpm, c.speed_rpm / 60.0);
-        // the label above and left of its marker, clear of the 1X line below it
-        let label = Text::new(
-            format!("{:.0} rpm", c.speed_rpm),
-            (-10, -10),
-            ("sans-serif", 14)
-                .into_font()
-                .color(&BLACK)
-                .pos(Pos::new(HPos::Right, VPos::Bottom)),
-        );
-        chart.draw_series(std::iter::once(
-            EmptyElement::at((x, y)) + diamond(8) + label,
-        ))?;
+    // the labels keep clear of the modes' points
+    for p in points {
+        for m in &p.modes {
+            placer.reserve_marker(chart.backend_coord(&(p.speed_rpm, m.frequency_hz)), 3.0);
+        }
+    }
+    let [critical, damped] = crossings;
+    chart.draw_series(damped.iter().map(|c| {
+        Circle::new(
+            (c.speed_rpm, c.speed_rpm / 60.0),
+            6,
+            DAMPED_CROSSING.stroke_width(2),
+        )
+    }))?;
+    for c in critical {
+        let at = (c.speed_rpm, c.speed_rpm / 60.0);
+        placer.reserve_marker(chart.backend_coord(&at), 8.0);
+        chart.draw_series(std::iter::once(EmptyElement::at(at) + diamond(8)))?;
+    }
+    for c in critical {
+        let at = (c.speed_rpm, c.speed_rpm / 60.0);
+        let text = format!("{:.0} rpm", c.speed_rpm);
+        if let Some(o) = placer.place(chart.backend_coord(&at), 8.0, &text, 14.0) {
+            chart.draw_series(std::iter::once(
+                EmptyElement::at(at) + placed_text(text, o, 14.0, &BLACK),
+            ))?;
+        }
     }
     if let Some(t) = threshold_rpm {
         chart.draw_series(LineSeries::new(

@@ -23,30 +23,17 @@ pub fn orbit_comparison_svg(
         .flat_map(|s| [s.measured_m, s.predicted_m])
         .map(|p| p[0].hypot(p[1]))
         .fold(clearance_m, f64::max);
+    let layout = super::SquareLayout {
+        size: (860, 660),
+        title_size: 18,
+        plot_width: 640,
+        y_label: 50,
+    };
     let lim = 1.1 * extent * 1e6;
-    let root = SVGBackend::new(path, (860, 660)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let titled = root.titled(title, ("sans-serif", 18))?;
-    let (chart_area, legend_area) = titled.split_horizontally(640);
-    let area = super::square_chart_area(chart_area, 15, 40, 50);
-    let mut chart = ChartBuilder::on(&area)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(-lim..lim, -lim..lim)?;
-    chart
-        .configure_mesh()
-        .x_desc("x (µm)")
-        .y_desc("y (µm)")
-        .draw()?;
+    let (root, mut chart, legend_area) =
+        super::square_plot(path, &layout, title, lim, ("x (µm)", "y (µm)"))?;
     let c = clearance_m * 1e6;
-    chart.draw_series(LineSeries::new(
-        (0..=360).map(|k| {
-            let a = (k as f64).to_radians();
-            (c * a.cos(), c * a.sin())
-        }),
-        BLACK,
-    ))?;
+    chart.draw_series(LineSeries::new(super::circle(c), BLACK))?;
     type Pick = fn(&Sample) -> [f64; 2];
     let series: [(&str, Pick, RGBColor); 2] = [
         ("measured", |s| s.measured_m, MEASURED),

@@ -4,6 +4,7 @@
 //! static-equilibrium locus), the full-spectrum cascade (forward and reverse orders of x + iy)
 //! and the orbit in the probes' own frame beside the machine frame, with keyphasor dots.
 
+use super::labels::{placed_text, LabelPlacer};
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::replay::compare::{BlockSpectra, Sample, WindowComparison, BLOCK_REVS};
 use crate::signals::PhaseReference;
@@ -17,6 +18,14 @@ const MEASURED_Y: RGBColor = RGBColor(240, 140, 20);
 const PREDICTED: RGBColor = RGBColor(30, 60, 200);
 const PREDICTED_Y: RGBColor = RGBColor(20, 170, 190);
 
+/// The square plots of this module: 1100 × 760 px, the legend right of 730 px.
+const WIDE_SQUARE: super::SquareLayout = super::SquareLayout {
+    size: (1100, 760),
+    title_size: 20,
+    plot_width: 730,
+    y_label: 70,
+};
+
 type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// The four 1X series of the Bode and polar plots: (measured?, axis, colour, label).
@@ -28,6 +37,27 @@ fn one_x_series(axes_deg: [f64; 2]) -> [(bool, usize, RGBColor, String); 4] {
         (false, 0, PREDICTED, l("predicted", 0)),
         (false, 1, PREDICTED_Y, l("predicted", 1)),
     ]
+}
+
+/// The legend entries of the four 1X series, measured a dot, predicted a ring, and the note of
+/// one point per block.
+fn series_entries(series: &[(bool, usize, RGBColor, String)]) -> Vec<Entry> {
+    let mut entries: Vec<Entry> = series
+        .iter()
+        .map(|(m, _, c, l)| {
+            let s = if *m {
+                Swatch::Dot(*c)
+            } else {
+                Swatch::Ring(*c)
+            };
+            Entry::new(s, l.clone())
+        })
+        .collect();
+    entries.push(Entry::new(
+        Swatch::Text,
+        format!("one point per {BLOCK_REVS} revolutions"),
+    ));
+    entries
 }
 
 /// A marker of a series: measured filled, predicted hollow.
@@ -89,63 +119,40 @@ pub fn one_x_bode_svg(
         .fold(1e-9, f64::max)
         * 1e6
         * 1.1;
-    let root = SVGBackend::new(path, (1150, 850)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 20))?;
-    let (plots, legend_area) = root.split_horizontally(840);
-    let (upper, lower) = plots.split_vertically(420);
-    let mut amp = ChartBuilder::on(&upper)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, 0.0..top)?;
-    amp.configure_mesh()
-        .x_desc("speed (rpm)")
-        .y_desc("1X amplitude along the probe (µm, 0-pk)")
-        .draw()?;
-    let mut phase = ChartBuilder::on(&lower)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, 0.0..360.0)?;
-    phase
-        .configure_mesh()
-        .x_desc("speed (rpm)")
-        .y_desc("1X phase lag (deg, API 670)")
-        .y_labels(9)
-        .draw()?;
+    let mut bode = super::bode_plot(
+        path,
+        &super::BodeLayout {
+            size: (1150, 850),
+            title_size: 20,
+            plot_width: 840,
+            amplitude_height: 420,
+        },
+        title,
+        (x0, x1),
+        top,
+        (
+            "1X amplitude along the probe (µm, 0-pk)",
+            "1X phase lag (deg, API 670)",
+        ),
+    )?;
     let series = one_x_series(axes_deg);
     for (measured, j, colour, _) in &series {
         let pick = |b: &WindowComparison| if *measured { b.measured } else { b.predicted };
-        amp.draw_series(blocks.iter().map(|b| {
+        bode.amplitude.draw_series(blocks.iter().map(|b| {
             let a = pick(b).one_x_probe_amplitudes_m[*j] * 1e6;
             marker((b.speed_rpm, a), *colour, *measured)
         }))?;
-        phase.draw_series(blocks.iter().filter_map(|b| {
+        bode.phase.draw_series(blocks.iter().filter_map(|b| {
             let v = pick(b).one_x_probe_axes?[*j];
             Some(marker((b.speed_rpm, v.phase_lag_deg), *colour, *measured))
         }))?;
     }
     if let Some(why) = phase_missing(blocks) {
-        draw_notice(&lower, "no 1X phase lag:", &why)?;
+        let area = bode.phase.plotting_area().strip_coord_spec();
+        draw_notice(&area, "no 1X phase lag:", &why)?;
     }
-    let mut entries: Vec<Entry> = series
-        .iter()
-        .map(|(m, _, c, l)| {
-            let s = if *m {
-                Swatch::Dot(*c)
-            } else {
-                Swatch::Ring(*c)
-            };
-            Entry::new(s, l.clone())
-        })
-        .collect();
-    entries.push(Entry::new(
-        Swatch::Text,
-        format!("one point per {BLOCK_REVS} revolutions"),
-    ));
-    draw_side_legend(&legend_area, &entries, 30)?;
-    root.present()?;
+    draw_side_legend(&bode.legend, &series_entries(&series), 30)?;
+    bode.root.present()?;
     Ok(())
 }
 
@@ -196,23 +203,20 @@ pub fn one_x_polar_svg(
         .fold(1e-9, f64::max)
         * 1e6
         * 1.15;
-    let root = SVGBackend::new(path, (1100, 760)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 20))?;
-    let (plot_area, legend_area) = root.split_horizontally(730);
-    let plot_area = super::square_chart_area(plot_area, 15, 40, 70);
-    let mut chart = ChartBuilder::on(&plot_area)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(-lim..lim, -lim..lim)?;
-    chart
-        .configure_mesh()
-        .x_desc("Re X, in phase with the keyphasor (µm)")
-        .y_desc("Im X (µm); lag clockwise from +Re")
-        .draw()?;
+    let (root, mut chart, legend_area) = super::square_plot(
+        path,
+        &WIDE_SQUARE,
+        title,
+        lim,
+        (
+            "Re X, in phase with the keyphasor (µm)",
+            "Im X (µm); lag clockwise from +Re",
+        ),
+    )?;
     let series = one_x_series(axes_deg);
     let every = (blocks.len() / 8).max(1);
+    let mut placer = LabelPlacer::in_chart(&chart);
+    let mut marks = Vec::new();
     for (measured, j, colour, _) in &series {
         let pts: Vec<(f64, f64, f64)> = blocks
             .iter()
@@ -229,35 +233,28 @@ pub fn one_x_polar_svg(
             ))?;
         }
         chart.draw_series(pts.iter().map(|p| marker((p.0, p.1), *colour, *measured)))?;
+        for p in &pts {
+            placer.reserve_marker(chart.backend_coord(&(p.0, p.1)), 4.0);
+        }
         if *measured {
-            chart.draw_series(pts.iter().step_by(every).map(|p| {
-                Text::new(
-                    format!("{:.0}", p.2),
-                    (p.0, p.1),
-                    ("sans-serif", 12).into_font(),
-                )
-            }))?;
+            marks.extend(pts.iter().step_by(every).copied());
+        }
+    }
+    // the speeds of the measured points, where a label finds room
+    for (x, y, rpm) in marks {
+        let text = format!("{rpm:.0}");
+        if let Some(o) = placer.place(chart.backend_coord(&(x, y)), 4.0, &text, 12.0) {
+            chart.draw_series(std::iter::once(
+                EmptyElement::at((x, y)) + placed_text(text, o, 12.0, &BLACK),
+            ))?;
         }
     }
     if let Some(why) = phase_missing(blocks) {
-        draw_notice(&plot_area, "no 1X vector (needs the phase):", &why)?;
+        let area = chart.plotting_area().strip_coord_spec();
+        draw_notice(&area, "no 1X vector (needs the phase):", &why)?;
     }
-    let mut entries: Vec<Entry> = series
-        .iter()
-        .map(|(m, _, c, l)| {
-            let s = if *m {
-                Swatch::Dot(*c)
-            } else {
-                Swatch::Ring(*c)
-            };
-            Entry::new(s, l.clone())
-        })
-        .collect();
+    let mut entries = series_entries(&series);
     entries.push(Entry::new(Swatch::Text, "numbers: speed (rpm)"));
-    entries.push(Entry::new(
-        Swatch::Text,
-        format!("one point per {BLOCK_REVS} revolutions"),
-    ));
     draw_side_legend(&legend_area, &entries, 30)?;
     root.present()?;
     Ok(())
@@ -400,7 +397,7 @@ pub type CenterlinePoint = (f64, [f64; 2]);
 
 /// The shaft centerline of a replay: the mean position of each block of 8 revolutions in the
 /// clearance circle (µm, machine frame, 1:1), measured (filled) and the twin's (hollow), and the
-/// predicted static-equilibrium locus (line, speeds labelled). With AC-coupled probes the
+/// predicted static-equilibrium locus (line, speeds labelled), drawn over the markers. With AC-coupled probes the
 /// measured mean is not the plant's: it is left out and the plot says so.
 pub fn replay_centerline_svg(
     path: &Path,
@@ -411,58 +408,41 @@ pub fn replay_centerline_svg(
     mean_not_measured: Option<&str>,
 ) -> anyhow::Result<()> {
     let c = clearance_m * 1e6;
-    let lim = 1.1 * c;
-    let root = SVGBackend::new(path, (1100, 760)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let root = root.titled(title, ("sans-serif", 20))?;
-    let (plot_area, legend_area) = root.split_horizontally(730);
-    let plot_area = super::square_chart_area(plot_area, 15, 40, 70);
-    let mut chart = ChartBuilder::on(&plot_area)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(-lim..lim, -lim..lim)?;
-    chart
-        .configure_mesh()
-        .x_desc("x (µm)")
-        .y_desc("y (µm)")
-        .draw()?;
-    chart.draw_series(LineSeries::new(
-        (0..=360).map(|k| {
-            let a = (k as f64).to_radians();
-            (c * a.cos(), c * a.sin())
-        }),
-        BLACK,
-    ))?;
+    let (root, mut chart, legend_area) =
+        super::square_plot(path, &WIDE_SQUARE, title, 1.1 * c, ("x (µm)", "y (µm)"))?;
+    chart.draw_series(LineSeries::new(super::circle(c), BLACK))?;
     let mut entries = vec![Entry::new(
         Swatch::Line(BLACK, 1),
         format!("bearing clearance ({c:.0} µm)"),
     )];
     let um = |p: [f64; 2]| (p[0] * 1e6, p[1] * 1e6);
-    draw_static_locus(&mut chart, static_locus)?;
-    entries.push(Entry::new(
-        Swatch::Line(BLACK, 2),
-        "static equilibrium, predicted",
-    ));
     if mean_not_measured.is_none() {
         chart.draw_series(
             blocks
                 .iter()
-                .map(|b| marker(um(b.measured.mean_m), MEASURED, true)),
+                .map(|b| Circle::new(um(b.measured.mean_m), 3, MEASURED.mix(0.5).filled())),
         )?;
         entries.push(Entry::new(
             Swatch::Dot(MEASURED),
             "measured mean, per block",
         ));
     }
-    chart.draw_series(
-        blocks
-            .iter()
-            .map(|b| marker(um(b.predicted.mean_m), PREDICTED, false)),
-    )?;
+    chart.draw_series(blocks.iter().map(|b| {
+        Circle::new(
+            um(b.predicted.mean_m),
+            4,
+            PREDICTED.mix(0.5).stroke_width(1),
+        )
+    }))?;
     entries.push(Entry::new(
         Swatch::Ring(PREDICTED),
         "twin's mean, per block",
+    ));
+    // the locus last, over the markers that gather on it
+    draw_static_locus(&mut chart, static_locus)?;
+    entries.push(Entry::new(
+        Swatch::Line(BLACK, 3),
+        "static equilibrium, predicted",
     ));
     entries.push(Entry::new(
         Swatch::Text,
@@ -486,7 +466,7 @@ fn draw_static_locus(
     let um = |p: [f64; 2]| (p[0] * 1e6, p[1] * 1e6);
     chart.draw_series(LineSeries::new(
         static_locus.iter().map(|(_, p)| um(*p)),
-        BLACK.stroke_width(2),
+        BLACK.stroke_width(3),
     ))?;
     // the ends of the locus labelled with their speeds (a short locus would crowd more)
     let ends = [static_locus.first(), static_locus.last()];

@@ -15,27 +15,15 @@ pub fn orbit_svg(
     clearance_m: f64,
 ) -> anyhow::Result<()> {
     let c = clearance_m * 1e6;
-    let root = SVGBackend::new(path, (900, 660)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let lim = 1.1 * c;
-    let titled = root.titled(title, ("sans-serif", 18))?;
-    let (chart_area, legend_area) = titled.split_horizontally(640);
-    let area = super::square_chart_area(chart_area, 15, 40, 50);
-    let mut chart = ChartBuilder::on(&area)
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(-lim..lim, -lim..lim)?;
-    chart
-        .configure_mesh()
-        .x_desc("x (µm)")
-        .y_desc("y (µm)")
-        .draw()?;
-    let circle = (0..=360).map(|k| {
-        let a = (k as f64).to_radians();
-        (c * a.cos(), c * a.sin())
-    });
-    chart.draw_series(LineSeries::new(circle, BLACK))?;
+    let layout = super::SquareLayout {
+        size: (900, 660),
+        title_size: 18,
+        plot_width: 640,
+        y_label: 50,
+    };
+    let (root, mut chart, legend_area) =
+        super::square_plot(path, &layout, title, 1.1 * c, ("x (µm)", "y (µm)"))?;
+    chart.draw_series(LineSeries::new(super::circle(c), BLACK))?;
     chart.draw_series(LineSeries::new(
         orbit_m.iter().map(|p| (p[0] * 1e6, p[1] * 1e6)),
         BLUE,
@@ -201,8 +189,15 @@ fn pressure_shade(p: f64, top: f64) -> RGBColor {
 }
 
 /// Mid-plane film pressure over the last two revolutions at constant speed: bearing angle
-/// against shaft rotation (degrees), grey = pressure, with a colour bar in MPa.
-pub fn pressure_map_svg(path: &Path, title: &str, map_pa: &[Vec<f64>]) -> anyhow::Result<()> {
+/// against shaft rotation (degrees), grey = pressure, with a colour bar in MPa. With
+/// `not_valid` (why the pressures are not physical figures) the title begins "PRESSURES NOT
+/// VALID" and the reason stands in red under it.
+pub fn pressure_map_svg(
+    path: &Path,
+    title: &str,
+    map_pa: &[Vec<f64>],
+    not_valid: Option<&str>,
+) -> anyhow::Result<()> {
     let steps = map_pa.len().max(1);
     let points = map_pa.first().map_or(1, Vec::len).max(1);
     let mut sorted: Vec<f64> = map_pa
@@ -224,8 +219,6 @@ pub fn pressure_map_svg(path: &Path, title: &str, map_pa: &[Vec<f64>]) -> anyhow
         p_max
     };
     let above = sorted.iter().filter(|&&p| p > top).count();
-    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
     let caption = if above > 0 {
         format!(
             "{title}: red = {above} cells above the scale, up to {:.1} MPa",
@@ -234,7 +227,9 @@ pub fn pressure_map_svg(path: &Path, title: &str, map_pa: &[Vec<f64>]) -> anyhow
     } else {
         title.to_string()
     };
-    let root = root.titled(&caption, ("sans-serif", 18))?;
+    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = titled_with_validity(root, &caption, not_valid)?;
     let (map_area, bar_area) = root.split_horizontally(790);
     let mut chart = ChartBuilder::on(&map_area)
         .margin(15)
@@ -266,6 +261,29 @@ pub fn pressure_map_svg(path: &Path, title: &str, map_pa: &[Vec<f64>]) -> anyhow
     colour_bar(&bar_area, top)?;
     root.present()?;
     Ok(())
+}
+
+/// `root` under its title `caption`; with `not_valid`, the title begins "PRESSURES NOT VALID"
+/// and the reason stands in red on a line under it. Returns the area left for the plot.
+fn titled_with_validity<'a>(
+    root: DrawingArea<SVGBackend<'a>, plotters::coord::Shift>,
+    caption: &str,
+    not_valid: Option<&str>,
+) -> anyhow::Result<DrawingArea<SVGBackend<'a>, plotters::coord::Shift>> {
+    let Some(why) = not_valid else {
+        return Ok(root.titled(caption, ("sans-serif", 18))?);
+    };
+    let root = root.titled(
+        &format!("PRESSURES NOT VALID — {caption}"),
+        ("sans-serif", 18),
+    )?;
+    let (notice, rest) = root.split_vertically(22);
+    notice.draw(&Text::new(
+        why.to_string(),
+        (15, 2),
+        ("sans-serif", 13).into_font().color(&ABOVE_SCALE),
+    ))?;
+    Ok(rest)
 }
 
 /// The pressure scale beside the map: grey 0 → `top` (MPa).

@@ -5,6 +5,7 @@
 //! (x, y) after the shaft's. The equations of motion are M q̈ + (C + Ω G) q̇ + K q = F plus the
 //! bearing forces between each journal and its pedestal (or the ground).
 
+mod critical_speeds;
 mod element;
 mod error;
 mod forces;
@@ -15,6 +16,7 @@ mod oil_heating;
 mod statics;
 mod unbalance_response;
 
+pub use critical_speeds::{critical_speeds, CriticalSpeed, API_684_MIN_AMPLIFICATION_FACTOR};
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
@@ -28,10 +30,9 @@ pub use machine::{
 };
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
-    campbell, critical_speeds, critical_speeds_rpm, damped_mode_shapes, damped_modes,
-    natural_frequencies, stability_threshold, undamped_frequencies_hz, BearingCoefficientSet,
-    CampbellPoint, Constraint, CriticalSpeed, Mode, ModeShape, NaturalFrequencies, Threshold,
-    WhirlDirection,
+    campbell, damped_mode_shapes, damped_modes, natural_frequencies, stability_threshold,
+    undamped_frequencies_hz, BearingCoefficientSet, CampbellPoint, Constraint, Mode, ModeShape,
+    NaturalFrequencies, Threshold, WhirlDirection,
 };
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};

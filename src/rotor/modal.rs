@@ -692,59 +692,6 @@ pub fn stability_threshold(
     Ok(None)
 }
 
-/// Forward critical speeds (rpm) read off a Campbell diagram: where a forward mode's frequency
-/// crosses the running frequency, the mode followed by its track (its shape), not by its rank;
-/// linear interpolation between grid speeds. Each is listed once with its track id.
-pub fn critical_speeds(points: &[CampbellPoint]) -> Vec<CriticalSpeed> {
-    let mut out = Vec::new();
-    for w in points.windows(2) {
-        for (m0, id) in w[0].modes.iter().zip(&w[0].tracks) {
-            let Some(m1) = w[1]
-                .tracks
-                .iter()
-                .position(|t| t == id)
-                .map(|j| w[1].modes[j])
-            else {
-                continue;
-            };
-            if m0.direction != WhirlDirection::Forward || m1.direction != WhirlDirection::Forward {
-                continue;
-            }
-            let ga = m0.frequency_hz - w[0].speed_rpm / 60.0;
-            let gb = m1.frequency_hz - w[1].speed_rpm / 60.0;
-            if (ga > 0.0 && gb <= 0.0) || (ga < 0.0 && gb >= 0.0) {
-                let t = ga / (ga - gb);
-                out.push(CriticalSpeed {
-                    speed_rpm: w[0].speed_rpm + t * (w[1].speed_rpm - w[0].speed_rpm),
-                    track: *id,
-                    log_dec: m0.log_dec + t * (m1.log_dec - m0.log_dec),
-                });
-            }
-        }
-    }
-    out.sort_by(|a, b| a.speed_rpm.total_cmp(&b.speed_rpm));
-    out
-}
-
-/// Forward critical speeds (rpm), see [`critical_speeds`].
-pub fn critical_speeds_rpm(points: &[CampbellPoint]) -> Vec<f64> {
-    critical_speeds(points)
-        .iter()
-        .map(|c| c.speed_rpm)
-        .collect()
-}
-
-/// A forward critical speed: a forward mode's frequency equals the running frequency.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CriticalSpeed {
-    /// Speed (rpm).
-    pub speed_rpm: f64,
-    /// Track id of the mode (see [`CampbellPoint::tracks`]).
-    pub track: usize,
-    /// The mode's log decrement there (interpolated).
-    pub log_dec: f64,
-}
-
 #[cfg(test)]
 mod eigen_failure_tests {
     use super::*;

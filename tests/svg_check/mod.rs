@@ -9,6 +9,53 @@ pub struct SvgText {
     pub x: f64,
     pub y: f64,
     pub text: String,
+    /// Font size (px).
+    pub font_size: f64,
+    /// `text-anchor`: start, middle or end.
+    pub anchor: String,
+    /// `dy`: how the baseline stands to y (plotters: "0.76em" top, "0.5ex" centre, "-0.5ex"
+    /// bottom, none for the baseline).
+    pub dy: String,
+}
+
+/// Advance of a character (em) assumed for a text's box: DejaVu Sans' lower case and digits
+/// average 0.55–0.64 em.
+const CHAR_EM: f64 = 0.6;
+
+impl SvgText {
+    /// The text's box (px): left, top, right, bottom, its width estimated at 0.6 em a character,
+    /// its height one em.
+    pub fn bbox(&self) -> [f64; 4] {
+        let fs = self.font_size;
+        let w = CHAR_EM * fs * self.text.chars().count() as f64;
+        let left = match self.anchor.as_str() {
+            "middle" => self.x - 0.5 * w,
+            "end" => self.x - w,
+            _ => self.x,
+        };
+        let top = match self.dy.as_str() {
+            "0.76em" => self.y,
+            "0.5ex" => self.y - 0.5 * fs,
+            "-0.5ex" => self.y - fs,
+            _ => self.y - 0.8 * fs,
+        };
+        [left, top, left + w, top + fs]
+    }
+}
+
+/// Asserts that no two of `texts` overlap (boxes of [`SvgText::bbox`], shrunk by half a pixel
+/// each side for the rounding of positions to whole pixels).
+pub fn assert_no_overlap(texts: &[&SvgText]) {
+    for (i, a) in texts.iter().enumerate() {
+        for b in &texts[i + 1..] {
+            let (p, q) = (a.bbox(), b.bbox());
+            let clear = p[2] - 0.5 <= q[0] + 0.5
+                || q[2] - 0.5 <= p[0] + 0.5
+                || p[3] - 0.5 <= q[1] + 0.5
+                || q[3] - 0.5 <= p[1] + 0.5;
+            assert!(clear, "labels overlap: {a:?} {p:?} and {b:?} {q:?}");
+        }
+    }
 }
 
 /// The parts of a plot's SVG that the checks need.
@@ -44,9 +91,21 @@ pub fn read(path: &std::path::Path) -> Svg {
         if tag.starts_with("<text") {
             let body_end = rest.find("</text>").unwrap_or(close + 1);
             let body = rest[close + 1..body_end].trim().to_string();
+            let word = |name: &str| {
+                let key = format!(" {name}=\"");
+                tag.find(&key)
+                    .and_then(|s| {
+                        let s = s + key.len();
+                        tag[s..].find('"').map(|e| tag[s..s + e].to_string())
+                    })
+                    .unwrap_or_default()
+            };
             svg.texts.push(SvgText {
                 x: attr(tag, "x").unwrap_or(0.0),
                 y: attr(tag, "y").unwrap_or(0.0),
+                font_size: attr(tag, "font-size").unwrap_or(0.0),
+                anchor: word("text-anchor"),
+                dy: word("dy"),
                 text: body
                     .replace("&lt;", "<")
                     .replace("&gt;", ">")
