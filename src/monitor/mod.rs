@@ -641,6 +641,7 @@ impl Monitor {
             max_eccentricity_ratio: if beyond_clearance { 0.0 } else { r.ecc },
             full_window,
             growth_per_rev: growth,
+            previous: self.report.bearings[bi].state,
         });
         let (alert, danger, time_to_alert_s) = self.alarms(c, speed_rad_s, subsync_m, growth);
         let old = self.report.bearings[bi];
