@@ -56,6 +56,18 @@ fn the_growing_linear_run_at_9000_rpm_is_not_stable() {
     );
 }
 
+/// The revolution's verdict is `stable` (else the revolution, its speed and its evidence).
+fn assert_stable(r: &RevolutionReport) {
+    assert_eq!(
+        r.state,
+        RotorState::Stable,
+        "rev {} at {:.0} rpm: {}",
+        r.revolution,
+        r.speed_rad_s * 30.0 / std::f64::consts::PI,
+        r.evidence()
+    );
+}
+
 /// Runs `rotor` at `speed_rpm` for `revs` revolutions (64 steps a revolution, tabulated film),
 /// calling `at_rev` after each revolution; returns every revolution's report.
 fn run(
@@ -122,13 +134,7 @@ fn a_sudden_unbalance_at_8000_rpm_decays_and_stays_stable() {
     println!("largest sub-synchronous amplitude after the step {peak:.3e} m");
     assert!(peak > 10.0 * 1e-3 * 40e-6, "a transient was excited");
     for r in &history {
-        assert_eq!(
-            r.state,
-            RotorState::Stable,
-            "rev {}: {}",
-            r.revolution,
-            r.evidence()
-        );
+        assert_stable(r);
     }
     let last = &history[history.len() - 1];
     for b in &last.bearings {
@@ -245,13 +251,7 @@ fn near_the_threshold_the_verdict_does_not_flip() {
     let history = run_driven(8450.0, 260, &Drive::default());
     let mut judged = 0;
     for r in &history {
-        assert_eq!(
-            r.state,
-            RotorState::Stable,
-            "rev {}: {}",
-            r.revolution,
-            r.evidence()
-        );
+        assert_stable(r);
         judged += r
             .bearings
             .iter()
@@ -286,14 +286,5 @@ fn a_run_up_through_the_first_critical_is_quiet() {
         .unwrap();
     println!("1X peak at {:.0} rpm", rpm(peak));
     assert!(rpm(peak) > 3000.0 && rpm(peak) < 5900.0, "{}", rpm(peak));
-    for r in &history {
-        assert_eq!(
-            r.state,
-            RotorState::Stable,
-            "rev {} at {:.0} rpm: {}",
-            r.revolution,
-            rpm(r),
-            r.evidence()
-        );
-    }
+    history.iter().for_each(assert_stable);
 }
