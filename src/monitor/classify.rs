@@ -62,7 +62,8 @@ pub struct ClassifierSettings {
     /// Half-width of the dead band about [`Self::growth_threshold_per_rev`] (1/rev): the growth
     /// estimate's own scatter. A small component starts `growing` only when its estimate exceeds
     /// the threshold by more than this, and a growing one stays growing until its estimate falls
-    /// below the threshold by more than this; in between the previous verdict holds. Default
+    /// below the threshold by more than this or it decays (below −threshold, which with the
+    /// defaults comes first: −0.002/rev); in between the previous verdict holds. Default
     /// 0.005/rev: near the stability threshold (Ø55 shipped rotor, nonlinear, tabulated film,
     /// 64 steps a revolution, 8,450 and 8,500 rpm, 700 revolutions each, both bearings) the
     /// estimate ([`log_growth_per_rev`] of the 16-revolution histories) differs from the local
@@ -377,7 +378,8 @@ mod tests {
         assert_eq!(s.classify(&ev(5e-6, None, 0.6)), RotorState::Stable);
         assert_eq!(s.classify(&ev(30e-6, None, 0.95)), RotorState::Whip);
         // the dead band (0.002 ± 0.005/rev): a small component starts growing only beyond
-        // 0.007/rev, and a growing one stays growing down to −0.003/rev
+        // 0.007/rev, and a growing one stays growing until it decays (below −0.002/rev, which
+        // comes before 0.002 − 0.005)
         assert_eq!(
             s.classify(&ev(0.3e-6, Some(0.0065), 0.6)),
             RotorState::Stable
@@ -390,8 +392,9 @@ mod tests {
             previous: RotorState::Growing,
             ..ev(0.3e-6, Some(g), 0.6)
         };
-        assert_eq!(s.classify(&was_growing(-0.0025)), RotorState::Growing);
-        assert_eq!(s.classify(&was_growing(-0.0035)), RotorState::Stable);
+        assert_eq!(s.classify(&was_growing(0.0015)), RotorState::Growing);
+        assert_eq!(s.classify(&was_growing(-0.0015)), RotorState::Growing);
+        assert_eq!(s.classify(&was_growing(-0.0025)), RotorState::Stable);
     }
 
     /// The microturbine at 9,000 rpm, c = 40 µm: ISO B/C 9000/√9000 = 94.87 µm p-p (47.4 µm
