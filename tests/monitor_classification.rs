@@ -8,6 +8,7 @@ use common::run_cli;
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::monitor::{ClassifierSettings, Monitor, RevolutionReport, RotorState};
 use rotor_twin::rotor::{MachineDescription, Rotor};
+use rotor_twin::transient::{self, Drive, SpeedHistory, TransientSpec};
 use rotor_twin::units::rpm_to_rad_s;
 use serde_json::Value;
 
@@ -52,6 +53,18 @@ fn the_growing_linear_run_at_9000_rpm_is_not_stable() {
     assert!(
         t > 0.0 && (t / expected - 1.0).abs() < 1e-6,
         "{t} s vs {expected} s"
+    );
+}
+
+/// The revolution's verdict is `stable` (else the revolution, its speed and its evidence).
+fn assert_stable(r: &RevolutionReport) {
+    assert_eq!(
+        r.state,
+        RotorState::Stable,
+        "rev {} at {:.0} rpm: {}",
+        r.revolution,
+        r.speed_rad_s * 30.0 / std::f64::consts::PI,
+        r.evidence()
     );
 }
 
@@ -121,13 +134,7 @@ fn a_sudden_unbalance_at_8000_rpm_decays_and_stays_stable() {
     println!("largest sub-synchronous amplitude after the step {peak:.3e} m");
     assert!(peak > 10.0 * 1e-3 * 40e-6, "a transient was excited");
     for r in &history {
-        assert_eq!(
-            r.state,
-            RotorState::Stable,
-            "rev {}: {}",
-            r.revolution,
-            r.evidence()
-        );
+        assert_stable(r);
     }
     let last = &history[history.len() - 1];
     for b in &last.bearings {
@@ -209,4 +216,75 @@ fn alarm_levels_in_the_machine_file_are_checked() {
         e.contains("alarm_levels.danger_amplitude_m") && e.contains("at least"),
         "{e}"
     );
+}
+
+/// A transient of the shipped rotor (nonlinear, tabulated film, 64 steps a revolution, the
+/// film tables cached in the build's temporary directory) under `drive`; every revolution's
+/// report.
+fn run_driven(speed_rpm: f64, revolutions: usize, drive: &Drive) -> Vec<RevolutionReport> {
+    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
+        common::test_cache_dir(),
+    )));
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let spec = TransientSpec {
+        speed_rpm,
+        revolutions,
+        coupling: Coupling::Nonlinear,
+        steps_per_rev: 64,
+        grid: None,
+        film: FilmEvaluation::Table,
+    };
+    transient::run_driven(&rotor, &spec, None, drive)
+        .unwrap()
+        .history
+}
+
+/// Near the stability threshold (8,450 rpm, the nonlinear model's sub-synchronous component of
+/// 0.06 µm grows at +0.0013/rev: measured over 700 revolutions, below the 0.002/rev threshold)
+/// the growth estimate scatters by ±0.005/rev about its true value. Without the dead band
+/// (`ClassifierSettings::growth_dead_band_per_rev`) the monitor called it `growing` from
+/// revolution 66 on, one to three revolutions in every twelve; with it every revolution is
+/// `stable`, while the component is present (above the floor of 10⁻³ c) with a known growth rate
+/// on at least 150 of them (so the band, not the floor, decides).
+#[test]
+fn near_the_threshold_the_verdict_does_not_flip() {
+    let history = run_driven(8450.0, 260, &Drive::default());
+    let mut judged = 0;
+    for r in &history {
+        assert_stable(r);
+        judged += r
+            .bearings
+            .iter()
+            .all(|b| b.subsync_growth_per_rev.is_some() && b.subsync_amplitude_m > 1e-3 * 40e-6)
+            as usize;
+    }
+    println!("revolutions judged on their growth: {judged}");
+    assert!(judged >= 150, "{judged}");
+}
+
+/// A run-up at 1,000 rpm/s from 2,000 to 6,000 rpm through the first critical speed (3,662 rpm,
+/// README "The microturbine") and 20 revolutions at 6,000: the 1X response peaks inside the ramp
+/// (the critical is crossed) and every revolution is `stable`. Before, revolutions 131–152
+/// (4,440–4,716 rpm) read `growing` at up to 0.066/rev: the spectrum's largest in-band bin was
+/// bin 2, the flank of the slow drift of the journal's mean position (bin 1 4× larger), read
+/// as a 0.04–0.11 µm component at 0.094X.
+#[test]
+fn a_run_up_through_the_first_critical_is_quiet() {
+    let drive = Drive {
+        speed: Some(SpeedHistory::ramp(2000.0, 6000.0, 1000.0).unwrap()),
+        kicks: vec![],
+    };
+    let history = run_driven(2000.0, 20, &drive);
+    let rpm = |r: &RevolutionReport| r.speed_rad_s * 30.0 / std::f64::consts::PI;
+    let peak = history
+        .iter()
+        .max_by(|a, b| {
+            a.bearings[0]
+                .one_x_amplitude_m
+                .total_cmp(&b.bearings[0].one_x_amplitude_m)
+        })
+        .unwrap();
+    println!("1X peak at {:.0} rpm", rpm(peak));
+    assert!(rpm(peak) > 3000.0 && rpm(peak) < 5900.0, "{}", rpm(peak));
+    history.iter().for_each(assert_stable);
 }

@@ -641,9 +641,8 @@ impl Monitor {
         let r = self.last_revolution(bi, self.recent_samples(span));
         let rub = self.last_revolution(bi, last);
         let (orbit_diff, pressure_diff) = self.rev_to_rev(bi, last);
-        let path_diff = self
-            .path_diff(bi, last)
-            .unwrap_or(self.report.bearings[bi].orbit_path_diff);
+        let old = self.report.bearings[bi];
+        let path_diff = self.path_diff(bi, last).unwrap_or(old.orbit_path_diff);
         let s = self.settings;
         // a journal beyond the clearance without a wall (the linear model) is outside the
         // model's validity: flagged, and never called a whip on its eccentricity alone
@@ -660,9 +659,9 @@ impl Monitor {
             max_eccentricity_ratio: if beyond_clearance { 0.0 } else { r.ecc },
             full_window,
             growth_per_rev: growth,
+            previous: old.state,
         });
         let (alert, danger, time_to_alert_s) = self.alarms(c, speed_rad_s, subsync_m, growth);
-        let old = self.report.bearings[bi];
         let (pp_x, pp_y) = ((r.x[1] - r.x[0]).max(0.0), (r.y[1] - r.y[0]).max(0.0));
         let min_film = (1.0 - r.ecc.min(self.contact_onset_ratio)).max(0.0) * c;
         let b = BearingRevolution {

@@ -153,15 +153,23 @@ pub fn one_x_component(spec: &[OrderComponent], resolution: usize) -> OrderCompo
 /// semi-major axis among bins k = 2 … resolution − 3, interpolated ([`interpolate_peak`]). Bin 1
 /// is left out (a drift of the mean position leaks into it), and so are bins resolution − 2 and
 /// resolution − 1: the Hann window puts half of the 1X component into bin resolution − 1, and
-/// the interpolation of a peak at resolution − 2 would use it. A zero component if the
-/// resolution is below 5. The one detector of the monitor and the replay.
+/// the interpolation of a peak at resolution − 2 would use it. The bin must be a peak, at least
+/// as large as both its neighbours (bins 1 and resolution − 2 included): a band edge that is
+/// only the flank of what lies outside the band is no sub-synchronous component. A drift of the
+/// mean position slower than the window (the equilibrium moving in a run-up) falls
+/// monotonically from bin 1 (1/(k(k² − 1)) for a ramp under the Hann window); without the rule
+/// its flank at bin 2 read as a component of 0.04–0.1 µm at 0.094X "growing" at up to
+/// 0.066/rev on a 1,000 rpm/s run-up past the first critical speed
+/// (`tests/monitor_classification.rs`). A zero component if there is none or the resolution is
+/// below 5. The one detector of the monitor and the replay.
 pub fn subsynchronous_peak(spec: &[OrderComponent], resolution: usize) -> OrderComponent {
     let last = resolution.saturating_sub(3).min(spec.len());
-    let best = (2..=last).max_by(|&a, &b| {
-        spec[a - 1]
-            .semi_major_m()
-            .total_cmp(&spec[b - 1].semi_major_m())
-    });
+    let size = |k: usize| spec[k - 1].semi_major_m();
+    let is_peak =
+        |k: usize| size(k) >= size(k - 1) && (k + 1 > spec.len() || size(k) >= size(k + 1));
+    let best = (2..=last)
+        .filter(|&k| is_peak(k))
+        .max_by(|&a, &b| size(a).total_cmp(&size(b)));
     match best {
         Some(k) => interpolate_peak(spec, k, resolution),
         None => OrderComponent::default(),
