@@ -25,3 +25,4 @@ pub mod sweep;
 pub mod topics;
 pub mod transient;
 pub mod units;
+pub mod viewer;

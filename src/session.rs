@@ -85,6 +85,23 @@ pub fn header(ns: i64, frame: &str) -> Header {
     }
 }
 
+/// Most revolutions an Orbit message holds (a whirl order down to 1/4.5 ≈ 0.22X is still a
+/// whole loop within half a revolution); the monitor keeps 16.
+pub const MAX_ORBIT_REVOLUTIONS: usize = 4;
+
+/// Revolutions in an Orbit message: one, or, when the monitor reports a sub-synchronous
+/// component of order `subsync_ratio` (0: none), the whole number of revolutions nearest one
+/// sub-synchronous period, 1/`subsync_ratio` revolutions (2 from 0.4X to 2/3X, oil whirl and whip at ≈0.45–0.5X),
+/// at most [`MAX_ORBIT_REVOLUTIONS`]: the orbit then closes on itself as the whirl loop does
+/// (one revolution at 0.5X is half the loop).
+pub fn orbit_revolutions(subsync_ratio: f64) -> usize {
+    if subsync_ratio > 0.0 && subsync_ratio < 1.0 {
+        ((1.0 / subsync_ratio).round() as usize).clamp(1, MAX_ORBIT_REVOLUTIONS)
+    } else {
+        1
+    }
+}
+
 /// What a warning about the twin's inputs or its own running is about (the classification's
 /// kinds, none | whirl | whip | contact, come from the monitor's state).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -382,7 +399,9 @@ impl Session {
     fn emit_revolution(&mut self, stamp: i64, emit: &mut impl FnMut(Outgoing)) {
         let rep = self.monitor.report();
         for (k, b) in rep.bearings.iter().enumerate() {
-            let orbit = self.monitor.recent_orbit(k, 1);
+            let orbit = self
+                .monitor
+                .recent_orbit(k, orbit_revolutions(b.subsync_ratio));
             emit(Outgoing::Orbit(Orbit {
                 header: header(stamp, &self.names[k]),
                 bearing: self.names[k].clone(),

@@ -35,8 +35,29 @@ pub const FORECAST: &str = "/rotor_twin/forecast";
 pub const JOURNAL: &str = "/rotor_twin/journal_state";
 /// Film state of each bearing, out.
 pub const FILM: &str = "/rotor_twin/film_state";
-/// One revolution's orbit of each bearing, out.
+/// The orbit of each bearing, every revolution (both bearings on one topic), out: whole whirl
+/// periods when a sub-synchronous component is present (see `session`).
 pub const ORBIT: &str = "/rotor_twin/orbit";
+/// Highest rate of a viewer's topics (Hz): the per-bearing orbit topics keep one orbit in every
+/// 1/`VIEWER_MAX_HZ` s of model time per bearing. Foxglove and Lichtblick warn about "High
+/// frequency topics" above 60 Hz (`FREQUENCY_LIMIT` in Lichtblick's players/utils/constants.ts);
+/// 50 Hz leaves room for jitter of the stamps.
+pub const VIEWER_MAX_HZ: f64 = 50.0;
+
+/// The orbit topic of one bearing, for viewers: `/rotor_twin/orbit/<bearing>` (in the node's
+/// namespace like the twin's other topics), the same Orbit messages as [`ORBIT`] for that bearing,
+/// at most [`VIEWER_MAX_HZ`]. A character a ROS 2 name token does not allow (not a letter, digit
+/// or `_`) becomes `_`, and a leading digit gets a `_` before it.
+pub fn bearing_orbit(bearing: &str) -> String {
+    let mut token: String = bearing
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if token.is_empty() || token.starts_with(|c: char| c.is_ascii_digit()) {
+        token.insert(0, '_');
+    }
+    format!("{ORBIT}/{token}")
+}
 /// Instability and input warnings, out.
 pub const WARNING: &str = "/rotor_twin/warning";
 /// diagnostic_msgs/DiagnosticArray, out.

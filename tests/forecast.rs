@@ -6,12 +6,9 @@
 
 mod common;
 
-use common::{run_cli, test_cache_dir};
-use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
+use common::run_cli;
 use rotor_twin::forecast::{ForecastSettings, ForecastStart, Forecaster};
 use rotor_twin::monitor::RotorState;
-use rotor_twin::rotor::{MachineDescription, Rotor};
-use rotor_twin::session::{Session, SessionSettings};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -29,18 +26,8 @@ fn scratch(name: &str) -> PathBuf {
 /// (restore replays the checkpoint).
 #[test]
 fn a_forecast_from_a_checkpoint_equals_the_direct_continuation() {
-    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(test_cache_dir())));
-    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let (rotor, config, mut session, input) = common::rated_nonlinear_session();
     let w = rotor.rated_speed_rad_s;
-    let config = TwinConfig {
-        film: FilmEvaluation::Table,
-        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64)
-    };
-    let mut session = Session::new(&rotor, config, w, SessionSettings::default(), 0).unwrap();
-    let input = StepInput {
-        speed_rad_s: w,
-        accel_rad_s2: 0.0,
-    };
     let h = config.time_step_s;
     for _ in 0..(0.4 / h).round() as usize {
         session.step(&input, &mut |_| {}).unwrap();

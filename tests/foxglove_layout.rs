@@ -4,16 +4,29 @@
 //! plots are square (equal x and y ranges, the clearance of the built-in machine); every panel has
 //! its title where Foxglove and Lichtblick read it (`foxglovePanelTitle`, `lichtblickPanelTitle`:
 //! ../shared/notes/foxglove-lichtblick.md; `title` is not read); no plot mixes units on its y axis.
+//! The XY orbit plots read one bearing's own topic (`/rotor_twin/orbit/<bearing>`) without a
+//! filter: an XY plot of the latest message filtered by bearing draws nothing for the bearing
+//! whose orbit comes first on the shared topic (seen in Lichtblick). The per-bearing topics
+//! exist in the replay's output bag, hold the shared topic's orbits of their bearing, and stay
+//! at ≤ 50 Hz (Lichtblick warns above 60 Hz, FREQUENCY_LIMIT).
+
+mod common;
 
 use rotor_twin::messages::{FilmState, JournalState, Orbit, RosMessage};
-use rotor_twin::rotor::MachineDescription;
+use rotor_twin::rotor::{MachineDescription, Rotor};
+use rotor_twin::topics;
+use rotor_twin::viewer::BearingOrbits;
 use serde_json::Value;
 
+/// The fields of a topic the node publishes (for the built-in machine), None if it does not.
 fn fields_of(topic: &str) -> Option<&'static [(&'static str, &'static str)]> {
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let per_bearing = BearingOrbits::new(&rotor).topics();
     match topic {
-        "/rotor_twin/orbit" => Some(Orbit::FIELDS),
-        "/rotor_twin/journal_state" => Some(JournalState::FIELDS),
-        "/rotor_twin/film_state" => Some(FilmState::FIELDS),
+        topics::ORBIT => Some(Orbit::FIELDS),
+        topics::JOURNAL => Some(JournalState::FIELDS),
+        topics::FILM => Some(FilmState::FIELDS),
+        t if per_bearing.iter().any(|p| p == t) => Some(Orbit::FIELDS),
         _ => None,
     }
 }
@@ -107,6 +120,26 @@ fn check_layout(v: &Value) {
                 check_path(x["value"].as_str().unwrap(), &bearings);
             }
         }
+        if cfg["xAxisVal"] == "currentCustom" {
+            // the latest message is drawn: it must be the bearing's own, unfiltered
+            for p in cfg["paths"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .chain([&cfg["xAxisPath"]])
+            {
+                let path = p["value"].as_str().unwrap();
+                assert!(
+                    !path.contains('{'),
+                    "{id}: {path} filters the latest message"
+                );
+                let topic = path.rsplit_once('.').unwrap().0;
+                assert!(
+                    bearings.iter().any(|b| topics::bearing_orbit(b) == topic),
+                    "{id}: {topic} is not one bearing's orbit topic"
+                );
+            }
+        }
         if id.starts_with("Plot!orbit") {
             let c = desc.bearings[0].film().unwrap().geometry.radial_clearance_m;
             for key in ["minXValue", "minYValue"] {
@@ -141,4 +174,110 @@ fn check_layout(v: &Value) {
     ids.dedup();
     assert_eq!(ids.len(), configs.len());
     assert!(ids.iter().all(|i| configs.contains_key(i)));
+}
+
+/// Topic names are ROS 2 name tokens whatever the bearing is called.
+#[test]
+fn bearing_orbit_topics_are_ros_names() {
+    assert_eq!(
+        topics::bearing_orbit("bearing_outboard"),
+        "/rotor_twin/orbit/bearing_outboard"
+    );
+    assert_eq!(
+        topics::bearing_orbit("2-drive end"),
+        "/rotor_twin/orbit/_2_drive_end"
+    );
+}
+
+fn orbit(bearing: &str, stamp_ns: i64) -> Orbit {
+    Orbit {
+        header: rotor_twin::session::header(stamp_ns, bearing),
+        bearing: bearing.into(),
+        ..Orbit::default()
+    }
+}
+
+/// 9,000 rpm: 150 revolutions a second; two bearings; 1 s of orbits. The viewer topics get
+/// every third revolution (50 Hz, 20 ms apart; the 6.67 ms revolution period · 3), each bearing
+/// its own; a stamp going back (a restarted twin) is kept at once.
+#[test]
+fn viewer_topics_keep_one_orbit_in_twenty_ms_per_bearing() {
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let mut r = BearingOrbits::new(&rotor);
+    let names: Vec<String> = rotor.bearings.iter().map(|b| b.name.clone()).collect();
+    assert_eq!(r.topics().len(), 2);
+    let period_ns = 1e9 / 150.0;
+    let mut kept = vec![Vec::new(); 2];
+    for rev in 0..150 {
+        let stamp = (rev as f64 * period_ns).round() as i64;
+        for (i, name) in names.iter().enumerate() {
+            if let Some(k) = r.route(&orbit(name, stamp)) {
+                assert_eq!(k, i);
+                kept[k].push(stamp);
+            }
+        }
+    }
+    for k in kept {
+        assert_eq!(k.len(), 50, "one in three of 150 revolutions");
+        let rate = (k.len() - 1) as f64 / ((k[k.len() - 1] - k[0]) as f64 * 1e-9);
+        assert!(rate <= 50.5, "{rate} Hz");
+    }
+    assert_eq!(r.route(&orbit("no_such_bearing", 0)), None);
+    assert_eq!(r.route(&orbit(&names[0], 0)), Some(0));
+}
+
+/// A replay's output bag (3 s of the shipped run-up, machine by default the built-in one, 8,000
+/// to 9,500 rpm) has every topic the replay layout names, each bearing's orbit topic holds
+/// that bearing's orbits of the shared topic only, at ≤ 50 Hz, while the shared topic keeps
+/// every revolution of both bearings (the consumers that rely on it lose nothing).
+#[test]
+fn the_replay_output_has_the_layout_topics_at_viewer_rates() {
+    let dir = std::env::temp_dir().join(format!("rotor-twin-layout-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let sample = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bags/orc_runup_synthetic");
+    let out = dir.join("out");
+    let (ok, stdout, stderr) = common::run_cli(&[
+        "replay",
+        sample.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--duration",
+        "3",
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let bag = rotor_twin::bag::Bag::read(&out.join("bag")).unwrap();
+    let layout = load("config/foxglove_layout_replay.json").to_string();
+    let names: Vec<&str> = bag.topics.iter().map(|t| t.name.as_str()).collect();
+    let mut per_topic: std::collections::HashMap<String, Vec<Orbit>> = Default::default();
+    for m in bag.messages() {
+        let name = &bag.topics[m.topic].name;
+        if name.starts_with(topics::ORBIT) {
+            let o: Orbit = rotor_twin::messages::from_cdr(m.payload()).unwrap();
+            per_topic.entry(name.clone()).or_default().push(o);
+        }
+    }
+    let shared = &per_topic[topics::ORBIT];
+    for b in ["bearing_pulley_end", "bearing_outboard"] {
+        let t = topics::bearing_orbit(b);
+        assert!(names.contains(&t.as_str()), "{t} not in {names:?}");
+        assert!(layout.contains(&t), "the layout reads {t}");
+        let own = &per_topic[&t];
+        let all: Vec<&Orbit> = shared.iter().filter(|o| o.bearing == b).collect();
+        assert!(own.iter().all(|o| o.bearing == b && all.contains(&o)));
+        let span = (own[own.len() - 1].header.stamp.as_nanos() - own[0].header.stamp.as_nanos())
+            as f64
+            * 1e-9;
+        let (rate, all_rate) = ((own.len() - 1) as f64 / span, (all.len() - 1) as f64 / span);
+        println!(
+            "{t}: {} orbits, {rate:.1} Hz; shared: {} ({all_rate:.1} Hz)",
+            own.len(),
+            all.len()
+        );
+        assert!(rate <= 50.5 && rate > 35.0, "{rate} Hz");
+        assert!(
+            all_rate > 120.0,
+            "every revolution on the shared topic: {all_rate} Hz"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -212,7 +212,8 @@ ros_message!(
 );
 
 ros_message!(
-    /// One revolution's orbit and spectral summary (m).
+    /// The last revolution's orbit (whole whirl loops, `session::orbit_revolutions`, when a
+    /// sub-synchronous component is present) and spectral summary (m).
     Orbit, "Orbit.msg" {
         /// Simulation time; frame: the bearing.
         header: Header = "std_msgs/Header",

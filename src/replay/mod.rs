@@ -173,7 +173,7 @@ pub fn replay(
     let wall = std::time::Instant::now();
     let (roles, comparisons) = roles_and_comparisons(bag, rotor, options)?;
     let mut out = match &options.out_bag {
-        Some(dir) => Some(OutputBag::create(dir, bag, &roles, options)?),
+        Some(dir) => Some(OutputBag::create(dir, bag, rotor, &roles, options)?),
         None => None,
     };
     let Some((t0, t_last)) = bag.time_span_ns() else {
@@ -625,6 +625,9 @@ struct OutputBag {
     journal: usize,
     film: usize,
     orbit: usize,
+    /// each bearing's orbit topic for viewers, and the rule that fills them (as the node's)
+    bearing_orbits: Vec<usize>,
+    orbit_routes: crate::viewer::BearingOrbits,
     warning: usize,
     residual: usize,
     margin: usize,
@@ -636,6 +639,7 @@ impl OutputBag {
     fn create(
         dir: &std::path::Path,
         bag: &Bag,
+        rotor: &Rotor,
         roles: &[Role],
         options: &ReplayOptions,
     ) -> Result<Self, ReplayError> {
@@ -660,7 +664,15 @@ impl OutputBag {
             });
         }
         use crate::topics;
+        let orbit_routes = crate::viewer::BearingOrbits::new(rotor);
+        let bearing_orbits = orbit_routes
+            .topics()
+            .iter()
+            .map(|t| rec.add_topic::<messages::Orbit>(t, topics::STATE))
+            .collect::<Result<_, _>>()?;
         Ok(Self {
+            bearing_orbits,
+            orbit_routes,
             journal: rec.add_topic::<messages::JournalState>(topics::JOURNAL, topics::STATE)?,
             film: rec.add_topic::<messages::FilmState>(topics::FILM, topics::STATE)?,
             orbit: rec.add_topic::<messages::Orbit>(topics::ORBIT, topics::STATE)?,
@@ -690,6 +702,12 @@ impl OutputBag {
 
     fn write_outgoing(&mut self, o: &Outgoing) -> Result<(), ReplayError> {
         let t = |h: &messages::Header| h.stamp.as_nanos().max(0) as u64;
+        if let Outgoing::Orbit(m) = o {
+            if let Some(k) = self.orbit_routes.route(m) {
+                let h = self.bearing_orbits[k];
+                self.rec.write(h, m, t(&m.header), t(&m.header))?;
+            }
+        }
         match o {
             Outgoing::Journal(m) => self.rec.write(self.journal, m, t(&m.header), t(&m.header)),
             Outgoing::Film(m) => self.rec.write(self.film, m, t(&m.header), t(&m.header)),

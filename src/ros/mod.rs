@@ -11,7 +11,8 @@
 //!   through the machine file's viscosity–temperature law (issue 12);
 //! - out `/rotor_twin/journal_state` JournalState and `/rotor_twin/film_state` FilmState, reliable,
 //!   keep last 10, at `state_rate_hz`; `/rotor_twin/orbit` Orbit per revolution, reliable, keep
-//!   last 10; `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
+//!   last 10, and `/rotor_twin/orbit/<bearing>` (each bearing's, ≤ 50 Hz, for viewers:
+//!   [`crate::viewer`]); `/rotor_twin/warning` InstabilityWarning, reliable, transient local, keep last 1
 //!   (a late subscriber sees the last one); `/diagnostics` diagnostic_msgs/DiagnosticArray, 1 Hz;
 //!   the journal and film states, orbits and residuals only while a reader is matched (all of
 //!   them when recording: [`model::Audience`]);

@@ -223,12 +223,12 @@ async fn run_async(
             node_options(&params, &live),
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
-    let publishers = Publishers::create(&mut node, &ros)?;
+    let publishers = Publishers::create(&mut node, &ros, &rotor)?;
     let counters = Arc::new(model::NodeCounters::default());
     follow_readers(&setup, &context, &publishers, &counters);
 
     let stop = Arc::new(AtomicBool::new(false));
-    let (recorder_thread, rec) = start_recorder(&setup, &params, &stop)?;
+    let (recorder_thread, rec) = start_recorder(&setup, &params, &rotor, &stop)?;
 
     // the model thread and the publishing thread
     let inbox = Arc::new(Mutex::new(Inbox::default()));
@@ -361,13 +361,15 @@ type Recording = (
 fn start_recorder(
     setup: &NodeSetup,
     params: &NodeParams,
+    rotor: &Rotor,
     stop: &Arc<AtomicBool>,
 ) -> anyhow::Result<Recording> {
     let Some(dir) = &setup.record else {
         return Ok((None, None));
     };
     let (tx, rx) = mpsc::sync_channel::<ToRecord>(65_536);
-    let thread = recording::spawn(dir, setup.record_split, params, rx, stop.clone())?;
+    let orbits = crate::viewer::BearingOrbits::new(rotor);
+    let thread = recording::spawn(dir, setup.record_split, params, orbits, rx, stop.clone())?;
     Ok((Some(thread), Some(tx)))
 }
 
@@ -551,6 +553,9 @@ struct Publishers {
     journal: ros2_client::Publisher<messages::JournalState>,
     film: ros2_client::Publisher<messages::FilmState>,
     orbit: ros2_client::Publisher<messages::Orbit>,
+    /// each bearing's orbit for viewers, at most `VIEWER_MAX_HZ` (crate::viewer)
+    bearing_orbits: Vec<ros2_client::Publisher<messages::Orbit>>,
+    orbit_routes: crate::viewer::BearingOrbits,
     warning: ros2_client::Publisher<messages::InstabilityWarning>,
     diagnostics: ros2_client::Publisher<messages::DiagnosticArray>,
     residual: ros2_client::Publisher<messages::OrbitResidual>,
@@ -619,27 +624,43 @@ async fn watch_readers(
             }),
             _ => continue,
         }
-        for ((_, g), r) in gated.iter().zip(&readers) {
-            counters.audience.set(*g, !r.is_empty());
+        // an output has an audience if any of its writers has a reader
+        for (_, g) in &gated {
+            let heard = gated
+                .iter()
+                .zip(&readers)
+                .any(|((_, h), r)| h == g && !r.is_empty());
+            counters.audience.set(*g, heard);
         }
     }
 }
 
 impl Publishers {
-    /// The writers of the outputs published only to a reader.
+    /// The writers of the outputs published only to a reader (the per-bearing orbit topics
+    /// are made from the orbits: a reader of any of them is a reader of the orbits).
     fn gated(&self) -> Vec<(ros2_client::dds::rustdds::GUID, model::Gated)> {
         use model::Gated;
-        vec![
+        let mut gated = vec![
             (self.journal.guid(), Gated::Journal),
             (self.film.guid(), Gated::Film),
             (self.orbit.guid(), Gated::Orbit),
             (self.residual.guid(), Gated::Residual),
-        ]
+        ];
+        gated.extend(self.bearing_orbits.iter().map(|w| (w.guid(), Gated::Orbit)));
+        gated
     }
 
-    fn create(node: &mut ros2_client::Node, ros: &RosArgs) -> anyhow::Result<Self> {
+    fn create(node: &mut ros2_client::Node, ros: &RosArgs, rotor: &Rotor) -> anyhow::Result<Self> {
         use crate::topics as qos;
+        let orbit_routes = crate::viewer::BearingOrbits::new(rotor);
+        let bearing_orbits = orbit_routes
+            .topics()
+            .iter()
+            .map(|t| publisher(node, ros, t, qos::STATE))
+            .collect::<anyhow::Result<_>>()?;
         Ok(Self {
+            bearing_orbits,
+            orbit_routes,
             journal: publisher(node, ros, JOURNAL, qos::STATE)?,
             film: publisher(node, ros, FILM, qos::STATE)?,
             orbit: publisher(node, ros, ORBIT, qos::STATE)?,
@@ -656,7 +677,7 @@ impl Publishers {
     /// The publishing thread: publishes what the model sends (a full send window drops the
     /// sample: the model is never blocked) and hands it to the recorder.
     fn spawn(
-        self,
+        mut self,
         out: mpsc::Receiver<Published>,
         rec: Option<mpsc::SyncSender<ToRecord>>,
         counters: Arc<model::NodeCounters>,
@@ -686,8 +707,16 @@ impl Publishers {
 
 impl Publishers {
     /// Publishes one of the twin's messages; false if the bus refused it.
-    fn publish_twin(&self, item: &Outgoing) -> bool {
-        match item {
+    fn publish_twin(&mut self, item: &Outgoing) -> bool {
+        // each bearing's orbit also on its viewer topic, when the rate rule keeps it
+        let viewer_sent = match item {
+            Outgoing::Orbit(m) => match self.orbit_routes.route(m) {
+                Some(k) => self.bearing_orbits[k].publish(m.clone()).is_ok(),
+                None => true,
+            },
+            _ => true,
+        };
+        let sent = match item {
             Outgoing::Journal(m) => self.journal.publish(m.clone()).is_ok(),
             Outgoing::Film(m) => self.film.publish(m.clone()).is_ok(),
             Outgoing::Orbit(m) => self.orbit.publish(m.clone()).is_ok(),
@@ -696,7 +725,8 @@ impl Publishers {
             Outgoing::Residual(m) => self.residual.publish(m.clone()).is_ok(),
             Outgoing::Margin(m) => self.margin.publish(m.clone()).is_ok(),
             Outgoing::Forecast(m) => self.forecast.publish((**m).clone()).is_ok(),
-        }
+        };
+        viewer_sent && sent
     }
 }
 

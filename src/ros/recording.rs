@@ -35,6 +35,32 @@ pub(super) enum ToRecord {
     ProbeValue(usize, messages::Float64, i64),
 }
 
+/// Stamps an unstamped input (header stamp 0: a tool that leaves it empty, e.g. `ros2 topic
+/// pub` without `--stamp`) with its receive time `ns` on the node's clock, in the recorded copy:
+/// the driver already takes the receive time for such an input (driver::inputs), and a stamp of
+/// 0 beside stamps of ~1.8·10⁹ s stretches a viewer's time axis so far that no data shows
+/// (Lichtblick, plotting by header stamp). Refusing them instead would lose a speed the twin
+/// ran on. Returns true if it stamped (the caller counts). std_msgs/Float64 inputs have no
+/// stamp and are left as they are.
+fn stamp_on_receipt(item: &mut ToRecord) -> bool {
+    let (header, ns) = match item {
+        ToRecord::Speed(m, ns) => (&mut m.header, *ns),
+        ToRecord::Unbalance(m, ns) => (&mut m.header, *ns),
+        ToRecord::Probe(m, ns) => (&mut m.header, *ns),
+        ToRecord::Point(_, m, ns) => (&mut m.header, *ns),
+        ToRecord::Temperature(m, ns) => (&mut m.header, *ns),
+        ToRecord::Keyphasor(m, ns) => (&mut m.header, *ns),
+        ToRecord::ProbeSignal(m, ns) => (&mut m.header, *ns),
+        ToRecord::KeyphasorHeader(m, ns) => (m, *ns),
+        ToRecord::Speed64(..) | ToRecord::ProbeValue(..) | ToRecord::Out(..) => return false,
+    };
+    if header.stamp != messages::Time::default() {
+        return false;
+    }
+    header.stamp = messages::Time::from_nanos(ns);
+    true
+}
+
 /// The recording's topic handles.
 struct Handles {
     speed: usize,
@@ -42,6 +68,9 @@ struct Handles {
     journal: usize,
     film: usize,
     orbit: usize,
+    /// each bearing's orbit topic for viewers, and the rule that fills them
+    bearing_orbits: Vec<usize>,
+    orbit_routes: crate::viewer::BearingOrbits,
     warning: usize,
     diagnostics: usize,
     probe: usize,
@@ -59,7 +88,11 @@ struct Handles {
 
 impl Handles {
     /// Every topic, the inputs in the types the node's parameters `params` subscribe them.
-    fn add(rec: &mut Recorder, params: &super::NodeParams) -> anyhow::Result<Self> {
+    fn add(
+        rec: &mut Recorder,
+        params: &super::NodeParams,
+        orbit_routes: crate::viewer::BearingOrbits,
+    ) -> anyhow::Result<Self> {
         let input = qos::INPUT_RECORDED;
         let speed = if params.speed_type == super::SpeedType::Float64 {
             rec.add_topic::<messages::Float64>(SPEED, input)?
@@ -82,7 +115,14 @@ impl Handles {
         };
         let points = each(&params.probe_point_topics, false)?;
         let values = each(&params.probe_signal_topics, true)?;
+        let bearing_orbits = orbit_routes
+            .topics()
+            .iter()
+            .map(|t| rec.add_topic::<messages::Orbit>(t, qos::STATE))
+            .collect::<Result<_, _>>()?;
         Ok(Self {
+            bearing_orbits,
+            orbit_routes,
             speed,
             keyphasor,
             points,
@@ -108,8 +148,17 @@ impl Handles {
     }
 
     /// Writes one item on its topic.
-    fn write(&self, rec: &mut Recorder, item: &ToRecord) -> Result<(), crate::record::RecordError> {
+    fn write(
+        &mut self,
+        rec: &mut Recorder,
+        item: &ToRecord,
+    ) -> Result<(), crate::record::RecordError> {
         let t = |ns: &i64| *ns as u64;
+        if let ToRecord::Out(Published::Twin(Outgoing::Orbit(m)), ns) = item {
+            if let Some(k) = self.orbit_routes.route(m) {
+                rec.write(self.bearing_orbits[k], m, t(ns), t(ns))?;
+            }
+        }
         match item {
             ToRecord::Speed(m, ns) => rec.write(self.speed, m, t(ns), t(ns)),
             ToRecord::Speed64(m, ns) => rec.write(self.speed, m, t(ns), t(ns)),
@@ -165,15 +214,25 @@ pub(super) fn spawn(
     dir: &Path,
     split: crate::record::SplitLimits,
     params: &super::NodeParams,
+    orbit_routes: crate::viewer::BearingOrbits,
     rx: mpsc::Receiver<ToRecord>,
     stop: Arc<AtomicBool>,
 ) -> anyhow::Result<JoinHandle<anyhow::Result<PathBuf>>> {
     let mut rec = Recorder::create_split(dir, split)?;
-    let handles = Handles::add(&mut rec, params)?;
+    let mut handles = Handles::add(&mut rec, params, orbit_routes)?;
     Ok(std::thread::spawn(move || -> anyhow::Result<PathBuf> {
+        let mut stamped = 0u64;
         loop {
             match rx.recv_timeout(Duration::from_millis(200)) {
-                Ok(item) => handles.write(&mut rec, &item)?,
+                Ok(mut item) => {
+                    if stamp_on_receipt(&mut item) {
+                        stamped += 1;
+                        if stamped == 1 {
+                            super::log::warn("recording: an input with header stamp 0 is recorded with its receive time as its stamp (counted; the total is said when the recording ends)");
+                        }
+                    }
+                    handles.write(&mut rec, &item)?
+                }
                 // after shutdown, the first quiet moment ends the recording
                 Err(mpsc::RecvTimeoutError::Timeout) if stop.load(Ordering::Relaxed) => break,
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
@@ -181,6 +240,36 @@ pub(super) fn spawn(
             }
             rec.flush_if_due(Duration::from_secs(1))?;
         }
+        if stamped > 0 {
+            super::log::warn(&format!(
+                "recording: {stamped} unstamped inputs recorded with their receive time as their stamp"
+            ));
+        }
         Ok(rec.finish()?)
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An unstamped speed gets its receive time; a stamped one and a Float64 (no stamp) keep
+    /// theirs.
+    #[test]
+    fn unstamped_inputs_get_their_receive_time() {
+        let recv_ns = 1_764_000_000_123_456_789;
+        let mut unstamped = ToRecord::Speed(messages::RotorSpeed::default(), recv_ns);
+        assert!(stamp_on_receipt(&mut unstamped));
+        let ToRecord::Speed(m, _) = &unstamped else {
+            unreachable!()
+        };
+        assert_eq!(m.header.stamp.as_nanos(), recv_ns);
+        let mut stamped = messages::RotorSpeed::default();
+        stamped.header.stamp = messages::Time::from_nanos(5);
+        assert!(!stamp_on_receipt(&mut ToRecord::Speed(stamped, recv_ns)));
+        let mut header = ToRecord::KeyphasorHeader(messages::Header::default(), recv_ns);
+        assert!(stamp_on_receipt(&mut header));
+        let bare = messages::Float64 { data: 1.0 };
+        assert!(!stamp_on_receipt(&mut ToRecord::Speed64(bare, recv_ns)));
+    }
 }

@@ -117,3 +117,31 @@ pub fn python() -> PathBuf {
     );
     root.join("tests/.venv/bin/python")
 }
+
+/// The built-in machine and its twin at the rated speed (nonlinear, film table cached in
+/// [`test_cache_dir`], 64 steps a revolution) from the static equilibrium, with the step input
+/// that holds that speed.
+pub fn rated_nonlinear_session() -> (
+    rotor_twin::rotor::Rotor,
+    rotor_twin::dynamics::TwinConfig,
+    rotor_twin::session::Session,
+    rotor_twin::dynamics::StepInput,
+) {
+    use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, TwinConfig};
+    use rotor_twin::session::{Session, SessionSettings};
+    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(test_cache_dir())));
+    let rotor = rotor_twin::rotor::Rotor::from_description(
+        &rotor_twin::rotor::MachineDescription::builtin_default(),
+    );
+    let w = rotor.rated_speed_rad_s;
+    let config = TwinConfig {
+        film: FilmEvaluation::Table,
+        ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64)
+    };
+    let session = Session::new(&rotor, config, w, SessionSettings::default(), 0).unwrap();
+    let input = StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    };
+    (rotor, config, session, input)
+}
