@@ -8,6 +8,7 @@ use crate::film::{
 use crate::units::rpm_to_rad_s;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use nalgebra::Matrix2;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -129,10 +130,14 @@ struct BearingReport {
     side_flow_m3_s: f64,
     inflow_m3_s: f64,
     film_reynolds_number: f64,
-    stiffness_n_per_m: [[f64; 2]; 2],
-    damping_n_s_per_m: [[f64; 2]; 2],
-    stiffness_dimensionless: [[f64; 2]; 2],
-    damping_dimensionless: [[f64; 2]; 2],
+    #[serde(with = "crate::film::rows")]
+    stiffness_n_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    damping_n_s_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    stiffness_dimensionless: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    damping_dimensionless: Matrix2<f64>,
     frame: &'static str,
 }
 
@@ -299,21 +304,26 @@ fn report_is_finite(r: &BearingReport) -> bool {
         r.stiffness_dimensionless,
         r.damping_dimensionless,
     ];
-    scalars.iter().all(|v| v.is_finite())
-        && matrices.iter().flatten().flatten().all(|v| v.is_finite())
+    scalars.iter().all(|v| v.is_finite()) && matrices.iter().flatten().all(|v| v.is_finite())
 }
 
 fn print_table(r: &BearingReport) -> anyhow::Result<()> {
-    let m = |a: [[f64; 2]; 2]| {
+    let m = |a: Matrix2<f64>| {
         format!(
             "[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]",
-            a[0][0], a[0][1], a[1][0], a[1][1]
+            a[(0, 0)],
+            a[(0, 1)],
+            a[(1, 0)],
+            a[(1, 1)]
         )
     };
-    let d = |a: [[f64; 2]; 2]| {
+    let d = |a: Matrix2<f64>| {
         format!(
             "[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]",
-            a[0][0], a[0][1], a[1][0], a[1][1]
+            a[(0, 0)],
+            a[(0, 1)],
+            a[(1, 0)],
+            a[(1, 1)]
         )
     };
     outln!(
