@@ -1,6 +1,7 @@
 //! `rotor-twin bearing`: static analysis of one journal bearing.
 
 use super::bearing_speeds::{self, SpeedRange, SweptBearing};
+use crate::film::rows2;
 use crate::film::{
     equilibrium_at_eccentricity, equilibrium_under_load, BearingGeometry, Equilibrium, FilmGrid,
     FilmModel, FiniteFilm, Lubricant, ShortFilm,
@@ -309,22 +310,12 @@ fn report_is_finite(r: &BearingReport) -> bool {
 
 fn print_table(r: &BearingReport) -> anyhow::Result<()> {
     let m = |a: Matrix2<f64>| {
-        format!(
-            "[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]",
-            a[(0, 0)],
-            a[(0, 1)],
-            a[(1, 0)],
-            a[(1, 1)]
-        )
+        let [[a00, a01], [a10, a11]] = rows2(&a);
+        format!("[{a00:>11.4e} {a01:>11.4e}; {a10:>11.4e} {a11:>11.4e}]")
     };
     let d = |a: Matrix2<f64>| {
-        format!(
-            "[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]",
-            a[(0, 0)],
-            a[(0, 1)],
-            a[(1, 0)],
-            a[(1, 1)]
-        )
+        let [[a00, a01], [a10, a11]] = rows2(&a);
+        format!("[{a00:>8.3} {a01:>8.3}; {a10:>8.3} {a11:>8.3}]")
     };
     outln!(
         "rotor-twin bearing: {:?} film, grid {}, grooves {:?}",

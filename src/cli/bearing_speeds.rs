@@ -334,9 +334,8 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
         "cyy"
     );
     for s in &r.speeds {
-        let flat = |a: Matrix2<f64>, unit: f64| {
-            [a[(0, 0)], a[(0, 1)], a[(1, 0)], a[(1, 1)]].map(|v| v * unit)
-        };
+        // xx, xy, yx, yy: the transpose's column-major order is the matrix's row order
+        let flat = |a: Matrix2<f64>, unit: f64| a.transpose() * unit;
         let (k, c) = (
             flat(s.stiffness_n_per_m, 1e-6),
             flat(s.damping_n_s_per_m, 1e-3),

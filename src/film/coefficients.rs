@@ -123,3 +123,32 @@ impl FilmCoefficients {
             .all(|v| v.is_finite())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rows form is row-major both ways (k_xy is row 0, column 1; nalgebra's own serde
+    /// would write the columns), and a FilmCoefficients' JSON keeps the nested rows of the
+    /// arrays it replaced, the zero added mass left out.
+    #[test]
+    fn matrices_read_and_write_as_rows() {
+        let text = "[[1.0, 2.0], [3.0, 4.0]]";
+        let m = rows::deserialize(&mut serde_json::Deserializer::from_str(text)).unwrap();
+        assert_eq!((m[(0, 1)], m[(1, 0)]), (2.0, 3.0));
+        let c = FilmCoefficients {
+            stiffness_n_per_m: m,
+            ..FilmCoefficients::default()
+        };
+        let v = serde_json::to_value(c).unwrap();
+        assert_eq!(
+            v["stiffness_n_per_m"],
+            serde_json::json!([[1.0, 2.0], [3.0, 4.0]])
+        );
+        assert_eq!(
+            v["damping_n_s_per_m"],
+            serde_json::json!([[0.0, 0.0], [0.0, 0.0]])
+        );
+        assert!(v.get("added_mass_kg").is_none(), "{v}");
+    }
+}

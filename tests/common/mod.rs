@@ -109,40 +109,48 @@ pub fn test_cache_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("film-cache")
 }
 
-/// The interop venv (created on first use by tests/interop/setup-venv.sh).
-pub fn python() -> PathBuf {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("run setup-venv.sh");
-    assert!(
-        out.status.success(),
-        "setup-venv.sh failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    root.join("tests/.venv/bin/python")
-}
-
-/// Runs the interop venv's Python on `tests/interop/<script>` with `args`, asserts that it
-/// succeeded (its standard error in the message if not), and returns its standard output.
-pub fn interop_script<I, S>(script: &str, args: I) -> Vec<u8>
+/// Runs `program tests/interop/<script> <args…>`, asserts that it succeeded (its standard
+/// error in the message if not) and returns its standard output.
+fn run_interop<I, S>(program: &std::ffi::OsStr, script: &str, args: I) -> Vec<u8>
 where
     I: IntoIterator<Item = S>,
     S: AsRef<std::ffi::OsStr>,
 {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new(python())
+    let out = Command::new(program)
         .arg(root.join("tests/interop").join(script))
         .args(args)
         .output()
         .unwrap_or_else(|e| panic!("{script}: {e}"));
     assert!(
         out.status.success(),
-        "{script}: {}",
+        "{script} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     out.stdout
+}
+
+/// Runs the venv set-up script `tests/interop/<script>` (it creates the venv on first use) and
+/// returns its standard output.
+pub fn set_up_venv(script: &str) -> String {
+    let out = run_interop("bash".as_ref(), script, [] as [&str; 0]);
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The interop venv's Python (Cyclone DDS, rosbags, mcap: tests/interop/setup-venv.sh).
+pub fn python() -> PathBuf {
+    set_up_venv("setup-venv.sh");
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/.venv/bin/python")
+}
+
+/// Runs the interop venv's Python on `tests/interop/<script>` with `args` (as
+/// [`run_interop`]).
+pub fn interop_script<I, S>(script: &str, args: I) -> Vec<u8>
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    run_interop(python().as_os_str(), script, args)
 }
 
 /// [`interop_script`]'s output read as JSON.

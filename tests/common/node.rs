@@ -15,16 +15,7 @@ pub fn root() -> &'static Path {
 
 /// The real ROS 2 (rclpy) venv, set up on first use by tests/interop/setup-venv-ros.sh.
 pub fn ros_venv() -> PathBuf {
-    let setup = Command::new("bash")
-        .arg(root().join("tests/interop/setup-venv-ros.sh"))
-        .output()
-        .expect("setup-venv-ros.sh");
-    assert!(
-        setup.status.success(),
-        "{}",
-        String::from_utf8_lossy(&setup.stderr)
-    );
-    PathBuf::from(String::from_utf8_lossy(&setup.stdout).trim())
+    PathBuf::from(super::set_up_venv("setup-venv-ros.sh").trim())
 }
 
 /// One scenario's scratch directory (under the system's temporary directory, named by `tag` and
