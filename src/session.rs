@@ -140,6 +140,11 @@ pub fn warning(ns: i64, level: u8, kind: WarningKind, bearing: &str, evidence: S
     })
 }
 
+/// A WARN-level warning about the inputs (bad or stale), of no bearing.
+pub fn input_warning(ns: i64, kind: WarningKind, evidence: String) -> Outgoing {
+    warning(ns, InstabilityWarning::WARN, kind, "", evidence)
+}
+
 /// The twin, its monitor and the message products.
 pub struct Session {
     twin: Twin,

@@ -10,40 +10,14 @@
 
 mod common;
 
+use common::calibration::{plant_rotor, twin_rotor};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rotor_twin::calibrate::{
     estimate_unbalance, estimate_viscosity, fit_windows, AngleSample, WindowFit,
 };
 use rotor_twin::dynamics::{Coupling, StepInput, Twin, TwinConfig};
-use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor, UnbalanceSpec};
-
-/// The twin's machine: the built-in one with a second (empty) unbalance plane at stage 7.
-fn twin_rotor() -> Rotor {
-    let mut d = MachineDescription::builtin_default();
-    d.unbalance.push(UnbalanceSpec {
-        node: 21,
-        magnitude_g_mm: 0.0,
-        phase_deg: 0.0,
-        correction_radius_m: None,
-    });
-    Rotor::from_description(&d)
-}
-
-fn plant_rotor(twin: &Rotor) -> Rotor {
-    let mut p = twin.clone();
-    p.unbalance[0].magnitude_kg_m = 0.0;
-    p.unbalance[1].magnitude_kg_m = 280e-6;
-    p.unbalance[1].phase_rad = 120f64.to_radians();
-    for b in &mut p.bearings {
-        if let BearingModel::Film(f) = &mut b.model {
-            f.lubricant.viscosity_pa_s *= 1.10;
-            f.grid.n_theta = 72;
-            f.grid.n_z = 12;
-        }
-    }
-    p
-}
+use rotor_twin::rotor::{MachineDescription, Rotor};
 
 /// The plant at `rpm` for 8 revolutions to settle, then 16 measured: one window fit per station.
 fn measure(plant: &Rotor, rpm: f64, noise: &mut impl FnMut() -> f64) -> Vec<WindowFit> {

@@ -4,6 +4,8 @@
 //! while the twin is paused is kept for its start, and input limits come from the machine that
 //! runs, not from the built-in one.
 
+mod common;
+
 use rotor_twin::bag::Bag;
 use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind, StationRef};
 use rotor_twin::dynamics::FilmEvaluation;
@@ -63,23 +65,26 @@ fn inputs(seconds: f64) -> Vec<(i64, Msg)> {
                 }),
             ));
         } else if k > 20 {
-            let station = if k % 2 == 0 {
-                "probe_pulley_end"
-            } else {
-                "probe_outboard"
-            };
-            out.push((
-                t,
-                Msg::Probe(messages::ProbeDisplacement {
-                    header: stamped(t - 100_000),
-                    station: station.into(),
-                    x: 1e-6 * (k as f64 * 0.01).sin(),
-                    y: 1e-6 * (k as f64 * 0.01).cos(),
-                }),
-            ));
+            out.push((t, probe_sample(t, k)));
         }
     }
     out
+}
+
+/// The `k`-th sample (received at `t_ns`, stamped 0.1 ms before) of a 1 µm probe circle,
+/// alternately at the two probe stations.
+fn probe_sample(t_ns: i64, k: i64) -> Msg {
+    let station = if k % 2 == 0 {
+        "probe_pulley_end"
+    } else {
+        "probe_outboard"
+    };
+    Msg::Probe(messages::ProbeDisplacement {
+        header: stamped(t_ns - 100_000),
+        station: station.into(),
+        x: 1e-6 * (k as f64 * 0.01).sin(),
+        y: 1e-6 * (k as f64 * 0.01).cos(),
+    })
 }
 
 fn input_of(m: &Msg) -> Input {
@@ -107,20 +112,7 @@ fn key(o: &Outgoing) -> Option<(u8, i64, Vec<u8>)> {
 
 /// The node's route: its model loop on a simulated clock that moves to each input's time.
 fn node_route(inputs: &[(i64, Msg)]) -> Vec<(u8, i64, Vec<u8>)> {
-    let params = NodeParams {
-        use_sim_time: true,
-        ..NodeParams::default()
-    };
-    let inbox = Arc::new(Mutex::new(Inbox::default()));
-    let clock = Arc::new(NodeClock {
-        sim: true,
-        ..NodeClock::default()
-    });
-    let live = (
-        Arc::new(Mutex::new(params.clone())),
-        Arc::new(AtomicU64::new(0)),
-    );
-    let mut model = ModelLoop::new(rotor(), params, live, inbox.clone(), clock.clone());
+    let (mut model, inbox, clock) = common::model_loop::on_sim_time(rotor());
     let mut out = Vec::new();
     // the threshold comes from a helper thread; the replay knows it from the start
     while !model.driver().threshold_known() {
@@ -249,20 +241,7 @@ fn segment(out: &mut Vec<(i64, Msg)>, from_ns: i64, to_ns: i64, rpm: Option<f64>
                 ));
             }
         } else if probes {
-            let station = if k % 2 == 0 {
-                "probe_pulley_end"
-            } else {
-                "probe_outboard"
-            };
-            out.push((
-                t,
-                Msg::Probe(messages::ProbeDisplacement {
-                    header: stamped(t - 100_000),
-                    station: station.into(),
-                    x: 1e-6 * (k as f64 * 0.01).sin(),
-                    y: 1e-6 * (k as f64 * 0.01).cos(),
-                }),
-            ));
+            out.push((t, probe_sample(t, k)));
         }
     }
 }

@@ -7,6 +7,7 @@
 //! its current pressure zone) move by 5.3 % of the stiffness scale (K_rt) and 11.8 % (B_rr) on
 //! 60 × 10 as the journal turns through one cell (README, "Grid convergence of the threshold").
 
+use nalgebra::Matrix2;
 use rotor_twin::film::{
     BearingGeometry, FilmGrid, FilmModel, FiniteFilm, JournalKinematics, Lubricant,
 };
@@ -21,31 +22,19 @@ fn line_of_centres_coefficients(film: &mut FiniteFilm, phi: f64) -> [f64; 8] {
     let load = w[0].hypot(w[1]);
     let k = film.linearised_coefficients(&kin).unwrap();
     let (cs, sn) = (phi.cos(), phi.sin());
-    let r = [[cs, -sn], [sn, cs]];
-    let turn = |a: [[f64; 2]; 2]| {
-        let mut o = [[0.0; 2]; 2];
-        for (i, row) in o.iter_mut().enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                for p in 0..2 {
-                    for q in 0..2 {
-                        *v += r[p][i] * a[p][q] * r[q][j];
-                    }
-                }
-            }
-        }
-        o
-    };
+    let r = Matrix2::new(cs, -sn, sn, cs);
+    let turn = |a: Matrix2<f64>| r.transpose() * a * r;
     let (kk, bb) = (turn(k.stiffness_n_per_m), turn(k.damping_n_s_per_m));
     let s = c / load;
     [
-        kk[0][0] * s,
-        kk[0][1] * s,
-        kk[1][0] * s,
-        kk[1][1] * s,
-        bb[0][0] * s * omega,
-        bb[0][1] * s * omega,
-        bb[1][0] * s * omega,
-        bb[1][1] * s * omega,
+        kk[(0, 0)] * s,
+        kk[(0, 1)] * s,
+        kk[(1, 0)] * s,
+        kk[(1, 1)] * s,
+        bb[(0, 0)] * s * omega,
+        bb[(0, 1)] * s * omega,
+        bb[(1, 0)] * s * omega,
+        bb[(1, 1)] * s * omega,
     ]
 }
 

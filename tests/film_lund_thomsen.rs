@@ -38,14 +38,14 @@ fn equilibrium_and_eight_coefficients_match_lund_thomsen() {
         let k = e.coefficients.dimensionless_stiffness(load, c);
         let b = e.coefficients.dimensionless_damping(load, c, w);
         let pairs = [
-            ("Kxx", k[0][0]),
-            ("Kxy", k[0][1]),
-            ("Kyx", k[1][0]),
-            ("Kyy", k[1][1]),
-            ("Bxx", b[0][0]),
-            ("Bxy", b[0][1]),
-            ("Bxy", b[1][0]),
-            ("Byy", b[1][1]),
+            ("Kxx", k[(0, 0)]),
+            ("Kxy", k[(0, 1)]),
+            ("Kyx", k[(1, 0)]),
+            ("Kyy", k[(1, 1)]),
+            ("Bxx", b[(0, 0)]),
+            ("Bxy", b[(0, 1)]),
+            ("Bxy", b[(1, 0)]),
+            ("Byy", b[(1, 1)]),
         ];
         for (name, value) in pairs {
             let table = row[name];

@@ -9,34 +9,6 @@ use rotor_twin::film::{
     ShortFilm,
 };
 
-/// Coefficients by central differences of `solve`, steps `dq` (m) and `dv` (m/s).
-fn finite_difference(
-    model: &mut dyn FilmModel,
-    kin: JournalKinematics,
-    dq: f64,
-    dv: f64,
-) -> FilmCoefficients {
-    let mut out = FilmCoefficients::default();
-    for j in 0..2 {
-        let mut force = |shift: f64, velocity: bool| {
-            let mut k = kin;
-            if velocity {
-                k.velocity_m_s[j] += shift;
-            } else {
-                k.position_m[j] += shift;
-            }
-            model.solve(&k).unwrap().force_n
-        };
-        let (fp, fm) = (force(dq, false), force(-dq, false));
-        let (gp, gm) = (force(dv, true), force(-dv, true));
-        for i in 0..2 {
-            out.stiffness_n_per_m[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
-            out.damping_n_s_per_m[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
-        }
-    }
-    out
-}
-
 /// Each coefficient within 1 % of the largest entry of its matrix (an entry near zero, such as
 /// k_yx around ε ≈ 0.7, has no meaningful relative error of its own).
 fn assert_close(tag: &str, a: &FilmCoefficients, b: &FilmCoefficients) {
@@ -45,16 +17,16 @@ fn assert_close(tag: &str, a: &FilmCoefficients, b: &FilmCoefficients) {
         ("k", a.stiffness_n_per_m, b.stiffness_n_per_m),
         ("c", a.damping_n_s_per_m, b.damping_n_s_per_m),
     ] {
-        let scale = r.iter().flatten().fold(0.0_f64, |s, v| s.max(v.abs()));
+        let scale = r.amax();
         for i in 0..2 {
             for j in 0..2 {
-                let miss = (m[i][j] - r[i][j]).abs() / scale;
+                let miss = (m[(i, j)] - r[(i, j)]).abs() / scale;
                 worst = worst.max(miss);
                 assert!(
                     miss < 0.01,
                     "{tag}: {name}{i}{j} perturbation {:.5e} vs difference {:.5e}",
-                    m[i][j],
-                    r[i][j]
+                    m[(i, j)],
+                    r[(i, j)]
                 );
             }
         }

@@ -32,15 +32,15 @@ fn short_model_matches_ocvirk_closed_forms() {
         for i in 0..2 {
             for j in 0..2 {
                 assert!(
-                    (k[i][j] - k_ref[i][j]).abs() < 1e-6 * (1.0 + k_ref[i][j].abs()),
+                    (k[(i, j)] - k_ref[i][j]).abs() < 1e-6 * (1.0 + k_ref[i][j].abs()),
                     "ε {eps} K{i}{j}: {} vs {}",
-                    k[i][j],
+                    k[(i, j)],
                     k_ref[i][j]
                 );
                 assert!(
-                    (b[i][j] - b_ref[i][j]).abs() < 1e-6 * (1.0 + b_ref[i][j].abs()),
+                    (b[(i, j)] - b_ref[i][j]).abs() < 1e-6 * (1.0 + b_ref[i][j].abs()),
                     "ε {eps} B{i}{j}: {} vs {}",
-                    b[i][j],
+                    b[(i, j)],
                     b_ref[i][j]
                 );
             }
@@ -64,14 +64,14 @@ fn short_model_reproduces_published_spot_values() {
     for i in 0..2 {
         for j in 0..2 {
             assert!(
-                (k[i][j] - k_ref[i][j]).abs() < 0.0006,
+                (k[(i, j)] - k_ref[i][j]).abs() < 0.0006,
                 "K{i}{j} {}",
-                k[i][j]
+                k[(i, j)]
             );
             assert!(
-                (b[i][j] - b_ref[i][j]).abs() < 0.0006,
+                (b[(i, j)] - b_ref[i][j]).abs() < 0.0006,
                 "B{i}{j} {}",
-                b[i][j]
+                b[(i, j)]
             );
         }
     }

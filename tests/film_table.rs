@@ -161,18 +161,18 @@ fn coefficients_at_the_equilibrium_agree() {
         ("stiffness", a.stiffness_n_per_m, b.stiffness_n_per_m),
         ("damping", a.damping_n_s_per_m, b.damping_n_s_per_m),
     ] {
-        let scale = ma.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let scale = ma.amax();
         for i in 0..2 {
             for j in 0..2 {
                 println!(
                     "{name}[{i}][{j}]: {:.5} of scale",
-                    (ma[i][j] - mb[i][j]).abs() / scale
+                    (ma[(i, j)] - mb[(i, j)]).abs() / scale
                 );
                 assert!(
-                    (ma[i][j] - mb[i][j]).abs() < 0.005 * scale,
+                    (ma[(i, j)] - mb[(i, j)]).abs() < 0.005 * scale,
                     "{name}[{i}][{j}]: direct {} table {}",
-                    ma[i][j],
-                    mb[i][j]
+                    ma[(i, j)],
+                    mb[(i, j)]
                 );
             }
         }
@@ -196,23 +196,10 @@ fn finer_phase_average(
             speed_rad_s: kin.speed_rad_s,
         };
         let l = direct.linearised_coefficients(&turned).unwrap();
-        let r = [[ca, -sa], [sa, ca]];
-        for (src, dst) in [
-            (l.stiffness_n_per_m, &mut out.stiffness_n_per_m),
-            (l.damping_n_s_per_m, &mut out.damping_n_s_per_m),
-        ] {
-            for i in 0..2 {
-                for j in 0..2 {
-                    let mut v = 0.0;
-                    for p in 0..2 {
-                        for q in 0..2 {
-                            v += r[p][i] * src[p][q] * r[q][j];
-                        }
-                    }
-                    dst[i][j] += 0.25 * v;
-                }
-            }
-        }
+        // back to the unturned frame: Rᵀ A R
+        let r = nalgebra::Matrix2::new(ca, -sa, sa, ca);
+        out.stiffness_n_per_m += 0.25 * r.transpose() * l.stiffness_n_per_m * r;
+        out.damping_n_s_per_m += 0.25 * r.transpose() * l.damping_n_s_per_m * r;
     }
     out
 }
@@ -243,8 +230,8 @@ fn coefficients_agree_over_the_whip_domain() {
             let mut v = [0.0; 8];
             for i in 0..2 {
                 for j in 0..2 {
-                    v[2 * i + j] = k.stiffness_n_per_m[i][j];
-                    v[4 + 2 * i + j] = k.damping_n_s_per_m[i][j] * w;
+                    v[2 * i + j] = k.stiffness_n_per_m[(i, j)];
+                    v[4 + 2 * i + j] = k.damping_n_s_per_m[(i, j)] * w;
                 }
             }
             v

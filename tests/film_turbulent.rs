@@ -2,9 +2,11 @@
 //! coefficients against a second method, and its short-bearing limit against the Ng–Pan short
 //! bearing closed form (an independent quadrature, not the solver).
 
+mod common;
+use common::finite_difference;
+use nalgebra::Matrix2;
 use rotor_twin::film::{
-    BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FiniteFilm, FlowRegime,
-    JournalKinematics, Lubricant,
+    BearingGeometry, FilmGrid, FilmModel, FiniteFilm, FlowRegime, JournalKinematics, Lubricant,
 };
 use std::f64::consts::PI;
 
@@ -40,13 +42,7 @@ fn the_turbulent_film_at_vanishing_reynolds_number_is_the_laminar_film() {
             assert!((a.force_n[i] - b.force_n[i]).abs() < 1e-9 * scale);
         }
         assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < 1e-9);
-        let close = |x: &[[f64; 2]; 2], y: &[[f64; 2]; 2]| {
-            let s = x.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
-            x.iter()
-                .flatten()
-                .zip(y.iter().flatten())
-                .all(|(p, q)| (p - q).abs() < 1e-9 * s)
-        };
+        let close = |x: &Matrix2<f64>, y: &Matrix2<f64>| (x - y).amax() < 1e-9 * x.amax();
         assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
         assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
     }
@@ -71,40 +67,13 @@ fn turbulent_coefficients_are_the_slopes_of_the_turbulent_force() {
                 (&c.stiffness_n_per_m, &fd.stiffness_n_per_m),
                 (&c.damping_n_s_per_m, &fd.damping_n_s_per_m),
             ] {
-                let s = m.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
-                for (p, q) in m.iter().flatten().zip(n.iter().flatten()) {
+                let s = m.amax();
+                for (p, q) in m.iter().zip(n.iter()) {
                     assert!((p - q).abs() < 0.01 * s, "ρ {density}: {m:?} vs {n:?}");
                 }
             }
         }
     }
-}
-
-fn finite_difference(
-    model: &mut FiniteFilm,
-    kin: JournalKinematics,
-    dq: f64,
-    dv: f64,
-) -> FilmCoefficients {
-    let mut out = FilmCoefficients::default();
-    for j in 0..2 {
-        let mut force = |shift: f64, velocity: bool| {
-            let mut k = kin;
-            if velocity {
-                k.velocity_m_s[j] += shift;
-            } else {
-                k.position_m[j] += shift;
-            }
-            model.solve(&k).unwrap().force_n
-        };
-        let (fp, fm) = (force(dq, false), force(-dq, false));
-        let (gp, gm) = (force(dv, true), force(-dv, true));
-        for i in 0..2 {
-            out.stiffness_n_per_m[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
-            out.damping_n_s_per_m[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
-        }
-    }
-    out
 }
 
 /// The Ng–Pan short bearing: with ∂p/∂x dropped, eq. T1 gives Ocvirk's pressure times

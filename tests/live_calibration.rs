@@ -10,6 +10,9 @@
 //! it. Targets (the issue's): viscosity within 3 %, unbalance within 10 % and 10°; after the
 //! estimate is applied the predicted 1X within 5 % and 5° of the measured at 8,000 rpm.
 
+mod common;
+
+use common::calibration::{plant_rotor, twin_rotor};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rotor_twin::driver::calibration::estimate;
@@ -18,36 +21,10 @@ use rotor_twin::driver::{
     StationRef,
 };
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
-use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor, UnbalanceSpec};
+use rotor_twin::rotor::{MachineDescription, Rotor};
 use std::f64::consts::TAU;
 
 const EPOCH_NS: i64 = 1_767_225_600_000_000_000;
-
-fn twin_rotor() -> Rotor {
-    let mut d = MachineDescription::builtin_default();
-    d.unbalance.push(UnbalanceSpec {
-        node: 21,
-        magnitude_g_mm: 0.0,
-        phase_deg: 0.0,
-        correction_radius_m: None,
-    });
-    Rotor::from_description(&d)
-}
-
-fn plant_rotor(twin: &Rotor) -> Rotor {
-    let mut p = twin.clone();
-    p.unbalance[0].magnitude_kg_m = 0.0;
-    p.unbalance[1].magnitude_kg_m = 280e-6;
-    p.unbalance[1].phase_rad = 120f64.to_radians();
-    for b in &mut p.bearings {
-        if let BearingModel::Film(f) = &mut b.model {
-            f.lubricant.viscosity_pa_s *= 1.10;
-            f.grid.n_theta = 72;
-            f.grid.n_z = 12;
-        }
-    }
-    p
-}
 
 /// The plant and the driver side by side: the plant's time, keyphasor and probes fed to the
 /// driver in time order; the blocks each station completes.
@@ -248,25 +225,9 @@ fn the_live_estimate_recovers_the_plant_and_applying_it_moves_the_prediction_ont
 #[test]
 fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes() {
     use rotor_twin::messages::{Header, Temperature, Time};
-    use rotor_twin::ros::model::{Inbox, ModelLoop, NodeClock, Queued};
-    use rotor_twin::ros::NodeParams;
-    use std::sync::atomic::AtomicU64;
-    use std::sync::{Arc, Mutex};
+    use rotor_twin::ros::model::{ModelLoop, Queued};
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
-    let params = NodeParams {
-        use_sim_time: true,
-        ..NodeParams::default()
-    };
-    let inbox = Arc::new(Mutex::new(Inbox::default()));
-    let clock = Arc::new(NodeClock {
-        sim: true,
-        ..NodeClock::default()
-    });
-    let live = (
-        Arc::new(Mutex::new(params.clone())),
-        Arc::new(AtomicU64::new(0)),
-    );
-    let mut model = ModelLoop::new(rotor.clone(), params, live, inbox.clone(), clock.clone());
+    let (mut model, inbox, clock) = common::model_loop::on_sim_time(rotor.clone());
     let mut t = EPOCH_NS;
     let mut wake_until = |model: &mut ModelLoop, done: &dyn Fn(&ModelLoop) -> bool| {
         for _ in 0..20_000 {

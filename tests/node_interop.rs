@@ -6,48 +6,15 @@
 //! a recording that independent readers open after
 //! SIGINT.
 
-use serde_json::Value;
-use std::path::Path;
-use std::process::Command;
+mod common;
+use common::node::Scenario;
 
 #[test]
 fn node_talks_to_an_independent_peer_and_records() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let setup = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("setup-venv.sh");
-    assert!(
-        setup.status.success(),
-        "{}",
-        String::from_utf8_lossy(&setup.stderr)
-    );
-    let py = root.join("tests/.venv/bin/python");
-    let out = std::env::temp_dir().join(format!("rotor-twin-node-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .env(
-            "ROTOR_TWIN_CACHE_DIR",
-            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
-        )
-        .arg("-n")
-        .arg("bash")
-        .arg(root.join("tests/interop/node_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&py)
-        .arg(&out)
-        .status()
-        .expect("unshare (needs root: every DDS test runs in a private network namespace)");
-    assert!(status.success());
-    let read = |name: &str| -> Value {
-        let text = std::fs::read_to_string(out.join(name)).unwrap_or_default();
-        serde_json::from_str(&text).unwrap_or_else(|e| {
-            panic!(
-                "{name}: {e}: '{text}'\nnode: {}",
-                std::fs::read_to_string(out.join("node.err")).unwrap_or_default()
-            )
-        })
-    };
+    let py = common::python();
+    let run = Scenario::new("node");
+    run.run("node_scenario.sh", [&py, &run.out]);
+    let read = |name: &str| run.json(name, &["node.err"]);
     let peer = read("peer.json");
     println!(
         "peer: {} journal states, first after {} s",
@@ -99,21 +66,11 @@ fn node_talks_to_an_independent_peer_and_records() {
         !late["warnings"].as_array().unwrap().is_empty(),
         "the late subscriber got no latched warning: {late}"
     );
-    let node_err = std::fs::read_to_string(out.join("node.err")).unwrap();
+    let node_err = run.file("node.err");
     assert!(node_err.contains("recording finished"), "{node_err}");
     assert!(node_err.contains("node exit 0"), "{node_err}");
     // the recording opens in rosbags and mcap-ros2-support with every topic
-    let bag = Command::new(&py)
-        .arg(root.join("tests/interop/read_bag.py"))
-        .arg(out.join("bag"))
-        .output()
-        .unwrap();
-    assert!(
-        bag.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bag.stderr)
-    );
-    let v: Value = serde_json::from_slice(&bag.stdout).unwrap();
+    let v = run.read_bag("bag");
     for reader in ["rosbags", "mcap_ros2"] {
         let c = &v[reader]["counts"];
         for topic in [
@@ -155,7 +112,7 @@ fn node_talks_to_an_independent_peer_and_records() {
         evidence.iter().any(|e| e.contains("rejected")),
         "{evidence:?}"
     );
-    std::fs::remove_dir_all(&out).ok();
+    run.remove();
 }
 
 /// Malformed samples on the bus (the right type name, a 1-byte body: the node cannot decode them)
@@ -166,33 +123,13 @@ fn node_talks_to_an_independent_peer_and_records() {
 /// subscription, 4 of 524 speeds were recorded).
 #[test]
 fn malformed_samples_are_counted_and_the_inputs_live_on() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let setup = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("setup-venv.sh");
-    assert!(setup.status.success());
-    let py = root.join("tests/.venv/bin/python");
-    let out = std::env::temp_dir().join(format!("rotor-twin-load-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .env(
-            "ROTOR_TWIN_CACHE_DIR",
-            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
-        )
-        .args(["-n", "bash"])
-        .arg(root.join("tests/interop/load_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&py)
-        .arg(&out)
-        .arg("6")
-        .status()
-        .expect("unshare");
-    assert!(status.success());
-    let read = |name: &str| -> Value {
-        let text = std::fs::read_to_string(out.join(name)).unwrap_or_default();
-        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}: '{text}'"))
-    };
+    let py = common::python();
+    let run = Scenario::new("load");
+    run.run(
+        "load_scenario.sh",
+        [py.as_os_str(), run.out.as_os_str(), "6".as_ref()],
+    );
+    let read = |name: &str| run.json(name, &[]);
     let peer = read("peer.json");
     let malformed = peer["malformed"].as_u64().unwrap();
     println!("load peer: {peer}");
@@ -216,22 +153,12 @@ fn malformed_samples_are_counted_and_the_inputs_live_on() {
         "refused {refused}, malformed {malformed}"
     );
     // every sample that decodes is recorded
-    let bag = Command::new(&py)
-        .arg(root.join("tests/interop/read_bag.py"))
-        .arg(out.join("bag"))
-        .output()
-        .unwrap();
-    assert!(
-        bag.status.success(),
-        "{}",
-        String::from_utf8_lossy(&bag.stderr)
-    );
-    let v: Value = serde_json::from_slice(&bag.stdout).unwrap();
+    let v = run.read_bag("bag");
     let c = &v["rosbags"]["counts"];
     assert_eq!(c["/rotor_twin/speed"], peer["sent_speeds"], "{c}");
     assert_eq!(c["/plant/probe_b"], peer["sent_points"], "{c}");
     assert_eq!(c["/rotor_twin/probe"], peer["sent_probes"], "{c}");
-    std::fs::remove_dir_all(&out).ok();
+    run.remove();
 }
 
 /// With use_sim_time the model follows `/clock` (rosgraph_msgs/Clock), not the wall clock: a peer
@@ -242,30 +169,10 @@ fn malformed_samples_are_counted_and_the_inputs_live_on() {
 /// an hour ahead for good (issue 15, item 10), and the last stamp was 3,600 s later.
 #[test]
 fn node_follows_simulation_time() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let setup = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("setup-venv.sh");
-    assert!(setup.status.success());
-    let py = root.join("tests/.venv/bin/python");
-    let out = std::env::temp_dir().join(format!("rotor-twin-sim-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .env(
-            "ROTOR_TWIN_CACHE_DIR",
-            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
-        )
-        .args(["-n", "bash"])
-        .arg(root.join("tests/interop/sim_time_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&py)
-        .arg(&out)
-        .status()
-        .expect("unshare");
-    assert!(status.success());
-    let text = std::fs::read_to_string(out.join("peer.json")).unwrap_or_default();
-    let peer: Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: '{text}'"));
+    let py = common::python();
+    let run = Scenario::new("sim");
+    run.run("sim_time_scenario.sh", [&py, &run.out]);
+    let peer = run.json("peer.json", &[]);
     let stamps = peer["stamps"].as_array().unwrap();
     let (first, last) = (stamps[0].as_f64().unwrap(), stamps[1].as_f64().unwrap());
     println!("sim time: journal stamps {first:.3} … {last:.3} s over 6 s of wall time at rate 0.5");
@@ -281,7 +188,7 @@ fn node_follows_simulation_time() {
             .any(|w| w["evidence"].as_str().unwrap_or("").contains("/clock")),
         "no warning names the refused /clock sample: {peer}"
     );
-    std::fs::remove_dir_all(&out).ok();
+    run.remove();
 }
 
 /// The parameter services over the bus (`rotor-twin param`, ros2-client's rcl_interfaces
@@ -290,22 +197,9 @@ fn node_follows_simulation_time() {
 /// ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST; an unknown range is refused, naming it.
 #[test]
 fn parameters_are_set_over_the_bus_where_safe() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = std::env::temp_dir().join(format!("rotor-twin-param-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .env(
-            "ROTOR_TWIN_CACHE_DIR",
-            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
-        )
-        .args(["-n", "bash"])
-        .arg(root.join("tests/interop/param_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&out)
-        .status()
-        .expect("unshare");
-    assert!(status.success());
-    let text = std::fs::read_to_string(out.join("param.out")).unwrap();
+    let run = Scenario::new("param");
+    run.run("param_scenario.sh", [&run.out]);
+    let text = run.file("param.out");
     let lines: Vec<&str> = text.lines().collect();
     let expect = [
         "state_rate_hz:=50: set",
@@ -326,5 +220,5 @@ fn parameters_are_set_over_the_bus_where_safe() {
         assert!(found.is_some(), "missing '{e}' in:\n{text}");
         at += found.unwrap() + 1;
     }
-    std::fs::remove_dir_all(&out).ok();
+    run.remove();
 }

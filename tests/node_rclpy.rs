@@ -5,42 +5,21 @@
 //! reliable publisher both driving the twin, simulation time from a rosgraph_msgs/Clock
 //! publisher, and the six parameter services with descriptors. All inside `unshare -n`.
 
+mod common;
+use common::node::Scenario;
 use serde_json::Value;
-use std::path::Path;
-use std::process::Command;
 
 fn run_scenario() -> (Value, String) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let setup = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv-ros.sh"))
-        .output()
-        .expect("setup-venv-ros.sh");
-    assert!(
-        setup.status.success(),
-        "{}",
-        String::from_utf8_lossy(&setup.stderr)
+    let venv = common::node::ros_venv();
+    let run = Scenario::new("rclpy");
+    run.run("rclpy_scenario.sh", [&venv, &run.out]);
+    let log = format!(
+        "node:\n{}\npeer:\n{}",
+        run.file("node.err"),
+        run.file("peer.err")
     );
-    let venv = String::from_utf8_lossy(&setup.stdout).trim().to_string();
-    let out = std::env::temp_dir().join(format!("rotor-twin-rclpy-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .env(
-            "ROTOR_TWIN_CACHE_DIR",
-            concat!(env!("CARGO_TARGET_TMPDIR"), "/film-cache"),
-        )
-        .args(["-n", "bash"])
-        .arg(root.join("tests/interop/rclpy_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&venv)
-        .arg(&out)
-        .status()
-        .expect("unshare (needs root: every DDS test runs in a private network namespace)");
-    assert!(status.success());
-    let file = |name: &str| std::fs::read_to_string(out.join(name)).unwrap_or_default();
-    let log = format!("node:\n{}\npeer:\n{}", file("node.err"), file("peer.err"));
-    let peer: Value = serde_json::from_str(&file("peer.json"))
-        .unwrap_or_else(|e| panic!("peer.json: {e}\n{log}"));
-    std::fs::remove_dir_all(&out).ok();
+    let peer = run.json("peer.json", &["node.err", "peer.err"]);
+    run.remove();
     (peer, log)
 }
 

@@ -4,10 +4,11 @@
 //! the raw probes as std_msgs/Float64 topics, selected by node parameters (`keyphasor_type`,
 //! `probe_signal_topics`), all best effort.
 
+mod common;
+use common::node::Scenario;
 use rotor_twin::rotor::DEFAULT_MACHINE_YAML;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The built-in machine with AC-coupled raw probes in µm at 45° and 135° at probe_outboard.
 fn machine(out: &Path) -> PathBuf {
@@ -30,39 +31,19 @@ fn scenario(name: &str, args: [&str; 5]) -> (Value, Value, String) {
     // unstamped Float64 readings on two cores
     static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let setup = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
-        .output()
-        .expect("setup-venv.sh");
-    assert!(setup.status.success());
-    let py = root.join("tests/.venv/bin/python");
-    let out = std::env::temp_dir().join(format!("rotor-twin-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
-    let status = Command::new("unshare")
-        .args(["-n", "bash"])
-        .arg(root.join("tests/interop/signal_scenario.sh"))
-        .arg(env!("CARGO_BIN_EXE_rotor-twin"))
-        .arg(&py)
-        .arg(&out)
-        .arg(machine(&out))
-        .args(args)
-        .status()
-        .expect("unshare (needs root: every DDS test runs in a private network namespace)");
-    assert!(status.success());
-    let read = |file: &str| -> Value {
-        let text = std::fs::read_to_string(out.join(file)).unwrap_or_default();
-        serde_json::from_str(&text).unwrap_or_else(|e| {
-            panic!(
-                "{file}: {e}: '{text}'\nnode: {}\npeer: {}",
-                std::fs::read_to_string(out.join("node.err")).unwrap_or_default(),
-                std::fs::read_to_string(out.join("peer.err")).unwrap_or_default()
-            )
-        })
-    };
-    let log = std::fs::read_to_string(out.join("node.err")).unwrap_or_default();
-    let got = (read("peer.json"), read("recorded.json"), log);
-    std::fs::remove_dir_all(&out).ok();
+    let py = common::python();
+    let run = Scenario::new(name);
+    let mut all = vec![py.into_os_string(), run.out.clone().into_os_string()];
+    all.push(machine(&run.out).into_os_string());
+    all.extend(args.map(Into::into));
+    run.run("signal_scenario.sh", all);
+    let read = |file: &str| run.json(file, &["node.err", "peer.err"]);
+    let got = (
+        read("peer.json"),
+        read("recorded.json"),
+        run.file("node.err"),
+    );
+    run.remove();
     got
 }
 

@@ -77,20 +77,12 @@ fn a_uniform_viscosity_scales_the_direct_and_the_tabulated_film_exactly() {
             for i in 0..2 {
                 assert!(close(a.force_n[i], b.force_n[i], f, 1e-9), "{name} {st:?}");
             }
-            let ks = cb
-                .stiffness_n_per_m
-                .iter()
-                .flatten()
-                .fold(0.0_f64, |m, v| m.max(v.abs()));
-            let ds = cb
-                .damping_n_s_per_m
-                .iter()
-                .flatten()
-                .fold(0.0_f64, |m, v| m.max(v.abs()));
+            let ks = cb.stiffness_n_per_m.amax();
+            let ds = cb.damping_n_s_per_m.amax();
             for i in 0..2 {
                 for j in 0..2 {
-                    let (k1, k2) = (ca.stiffness_n_per_m[i][j], cb.stiffness_n_per_m[i][j]);
-                    let (d1, d2) = (ca.damping_n_s_per_m[i][j], cb.damping_n_s_per_m[i][j]);
+                    let (k1, k2) = (ca.stiffness_n_per_m[(i, j)], cb.stiffness_n_per_m[(i, j)]);
+                    let (d1, d2) = (ca.damping_n_s_per_m[(i, j)], cb.damping_n_s_per_m[(i, j)]);
                     assert!(close(k1, k2, ks, 1e-8), "{name} {st:?} k[{i}][{j}]");
                     assert!(close(d1, d2, ds, 1e-8), "{name} {st:?} c[{i}][{j}]");
                 }

@@ -306,19 +306,10 @@ fn a_bad_keyphasor_is_refused_and_the_twin_carries_on() {
 /// one the script wrote (β + α: 95° at 45°, 185° at 135°) within 0.5°, 2 µm within 1 %.
 #[test]
 fn a_rosbags_bag_of_standard_types_gives_the_written_phase_lags() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = common::python();
     let dir = scratch("rosbags-signals");
-    let written = std::process::Command::new(&python)
-        .arg(root.join("tests/interop/write_signal_bag.py"))
-        .arg(&dir)
-        .args(["0.4", "8000"])
-        .output()
-        .unwrap();
-    assert!(
-        written.status.success(),
-        "{}",
-        String::from_utf8_lossy(&written.stderr)
+    common::interop_script(
+        "write_signal_bag.py",
+        [dir.as_os_str(), "0.4".as_ref(), "8000".as_ref()],
     );
     let rotor = raw_machine("unit: um, coupling: ac", None);
     let mut options = ReplayOptions {

@@ -6,26 +6,16 @@ use rotor_twin::messages::{Header, InstabilityWarning, JournalState, RotorSpeed,
 use rotor_twin::record::{Recorder, TopicQos};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Duration;
 
 mod common;
-use common::python;
 
 fn read_bag(path: &Path, stream: bool) -> Value {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut cmd = Command::new(python());
-    cmd.arg(root.join("tests/interop/read_bag.py")).arg(path);
+    let mut args = vec![path.as_os_str()];
     if stream {
-        cmd.arg("--stream");
+        args.push("--stream".as_ref());
     }
-    let out = cmd.output().unwrap();
-    assert!(
-        out.status.success(),
-        "read_bag.py: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    common::interop_json("read_bag.py", args)
 }
 
 fn scratch(name: &str) -> PathBuf {

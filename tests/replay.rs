@@ -13,7 +13,6 @@ use rotor_twin::replay::{replay, ReplayOptions};
 use rotor_twin::rotor::{MachineDescription, Rotor};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("rotor-twin-replay-{name}-{}", std::process::id()));
@@ -148,21 +147,11 @@ fn probe_noise_shows_as_its_rms_in_the_orbit_distance() {
 /// with every message and the right types. Without the remap, the missing topic is named.
 #[test]
 fn a_rosbags_bag_in_standard_types_replays_with_remaps() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let python = common::python();
     let bag = scratch("rosbags");
-    let written = Command::new(&python)
-        .arg(root.join("tests/interop/write_bag.py"))
-        .arg(&bag)
-        .args(["0.25", "8000"])
-        .output()
-        .unwrap();
-    assert!(
-        written.status.success(),
-        "{}",
-        String::from_utf8_lossy(&written.stderr)
+    let counts = common::interop_json(
+        "write_bag.py",
+        [bag.as_os_str(), "0.25".as_ref(), "8000".as_ref()],
     );
-    let counts: Value = serde_json::from_slice(&written.stdout).unwrap();
     let total: u64 = counts
         .as_object()
         .unwrap()
@@ -211,17 +200,7 @@ fn a_rosbags_bag_in_standard_types_replays_with_remaps() {
         .as_f64()
         .unwrap();
     assert!((m - 2e-6).abs() < 0.02e-6, "measured 1X {m} m vs 2 µm");
-    let read = Command::new(&python)
-        .arg(root.join("tests/interop/read_bag.py"))
-        .arg(out.join("bag"))
-        .output()
-        .unwrap();
-    assert!(
-        read.status.success(),
-        "{}",
-        String::from_utf8_lossy(&read.stderr)
-    );
-    let v: Value = serde_json::from_slice(&read.stdout).unwrap();
+    let v = common::interop_json("read_bag.py", [out.join("bag")]);
     let rosbags = &v["rosbags"];
     let sum = |c: &Value| -> u64 {
         c.as_object()

@@ -63,16 +63,10 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
     let (n0, n1) = (6000.0, 8000.0);
     let dir = scratch("runup");
     let bag = dir.join("bag");
-    let written = std::process::Command::new(common::python())
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/interop/write_runup_signal_bag.py"))
-        .arg(&bag)
-        .args(["2.0", &n0.to_string(), &n1.to_string()])
-        .output()
-        .unwrap();
-    assert!(
-        written.status.success(),
-        "{}",
-        String::from_utf8_lossy(&written.stderr)
+    let (n0s, n1s) = (n0.to_string(), n1.to_string());
+    common::interop_script(
+        "write_runup_signal_bag.py",
+        [bag.as_os_str(), "2.0".as_ref(), n0s.as_ref(), n1s.as_ref()],
     );
     let config = raw_probe_machine(&dir);
     let out = dir.join("out");

@@ -5,12 +5,10 @@
 
 mod common;
 
-use common::python;
 use rotor_twin::messages::{self, RosMessage};
 use rotor_twin::record::{Recorder, TopicQos};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::Command;
 
 /// Adds a topic of type `T` named after it.
 fn add<T: RosMessage>(rec: &mut Recorder) -> String {
@@ -49,18 +47,7 @@ fn recorded_type_hashes_equal_rosbags_hashes() {
     rec.finish().unwrap();
 
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new(python())
-        .arg(root.join("tests/interop/type_hashes.py"))
-        .arg(&dir)
-        .arg(root.join("msg/msg"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = common::interop_json("type_hashes.py", [dir.clone(), root.join("msg/msg")]);
 
     // every .msg file of the package is among the types checked here
     let ours: Vec<&str> = v["_our_types"]

@@ -9,7 +9,7 @@
 
 use super::linalg::solve_spd;
 use super::{CalibrationError, MeanPosition};
-use crate::film::{equilibrium_under_load, FilmModel, ViscosityScaledFilm, ZERO_CELSIUS_K};
+use crate::film::{equilibrium_under_load, solve2, FilmModel, ViscosityScaledFilm, ZERO_CELSIUS_K};
 use crate::rotor::{static_solution, BearingModel, Rotor, StaticSolution};
 use serde::Serialize;
 
@@ -91,14 +91,7 @@ fn positions(
                     .map_err(|e| CalibrationError::Model(format!("bearing '{}': {e}", b.name)))?;
                 eq.position_m
             }
-            (BearingModel::Linear(c), _) => {
-                let k = c.stiffness_n_per_m;
-                let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
-                [
-                    (k[1][1] * load[0] - k[0][1] * load[1]) / det,
-                    (-k[1][0] * load[0] + k[0][0] * load[1]) / det,
-                ]
-            }
+            (BearingModel::Linear(c), _) => solve2(&c.stiffness_n_per_m, *load),
             _ => continue,
         };
         journals.push((rotor.node_z_m[b.node], d));

@@ -1,6 +1,7 @@
 //! `rotor-twin bearing`: static analysis of one journal bearing.
 
 use super::bearing_speeds::{self, SpeedRange, SweptBearing};
+use crate::film::rows2;
 use crate::film::{
     equilibrium_at_eccentricity, equilibrium_under_load, BearingGeometry, Equilibrium, FilmGrid,
     FilmModel, FiniteFilm, Lubricant, ShortFilm, MAX_EQUILIBRIUM_ECCENTRICITY,
@@ -9,6 +10,7 @@ use crate::rotor::MAX_SURFACE_SPEED_M_S;
 use crate::units::{rpm_to_rad_s, shown_value};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use nalgebra::Matrix2;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -129,10 +131,14 @@ struct BearingReport {
     side_flow_m3_s: f64,
     inflow_m3_s: f64,
     film_reynolds_number: f64,
-    stiffness_n_per_m: [[f64; 2]; 2],
-    damping_n_s_per_m: [[f64; 2]; 2],
-    stiffness_dimensionless: [[f64; 2]; 2],
-    damping_dimensionless: [[f64; 2]; 2],
+    #[serde(with = "crate::film::rows")]
+    stiffness_n_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    damping_n_s_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    stiffness_dimensionless: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    damping_dimensionless: Matrix2<f64>,
     frame: &'static str,
 }
 
@@ -345,22 +351,17 @@ fn report_is_finite(r: &BearingReport) -> bool {
         r.stiffness_dimensionless,
         r.damping_dimensionless,
     ];
-    scalars.iter().all(|v| v.is_finite())
-        && matrices.iter().flatten().flatten().all(|v| v.is_finite())
+    scalars.iter().all(|v| v.is_finite()) && matrices.iter().flatten().all(|v| v.is_finite())
 }
 
 fn print_table(r: &BearingReport) -> anyhow::Result<()> {
-    let m = |a: [[f64; 2]; 2]| {
-        format!(
-            "[{:>11.4e} {:>11.4e}; {:>11.4e} {:>11.4e}]",
-            a[0][0], a[0][1], a[1][0], a[1][1]
-        )
+    let m = |a: Matrix2<f64>| {
+        let [[a00, a01], [a10, a11]] = rows2(&a);
+        format!("[{a00:>11.4e} {a01:>11.4e}; {a10:>11.4e} {a11:>11.4e}]")
     };
-    let d = |a: [[f64; 2]; 2]| {
-        format!(
-            "[{:>8.3} {:>8.3}; {:>8.3} {:>8.3}]",
-            a[0][0], a[0][1], a[1][0], a[1][1]
-        )
+    let d = |a: Matrix2<f64>| {
+        let [[a00, a01], [a10, a11]] = rows2(&a);
+        format!("[{a00:>8.3} {a01:>8.3}; {a10:>8.3} {a11:>8.3}]")
     };
     outln!(
         "rotor-twin bearing: {:?} film, grid {}, grooves {:?}",

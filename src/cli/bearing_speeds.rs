@@ -10,7 +10,7 @@ use crate::film::{equilibrium_under_load, FilmModel};
 use crate::rotor::{static_solution, BearingModel, MachineDescription, Rotor};
 use crate::units::rpm_to_rad_s;
 use anyhow::Context;
-use nalgebra::Rotation2;
+use nalgebra::{Matrix2, Rotation2};
 use serde::Serialize;
 use std::path::Path;
 
@@ -158,10 +158,14 @@ pub(crate) struct SpeedRow {
     pub min_film_thickness_m: f64,
     pub max_pressure_pa: f64,
     pub power_loss_w: f64,
-    pub stiffness_n_per_m: [[f64; 2]; 2],
-    pub damping_n_s_per_m: [[f64; 2]; 2],
-    pub stiffness_dimensionless: [[f64; 2]; 2],
-    pub damping_dimensionless: [[f64; 2]; 2],
+    #[serde(with = "crate::film::rows")]
+    pub stiffness_n_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    pub damping_n_s_per_m: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    pub stiffness_dimensionless: Matrix2<f64>,
+    #[serde(with = "crate::film::rows")]
+    pub damping_dimensionless: Matrix2<f64>,
     /// With `oil_heating`: the effective temperature (°C), its rise ΔT (K) and µ there (Pa·s).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub effective_temperature_c: Option<f64>,
@@ -292,7 +296,7 @@ fn row_is_finite(r: &SpeedRow) -> bool {
     ];
     scalars.iter().all(|v| v.is_finite())
         && r.journal_position_machine_m.iter().all(|v| v.is_finite())
-        && matrices.iter().flatten().flatten().all(|v| v.is_finite())
+        && matrices.iter().flatten().all(|v| v.is_finite())
 }
 
 /// The sweep as a bearing code's table: S, ε, φ, the four stiffnesses (MN/m) and the four
@@ -330,8 +334,8 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
         "cyy"
     );
     for s in &r.speeds {
-        let flat =
-            |a: [[f64; 2]; 2], unit: f64| [a[0][0], a[0][1], a[1][0], a[1][1]].map(|v| v * unit);
+        // xx, xy, yx, yy: the transpose's column-major order is the matrix's row order
+        let flat = |a: Matrix2<f64>, unit: f64| a.transpose() * unit;
         let (k, c) = (
             flat(s.stiffness_n_per_m, 1e-6),
             flat(s.damping_n_s_per_m, 1e-3),

@@ -229,7 +229,7 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
         |f, k| {
             let q = if k % 2 == 0 { moved } else { q0 };
             f.solve_with_coefficients(&at(q))
-                .map(|(r, c)| r.force_n[0] + c.stiffness_n_per_m[0][0])
+                .map(|(r, c)| r.force_n[0] + c.stiffness_n_per_m[(0, 0)])
         },
     )?;
     // the same film tabulated (built before timing): interpolation and chain-rule coefficients
@@ -243,7 +243,7 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
         let t = Instant::now();
         let (r, c) = tabulated.solve_with_coefficients(&at(q))?;
         times.push(t.elapsed().as_secs_f64() * 1e6);
-        black_box(r.force_n[0] + c.stiffness_n_per_m[0][0]);
+        black_box(r.force_n[0] + c.stiffness_n_per_m[(0, 0)]);
         k += 1;
     }
     times.sort_by(f64::total_cmp);

@@ -26,7 +26,9 @@ pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 use crate::dynamics::StepInput;
 use crate::messages::InstabilityWarning;
 use crate::rotor::Rotor;
-use crate::session::{margin, warning, Outgoing, Session, SessionSettings, WarningKind};
+use crate::session::{
+    input_warning, margin, warning, Outgoing, Session, SessionSettings, WarningKind,
+};
 
 /// Interval between stability-margin messages (s of driver time): 1 Hz, the diagnostics rate.
 pub const MARGIN_INTERVAL_S: f64 = 1.0;
@@ -544,11 +546,9 @@ impl Driver {
         }
         self.last_off_clock_warning_ns = Some(now_ns);
         let name = self.limits.stations.get(k).map_or("", String::as_str);
-        emit(warning(
+        emit(input_warning(
             now_ns,
-            InstabilityWarning::WARN,
             WarningKind::StaleInput,
-            "",
             format!(
                 "probe station '{name}' stamped {:+.3} s from its receive time (over {} s): compared at the receive time",
                 off_ns as f64 * 1e-9,
@@ -576,11 +576,9 @@ impl Driver {
         if self.refused_unwarned == 0 || !due {
             return;
         }
-        emit(warning(
+        emit(input_warning(
             now_ns,
-            InstabilityWarning::WARN,
             WarningKind::BadInput,
-            "",
             format!(
                 "{} input(s) rejected ({} in all); last: {}",
                 self.refused_unwarned, self.counts.refused, self.last_refusal
@@ -599,11 +597,9 @@ impl Driver {
         let gap = now_ns.saturating_sub(last);
         if self.session.is_some() && gap > seconds_to_ns(self.settings.max_gap_s) {
             self.session = None;
-            emit(warning(
+            emit(input_warning(
                 now_ns,
-                InstabilityWarning::WARN,
                 WarningKind::StaleInput,
-                "",
                 format!(
                     "no input for {:.3} s (over {} s): the twin stops and restarts at the next speed",
                     gap as f64 * 1e-9,
@@ -627,11 +623,9 @@ impl Driver {
             return;
         }
         self.last_stale_warning_ns = Some(now_ns);
-        emit(warning(
+        emit(input_warning(
             now_ns,
-            InstabilityWarning::WARN,
             WarningKind::StaleInput,
-            "",
             format!(
                 "no speed for {:.2} s; holding {w:.1} rad/s",
                 (now_ns - at) as f64 * 1e-9

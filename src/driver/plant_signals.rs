@@ -4,8 +4,7 @@
 //! runout subtracted, before they are compared like any probe pair.
 
 use super::{seconds_to_ns, Driver, Fed, ProbeRef, StationRef};
-use crate::messages::InstabilityWarning;
-use crate::session::{warning, Outgoing, WarningKind};
+use crate::session::{input_warning, Outgoing, WarningKind};
 use crate::signals::probes::{check_reading, machine_from_probes, runout_at, SlowRoll};
 use crate::signals::{KeyphasorLock, KeyphasorSettings, OneXVector, PhaseReference};
 use std::f64::consts::TAU;
@@ -176,11 +175,9 @@ impl Driver {
             s.shift_angle(c);
         }
         if ev.relocked {
-            emit(warning(
+            emit(input_warning(
                 now_ns,
-                InstabilityWarning::WARN,
                 WarningKind::BadInput,
-                "",
                 "keyphasor: the reference moved and held; the twin's angle is locked to the new one"
                     .into(),
             ));
@@ -242,11 +239,9 @@ impl Driver {
             return;
         }
         self.signals.stop_warned = true;
-        emit(warning(
+        emit(input_warning(
             now_ns,
-            InstabilityWarning::WARN,
             WarningKind::StaleInput,
-            "",
             format!(
                 "keyphasor stopped: no event for {KEYPHASOR_STOP_REVS} revolutions; 1X phases are null until it is back, the twin carries on with the speed"
             ),

@@ -5,6 +5,7 @@ use crate::film::{
     FilmCoefficients, FilmError, FilmInertia, FilmModel, FilmResult, JournalKinematics,
     ViscosityScaledFilm,
 };
+use nalgebra::{Matrix2, Vector2};
 
 /// Contact with the bearing wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,14 +43,14 @@ pub struct LinkEvaluation {
     /// Total force on the journal: film plus wall contact (N).
     pub force_n: [f64; 2],
     /// −∂F/∂d (N/m).
-    pub stiffness: [[f64; 2]; 2],
+    pub stiffness: Matrix2<f64>,
     /// −∂F/∂ḋ (N·s/m).
-    pub damping: [[f64; 2]; 2],
+    pub damping: Matrix2<f64>,
     /// The film's own share of `stiffness` (the rest is the wall's) (N/m).
-    pub film_stiffness: [[f64; 2]; 2],
+    pub film_stiffness: Matrix2<f64>,
     /// −∂F/∂d̈ (kg): the film's fluid inertia, zero without it (its force −m d̈ is added by
     /// the step, which knows the acceleration).
-    pub added_mass_kg: [[f64; 2]; 2],
+    pub added_mass_kg: Matrix2<f64>,
     /// The film solution.
     pub film: FilmResult,
     /// True if the journal was in contact with the wall.
@@ -175,18 +176,10 @@ impl BearingLink {
         if in_contact {
             let n = [d[0] / e, d[1] / e];
             let t = [-n[1], n[0]];
-            // the film is evaluated on the onset circle: it sees only the tangential motion
-            let shrink = onset / e;
-            let k = coef.stiffness_n_per_m;
-            for i in 0..2 {
-                for j in 0..2 {
-                    // K_f · (I − n nᵀ) · (onset / e)
-                    out.stiffness[i][j] = shrink
-                        * (0..2)
-                            .map(|m| k[i][m] * (if m == j { 1.0 } else { 0.0 } - n[m] * n[j]))
-                            .sum::<f64>();
-                }
-            }
+            let n_nt = Vector2::from(n) * Vector2::from(n).transpose();
+            // the film is evaluated on the onset circle: it sees only the tangential motion,
+            // K_f · (I − n nᵀ) · (onset / e)
+            out.stiffness = coef.stiffness_n_per_m * (Matrix2::identity() - n_nt) * (onset / e);
             out.film_stiffness = out.stiffness;
             // wall: radial spring beyond the onset, Coulomb friction against the surface sliding
             let penetration = e - onset;
@@ -196,10 +189,8 @@ impl BearingLink {
             out.rub_power_w = (friction * slide).abs();
             for i in 0..2 {
                 out.force_n[i] += -normal * n[i] + friction * t[i];
-                for j in 0..2 {
-                    out.stiffness[i][j] += contact.wall_stiffness_n_per_m * n[i] * n[j];
-                }
             }
+            out.stiffness += n_nt * contact.wall_stiffness_n_per_m;
         }
         self.last = out;
         Ok(out)
@@ -217,14 +208,10 @@ impl BearingLink {
             .expect("linear reference set at construction");
         let k = coef.stiffness_n_per_m;
         let cc = coef.damping_n_s_per_m;
-        let mut f = f0;
-        for i in 0..2 {
-            for j in 0..2 {
-                f[i] -= k[i][j] * (d[j] - d0[j]) + cc[i][j] * v[j];
-            }
-        }
+        let (d, d0, v) = (Vector2::from(d), Vector2::from(d0), Vector2::from(v));
+        let f = Vector2::from(f0) - k * (d - d0) - cc * v;
         let out = LinkEvaluation {
-            force_n: f,
+            force_n: f.into(),
             stiffness: k,
             damping: cc,
             film_stiffness: k,

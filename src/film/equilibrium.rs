@@ -3,6 +3,7 @@
 use super::coefficients::FilmCoefficients;
 use super::error::{positive, FilmError};
 use super::{FilmModel, FilmResult, JournalKinematics, MAX_ECCENTRICITY_RATIO};
+use nalgebra::Vector2;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -122,15 +123,13 @@ pub fn equilibrium_under_load(
             });
         }
         // −K Δq = −r  →  Δq = K⁻¹ r
-        let k = coef.stiffness_n_per_m;
-        let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
-        let mut dq = if det.abs() > 0.0 && det.is_finite() {
-            [
-                (k[1][1] * r[0] - k[0][1] * r[1]) / det,
-                (-k[1][0] * r[0] + k[0][0] * r[1]) / det,
-            ]
-        } else {
-            [0.01 * c * r[0] / norm(r), 0.01 * c * r[1] / norm(r)]
+        let newton = coef
+            .stiffness_n_per_m
+            .try_inverse()
+            .map(|k_inv| k_inv * Vector2::from(r));
+        let mut dq = match newton {
+            Some(d) if d.iter().all(|v| v.is_finite()) => [d.x, d.y],
+            _ => [0.01 * c * r[0] / norm(r), 0.01 * c * r[1] / norm(r)],
         };
         let mut accepted = false;
         for _ in 0..30 {
@@ -209,7 +208,7 @@ pub fn equilibrium_at_eccentricity(
         }
         // dF_y/dφ = −(k_yx ∂x/∂φ + k_yy ∂y/∂φ), ∂q/∂φ = turn·e(−sin ψ, cos ψ)
         let k = coef.stiffness_n_per_m;
-        let dfy = -turn * e * (-k[1][0] * psi.sin() + k[1][1] * psi.cos());
+        let dfy = -turn * e * (-k[(1, 0)] * psi.sin() + k[(1, 1)] * psi.cos());
         let step = if dfy != 0.0 && dfy.is_finite() {
             -fy / dfy
         } else {

@@ -564,8 +564,8 @@ impl FiniteFilm {
         let mut out = FilmCoefficients::default();
         for i in 0..2 {
             for j in 0..2 {
-                out.stiffness_n_per_m[i][j] = -derivative[j][i] / c;
-                out.damping_n_s_per_m[i][j] = -derivative[2 + j][i] / c;
+                out.stiffness_n_per_m[(i, j)] = -derivative[j][i] / c;
+                out.damping_n_s_per_m[(i, j)] = -derivative[2 + j][i] / c;
             }
         }
         out

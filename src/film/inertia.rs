@@ -25,6 +25,7 @@
 
 use super::BearingGeometry;
 use super::{FilmCoefficients, FilmResult};
+use nalgebra::Matrix2;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
@@ -100,16 +101,10 @@ impl FilmInertia {
         }
         let kappa = self.length_factor(position_m, film, damping, viscosity_pa_s);
         let conv = self.convective_coefficients(position_m, film, speed_rad_s, kappa);
-        let add = |a: [[f64; 2]; 2], b: [[f64; 2]; 2]| {
-            [
-                [a[0][0] + b[0][0], a[0][1] + b[0][1]],
-                [a[1][0] + b[1][0], a[1][1] + b[1][1]],
-            ]
-        };
         FilmCoefficients {
             added_mass_kg,
-            stiffness_n_per_m: add(coef.stiffness_n_per_m, conv.stiffness_n_per_m),
-            damping_n_s_per_m: add(coef.damping_n_s_per_m, conv.damping_n_s_per_m),
+            stiffness_n_per_m: coef.stiffness_n_per_m + conv.stiffness_n_per_m,
+            damping_n_s_per_m: coef.damping_n_s_per_m + conv.damping_n_s_per_m,
         }
     }
 
@@ -121,18 +116,18 @@ impl FilmInertia {
         &self,
         position_m: [f64; 2],
         film: &FilmResult,
-        damping: &[[f64; 2]; 2],
+        damping: &Matrix2<f64>,
         viscosity_pa_s: f64,
-    ) -> [[f64; 2]; 2] {
+    ) -> Matrix2<f64> {
         let Some((start, span)) = active_zone(film) else {
-            return [[0.0; 2]; 2];
+            return Matrix2::zeros();
         };
         let c = self.clearance_m;
         let z = zone_integrals([position_m[0] / c, position_m[1] / c], start, span);
         let kappa = self.kappa_of(&z, damping, viscosity_pa_s);
         let s = kappa * self.mass_scale();
         let [xx, xy, yy] = z.inertia.map(|v| s * v);
-        [[xx, xy], [xy, yy]]
+        Matrix2::new(xx, xy, xy, yy)
     }
 
     /// ρ R L³ / (12 c) (kg): the short film's inertia scale.
@@ -146,7 +141,7 @@ impl FilmInertia {
         &self,
         position_m: [f64; 2],
         film: &FilmResult,
-        damping: &[[f64; 2]; 2],
+        damping: &Matrix2<f64>,
         viscosity_pa_s: f64,
     ) -> f64 {
         let Some((start, span)) = active_zone(film) else {
@@ -157,11 +152,11 @@ impl FilmInertia {
         self.kappa_of(&z, damping, viscosity_pa_s)
     }
 
-    fn kappa_of(&self, z: &ZoneIntegrals, damping: &[[f64; 2]; 2], viscosity_pa_s: f64) -> f64 {
+    fn kappa_of(&self, z: &ZoneIntegrals, damping: &Matrix2<f64>, viscosity_pa_s: f64) -> f64 {
         let c = self.clearance_m;
         let squeeze_scale = viscosity_pa_s * self.radius_m * self.length_m.powi(3) / c.powi(3);
         let short_trace = squeeze_scale * (z.squeeze[0] + z.squeeze[2]);
-        let film_trace = damping[0][0] + damping[1][1];
+        let film_trace = damping.trace();
         if short_trace > 0.0 && film_trace.is_finite() {
             (film_trace / short_trace).clamp(0.0, 1.0)
         } else {
@@ -202,9 +197,9 @@ impl FilmInertia {
         let k = |v: f64| -m * 0.25 * w * w * v;
         let d = |v: f64| -m * w * v;
         FilmCoefficients {
-            stiffness_n_per_m: z.stiffness.map(|r| r.map(k)),
-            damping_n_s_per_m: z.damping.map(|r| r.map(d)),
-            added_mass_kg: [[0.0; 2]; 2],
+            stiffness_n_per_m: z.stiffness.map(k),
+            damping_n_s_per_m: z.damping.map(d),
+            added_mass_kg: Matrix2::zeros(),
         }
     }
 
@@ -252,8 +247,8 @@ impl FilmInertia {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct ConvectiveIntegrals {
     force: [f64; 2],
-    stiffness: [[f64; 2]; 2],
-    damping: [[f64; 2]; 2],
+    stiffness: Matrix2<f64>,
+    damping: Matrix2<f64>,
 }
 
 /// Simpson's rule over `ZONE_PANELS` panels, as [`zone_integrals`].
@@ -281,8 +276,8 @@ fn convective_integrals(pos: [f64; 2], start: f64, span: f64) -> ConvectiveInteg
         for i in 0..2 {
             out.force[i] += w * n[i] * g / h;
             for j in 0..2 {
-                out.stiffness[i][j] += w * n[i] * df[j];
-                out.damping[i][j] += w * n[i] * db[j] / h;
+                out.stiffness[(i, j)] += w * n[i] * df[j];
+                out.damping[(i, j)] += w * n[i] * db[j] / h;
             }
         }
         (s, co) = (s * cd + co * sd, co * cd - s * sd);
@@ -365,16 +360,16 @@ mod tests {
         let m = inertia.added_mass(
             [0.0; 2],
             &zone(0.0, 0.0),
-            &[[c_short, 0.0], [0.0, c_short]],
+            &Matrix2::from_diagonal_element(c_short),
             mu,
         );
         let expected = PI * 900.0 * 0.03 * 0.03_f64.powi(3) / (12.0 * 40e-6);
         assert!(
-            (m[0][0] / expected - 1.0).abs() < 1e-9,
+            (m[(0, 0)] / expected - 1.0).abs() < 1e-9,
             "{m:?} vs {expected}"
         );
-        assert!((m[1][1] / expected - 1.0).abs() < 1e-9);
-        assert!(m[0][1].abs() < 1e-9 * expected);
+        assert!((m[(1, 1)] / expected - 1.0).abs() < 1e-9);
+        assert!(m[(0, 1)].abs() < 1e-9 * expected);
         assert!((expected - 4.77).abs() < 0.01);
     }
 
@@ -440,7 +435,7 @@ mod tests {
         let z = zone_integrals([pos[0] / 40e-6, pos[1] / 40e-6], start, span);
         let scale = 0.8e-3 * 0.03 * 0.015_f64.powi(3) / 40e-6_f64.powi(3);
         let trace = scale * (z.squeeze[0] + z.squeeze[2]);
-        let film_trace = coef.damping_n_s_per_m[0][0] + coef.damping_n_s_per_m[1][1];
+        let film_trace = coef.damping_n_s_per_m.trace();
         assert!(
             (film_trace / trace - 1.0).abs() < 0.01,
             "{film_trace} vs {trace}"
@@ -462,12 +457,12 @@ mod tests {
         let k = conv.stiffness_n_per_m;
         let c = conv.damping_n_s_per_m;
         let tol = 1e-9 * m * w * w;
-        assert!((k[0][0] + m * w * w / 4.0).abs() < tol, "{k:?}");
-        assert!((k[1][1] + m * w * w / 4.0).abs() < tol, "{k:?}");
-        assert!(k[0][1].abs() < tol && k[1][0].abs() < tol, "{k:?}");
-        assert!((c[0][1] - m * w).abs() < 1e-9 * m * w, "{c:?}");
-        assert!((c[1][0] + m * w).abs() < 1e-9 * m * w, "{c:?}");
-        assert!(c[0][0].abs() < 1e-9 * m * w && c[1][1].abs() < 1e-9 * m * w);
+        assert!((k[(0, 0)] + m * w * w / 4.0).abs() < tol, "{k:?}");
+        assert!((k[(1, 1)] + m * w * w / 4.0).abs() < tol, "{k:?}");
+        assert!(k[(0, 1)].abs() < tol && k[(1, 0)].abs() < tol, "{k:?}");
+        assert!((c[(0, 1)] - m * w).abs() < 1e-9 * m * w, "{c:?}");
+        assert!((c[(1, 0)] + m * w).abs() < 1e-9 * m * w, "{c:?}");
+        assert!(c[(0, 0)].abs() < 1e-9 * m * w && c[(1, 1)].abs() < 1e-9 * m * w);
         let f = inertia.convective_static_force([0.0; 2], &zone(0.0, 0.0), w, 1.0);
         assert!(f[0].hypot(f[1]) < 1e-9 * m * w * w * 40e-6, "{f:?}");
     }
@@ -485,7 +480,7 @@ mod tests {
             let k = inertia
                 .convective_coefficients(pos, &z, w, 0.7)
                 .stiffness_n_per_m;
-            let scale = k.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let scale = k.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
             let d = 1e-9;
             for j in 0..2 {
                 let mut p = pos;
@@ -497,9 +492,9 @@ mod tests {
                 for i in 0..2 {
                     let fd = -(fp[i] - fq[i]) / (2.0 * d);
                     assert!(
-                        (fd - k[i][j]).abs() < 1e-5 * scale,
+                        (fd - k[(i, j)]).abs() < 1e-5 * scale,
                         "{i}{j}: {fd} vs {}",
-                        k[i][j]
+                        k[(i, j)]
                     );
                 }
             }
@@ -528,8 +523,8 @@ mod tests {
         let c_ref = [[1.690, 2.028], [-1.901, 1.257]];
         for i in 0..2 {
             for j in 0..2 {
-                let k = conv.stiffness_n_per_m[i][j] / 1e6;
-                let c = conv.damping_n_s_per_m[i][j] / 1e3;
+                let k = conv.stiffness_n_per_m[(i, j)] / 1e6;
+                let c = conv.damping_n_s_per_m[(i, j)] / 1e3;
                 // 3 printed digits: 0.005 of the largest entry
                 assert!((k - k_ref[i][j]).abs() < 0.005 * 0.721, "K{i}{j} {k}");
                 assert!((c - c_ref[i][j]).abs() < 0.005 * 2.028, "C{i}{j} {c}");

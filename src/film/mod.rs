@@ -26,7 +26,7 @@ mod table;
 mod turbulence;
 mod viscosity;
 
-pub use coefficients::{matrix2, rows2, FilmCoefficients};
+pub use coefficients::{matrix2, rows, rows2, solve2, FilmCoefficients};
 pub use equilibrium::{
     equilibrium_at_eccentricity, equilibrium_under_load, short_bearing_eccentricity,
     sommerfeld_number, Equilibrium, MAX_EQUILIBRIUM_ECCENTRICITY,

@@ -217,8 +217,8 @@ impl FilmModel for ShortFilm {
         let mut out = FilmCoefficients::default();
         for i in 0..2 {
             for j in 0..2 {
-                out.stiffness_n_per_m[i][j] = -k * zi.d_force[j][i];
-                out.damping_n_s_per_m[i][j] = -k * zi.d_force[2 + j][i];
+                out.stiffness_n_per_m[(i, j)] = -k * zi.d_force[j][i];
+                out.damping_n_s_per_m[(i, j)] = -k * zi.d_force[2 + j][i];
             }
         }
         Ok((res, out))

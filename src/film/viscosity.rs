@@ -202,8 +202,8 @@ impl ViscosityScaledFilm {
     fn scaled_coefficients(&self, c: FilmCoefficients) -> FilmCoefficients {
         let s = self.scale;
         FilmCoefficients {
-            stiffness_n_per_m: c.stiffness_n_per_m.map(|row| row.map(|v| s * v)),
-            damping_n_s_per_m: c.damping_n_s_per_m.map(|row| row.map(|v| s * v)),
+            stiffness_n_per_m: c.stiffness_n_per_m * s,
+            damping_n_s_per_m: c.damping_n_s_per_m * s,
             // the fluid's inertia is the density's, not the viscosity's
             added_mass_kg: c.added_mass_kg,
         }

@@ -18,9 +18,9 @@ pub struct BearingCurves {
     /// Attitude angle (deg).
     pub attitude_deg: Vec<f64>,
     /// `[[kxx, kxy], [kyx, kyy]]` (N/m), load frame.
-    pub stiffness: Vec<[[f64; 2]; 2]>,
+    pub stiffness: Vec<nalgebra::Matrix2<f64>>,
     /// `[[cxx, cxy], [cyx, cyy]]` (N·s/m), load frame.
-    pub damping: Vec<[[f64; 2]; 2]>,
+    pub damping: Vec<nalgebra::Matrix2<f64>>,
     /// Journal centre in the machine frame (m).
     pub position_m: Vec<[f64; 2]>,
     /// Radial clearance (m).
@@ -115,10 +115,10 @@ pub fn bearing_coefficients_svg(path: &Path, b: &BearingCurves) -> anyhow::Resul
         &[(b.attitude_deg.clone(), blue)],
         false,
     )?;
-    let pick = |m: &[[[f64; 2]; 2]], unit: f64| -> Vec<(Vec<f64>, RGBColor)> {
+    let pick = |m: &[nalgebra::Matrix2<f64>], unit: f64| -> Vec<(Vec<f64>, RGBColor)> {
         (0..4)
             .map(|k| {
-                let v = m.iter().map(|a| a[k / 2][k % 2] * unit).collect();
+                let v = m.iter().map(|a| a[(k / 2, k % 2)] * unit).collect();
                 (v, COEF_COLOURS[k])
             })
             .collect()

@@ -407,8 +407,8 @@ impl Rotor {
                 for i in 0..2 {
                     mass[(p[i], p[i])] += s.mass_kg;
                     for j in 0..2 {
-                        stiffness[(p[i], p[j])] += s.stiffness_n_per_m[i][j];
-                        damping[(p[i], p[j])] += s.damping_n_s_per_m[i][j];
+                        stiffness[(p[i], p[j])] += s.stiffness_n_per_m[(i, j)];
+                        damping[(p[i], p[j])] += s.damping_n_s_per_m[(i, j)];
                     }
                 }
             }

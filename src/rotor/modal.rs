@@ -308,9 +308,9 @@ pub(crate) fn assembled_matrices(
             for &(dj, sj) in &sides {
                 for i in 0..2 {
                     for j in 0..2 {
-                        k[(di[i], dj[j])] += si * sj * coef.stiffness_n_per_m[i][j];
-                        c[(di[i], dj[j])] += si * sj * coef.damping_n_s_per_m[i][j];
-                        m[(di[i], dj[j])] += si * sj * coef.added_mass_kg[i][j];
+                        k[(di[i], dj[j])] += si * sj * coef.stiffness_n_per_m[(i, j)];
+                        c[(di[i], dj[j])] += si * sj * coef.damping_n_s_per_m[(i, j)];
+                        m[(di[i], dj[j])] += si * sj * coef.added_mass_kg[(i, j)];
                     }
                 }
             }
@@ -340,13 +340,13 @@ fn eigen_failure(
             entries.push((
                 b.name.as_str(),
                 format!("k_{n}"),
-                c.stiffness_n_per_m[i][j],
+                c.stiffness_n_per_m[(i, j)],
                 "N/m",
             ));
             entries.push((
                 b.name.as_str(),
                 format!("c_{n}"),
-                c.damping_n_s_per_m[i][j],
+                c.damping_n_s_per_m[(i, j)],
                 "N·s/m",
             ));
         }
@@ -703,13 +703,13 @@ mod eigen_failure_tests {
         let rotor = Rotor::from_description(&crate::rotor::MachineDescription::builtin_default());
         let mut coefficients = vec![
             FilmCoefficients {
-                stiffness_n_per_m: [[1e8, 2e7], [-3e7, 9e7]],
-                damping_n_s_per_m: [[1e5, 0.0], [0.0, 1e5]],
+                stiffness_n_per_m: nalgebra::Matrix2::new(1e8, 2e7, -3e7, 9e7),
+                damping_n_s_per_m: nalgebra::Matrix2::from_diagonal_element(1e5),
                 ..FilmCoefficients::default()
             };
             rotor.bearings.len()
         ];
-        coefficients[0].stiffness_n_per_m[0][0] = 2e8;
+        coefficients[0].stiffness_n_per_m[(0, 0)] = 2e8;
         let ok = eigen_failure("NoConvergence", &rotor, 900.0, &coefficients);
         let first = &rotor.bearings[0].name;
         assert!(
@@ -721,7 +721,7 @@ mod eigen_failure_tests {
             "{ok}"
         );
         let last = rotor.bearings.len() - 1;
-        coefficients[last].damping_n_s_per_m[1][0] = f64::NAN;
+        coefficients[last].damping_n_s_per_m[(1, 0)] = f64::NAN;
         let bad = eigen_failure("NoConvergence", &rotor, 900.0, &coefficients);
         let name = &rotor.bearings[last].name;
         assert!(

@@ -1,7 +1,13 @@
 //! Helpers shared by the integration tests: reference tables and the seed's bearing.
 #![allow(dead_code)]
 
-use rotor_twin::film::{BearingGeometry, Lubricant};
+pub mod calibration;
+pub mod model_loop;
+pub mod node;
+
+use rotor_twin::film::{
+    BearingGeometry, FilmCoefficients, FilmModel, JournalKinematics, Lubricant,
+};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::process::Command;
@@ -103,19 +109,88 @@ pub fn test_cache_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("film-cache")
 }
 
-/// The interop venv (created on first use by tests/interop/setup-venv.sh).
-pub fn python() -> PathBuf {
+/// Runs `program tests/interop/<script> <args…>`, asserts that it succeeded (its standard
+/// error in the message if not) and returns its standard output.
+fn run_interop<I, S>(program: &std::ffi::OsStr, script: &str, args: I) -> Vec<u8>
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("bash")
-        .arg(root.join("tests/interop/setup-venv.sh"))
+    let out = Command::new(program)
+        .arg(root.join("tests/interop").join(script))
+        .args(args)
         .output()
-        .expect("run setup-venv.sh");
+        .unwrap_or_else(|e| panic!("{script}: {e}"));
     assert!(
         out.status.success(),
-        "setup-venv.sh failed: {}",
+        "{script} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    root.join("tests/.venv/bin/python")
+    out.stdout
+}
+
+/// Runs the venv set-up script `tests/interop/<script>` (it creates the venv on first use) and
+/// returns its standard output.
+pub fn set_up_venv(script: &str) -> String {
+    let out = run_interop("bash".as_ref(), script, [] as [&str; 0]);
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The interop venv's Python (Cyclone DDS, rosbags, mcap: tests/interop/setup-venv.sh).
+pub fn python() -> PathBuf {
+    set_up_venv("setup-venv.sh");
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/.venv/bin/python")
+}
+
+/// Runs the interop venv's Python on `tests/interop/<script>` with `args` (as
+/// [`run_interop`]).
+pub fn interop_script<I, S>(script: &str, args: I) -> Vec<u8>
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    run_interop(python().as_os_str(), script, args)
+}
+
+/// [`interop_script`]'s output read as JSON.
+pub fn interop_json<I, S>(script: &str, args: I) -> serde_json::Value
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let out = interop_script(script, args);
+    serde_json::from_slice(&out)
+        .unwrap_or_else(|e| panic!("{script}: {e}: '{}'", String::from_utf8_lossy(&out)))
+}
+
+/// The eight coefficients by central differences of the film force `solve` (a second method
+/// for the perturbation equations, seed eq. 3–4), steps `dq` (m) and `dv` (m/s).
+pub fn finite_difference(
+    model: &mut dyn FilmModel,
+    kin: JournalKinematics,
+    dq: f64,
+    dv: f64,
+) -> FilmCoefficients {
+    let mut out = FilmCoefficients::default();
+    for j in 0..2 {
+        let mut force = |shift: f64, velocity: bool| {
+            let mut k = kin;
+            if velocity {
+                k.velocity_m_s[j] += shift;
+            } else {
+                k.position_m[j] += shift;
+            }
+            model.solve(&k).unwrap().force_n
+        };
+        let (fp, fm) = (force(dq, false), force(-dq, false));
+        let (gp, gm) = (force(dv, true), force(-dv, true));
+        for i in 0..2 {
+            out.stiffness_n_per_m[(i, j)] = -(fp[i] - fm[i]) / (2.0 * dq);
+            out.damping_n_s_per_m[(i, j)] = -(gp[i] - gm[i]) / (2.0 * dv);
+        }
+    }
+    out
 }
 
 /// The built-in machine and its twin at the rated speed (nonlinear, film table cached in

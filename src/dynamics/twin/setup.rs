@@ -6,10 +6,11 @@ use crate::dynamics::linear::{SparseRows, StepFactor};
 use crate::dynamics::{
     BearingState, Coupling, FilmEvaluation, ProbeState, StepOutput, TwinConfig, TwinError,
 };
-use crate::film::{equilibrium_under_load, FilmCoefficients};
+use crate::film::{equilibrium_under_load, solve2, FilmCoefficients};
 use crate::rotor::{static_solution, BearingModel, Rotor};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
+use nalgebra::Matrix2;
 
 impl Twin {
     /// Builds the twin of `rotor`, at rest in its static equilibrium on the films at
@@ -460,11 +461,11 @@ fn add_relative_block(
     m: &mut Mat<f64>,
     j: [usize; 2],
     p: Option<[usize; 2]>,
-    block: &[[f64; 2]; 2],
+    block: &Matrix2<f64>,
 ) {
     for a in 0..2 {
         for b in 0..2 {
-            let v = block[a][b];
+            let v = block[(a, b)];
             if j[a] != HELD && j[b] != HELD {
                 m[(j[a], j[b])] += v;
             }
@@ -482,22 +483,8 @@ fn add_relative_block(
 }
 
 /// The pedestal's spring matrix (N/m), read back from the rotor's stiffness.
-fn pedestal_stiffness(rotor: &Rotor, p: Option<[usize; 2]>) -> Option<[[f64; 2]; 2]> {
-    p.map(|p| {
-        [
-            [rotor.stiffness[(p[0], p[0])], rotor.stiffness[(p[0], p[1])]],
-            [rotor.stiffness[(p[1], p[0])], rotor.stiffness[(p[1], p[1])]],
-        ]
-    })
-}
-
-/// x = A⁻¹ b for a 2 × 2 matrix (zero if singular).
-fn solve2(a: &[[f64; 2]; 2], b: [f64; 2]) -> [f64; 2] {
-    crate::film::matrix2(a)
-        .try_inverse()
-        .map(|inv| (inv * nalgebra::Vector2::from(b)).into())
-        .filter(|x: &[f64; 2]| x.iter().all(|v| v.is_finite()))
-        .unwrap_or([0.0, 0.0])
+fn pedestal_stiffness(rotor: &Rotor, p: Option<[usize; 2]>) -> Option<Matrix2<f64>> {
+    p.map(|p| Matrix2::from_fn(|i, j| rotor.stiffness[(p[i], p[j])]))
 }
 
 /// Least-squares straight lines x(z) = a + b z, y(z) = a + b z through the journal positions:

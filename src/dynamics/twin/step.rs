@@ -6,6 +6,7 @@ use crate::dynamics::linear::solve_small;
 use crate::dynamics::{Coupling, StepInput, StepOutput, TwinError};
 use crate::film::{equilibrium_under_load, FilmCoefficients};
 use crate::rotor::unbalance_force;
+use nalgebra::{Matrix2, Vector2};
 
 impl Twin {
     /// Advances one time step of `config.time_step_s` to the input speed. On failure the state is
@@ -237,9 +238,9 @@ impl Twin {
                     self.f_b[o + 2 + i] -= ev.force_n[i];
                 }
                 for j in 0..2 {
-                    let kd = ev.stiffness[i][j]
-                        + nm.a2 * ev.damping[i][j]
-                        + nm.a0 * ev.added_mass_kg[i][j];
+                    let kd = ev.stiffness[(i, j)]
+                        + nm.a2 * ev.damping[(i, j)]
+                        + nm.a0 * ev.added_mass_kg[(i, j)];
                     self.d_b[(o + i) * nb + o + j] += kd;
                     if w == 4 {
                         self.d_b[(o + i) * nb + o + 2 + j] -= kd;
@@ -289,14 +290,14 @@ impl Twin {
                 })?,
         };
         let m = ev.added_mass_kg;
-        if m != [[0.0; 2]; 2] {
+        if m != Matrix2::zeros() {
             let acc = rel(&|r| {
                 let d = b_dofs[r];
                 nm.a0 * (qb[r] - s.q[d]) - nm.a1 * s.qd[d] - s.qdd[d]
             });
-            for i in 0..2 {
-                ev.force_n[i] -= m[i][0] * acc[0] + m[i][1] * acc[1];
-            }
+            let inertia = m * Vector2::from(acc);
+            ev.force_n[0] -= inertia.x;
+            ev.force_n[1] -= inertia.y;
         }
         if relax {
             self.relax_prehistory(li, &mut ev, fresh);
@@ -324,13 +325,9 @@ impl Twin {
             };
         }
         let r = self.relaxed[li];
-        for i in 0..2 {
-            for j in 0..2 {
-                let wall = ev.stiffness[i][j] - ev.film_stiffness[i][j];
-                ev.stiffness[i][j] = wall + r.stiffness_n_per_m[i][j];
-                ev.damping[i][j] = r.damping_n_s_per_m[i][j];
-            }
-        }
+        let wall = ev.stiffness - ev.film_stiffness;
+        ev.stiffness = wall + r.stiffness_n_per_m;
+        ev.damping = r.damping_n_s_per_m;
     }
 
     /// One Newton move Δ = −J⁻¹ g, g = q_B − a − S f_B, J = I + S D, limited to a fifth of the

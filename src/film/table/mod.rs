@@ -20,6 +20,7 @@ use super::{
     wrap_angle_rad, BearingGeometry, FilmError, FilmGrid, FilmModel, FiniteFilm, JournalKinematics,
     Lubricant, MAX_ECCENTRICITY_RATIO,
 };
+use nalgebra::Matrix2;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -333,7 +334,7 @@ impl FilmTable {
         &self,
         kin: &JournalKinematics,
         s: &LineOfCentres,
-    ) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+    ) -> (Matrix2<f64>, Matrix2<f64>) {
         let c = self.geometry.radial_clearance_m;
         let (cp, sp) = (s.cos_phi, s.sin_phi);
         let e = s.eps * c;
@@ -362,14 +363,8 @@ impl FilmTable {
             ];
             dfdq[q] = s.rotate_to_fixed(local);
         }
-        let mut k = [[0.0; 2]; 2];
-        let mut d = [[0.0; 2]; 2];
-        for i in 0..2 {
-            for j in 0..2 {
-                k[i][j] = -dfdq[j][i];
-                d[i][j] = -dfdq[2 + j][i];
-            }
-        }
+        let k = Matrix2::from_fn(|i, j| -dfdq[j][i]);
+        let d = Matrix2::from_fn(|i, j| -dfdq[2 + j][i]);
         (k, d)
     }
 
@@ -377,12 +372,12 @@ impl FilmTable {
     /// turns fast with the position): steps of 1e-4 c and 1e-4 c ω (at least 1e-4 c /s), small
     /// against the table's spacing, large enough that the interpolant's small inconsistencies
     /// under rotation do not swamp the derivative.
-    fn difference_coefficients(&self, kin: &JournalKinematics) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+    fn difference_coefficients(&self, kin: &JournalKinematics) -> (Matrix2<f64>, Matrix2<f64>) {
         let c = self.geometry.radial_clearance_m;
         let dq = 1e-4 * c;
         let dv = 1e-4 * c * kin.speed_rad_s.abs().max(1.0);
-        let mut k = [[0.0; 2]; 2];
-        let mut d = [[0.0; 2]; 2];
+        let mut k = Matrix2::zeros();
+        let mut d = Matrix2::zeros();
         for j in 0..2 {
             let mut plus = *kin;
             let mut minus = *kin;
@@ -395,8 +390,8 @@ impl FilmTable {
             vminus.velocity_m_s[j] -= dv;
             let (gp, gm) = (self.force(&vplus), self.force(&vminus));
             for i in 0..2 {
-                k[i][j] = -(fp[i] - fm[i]) / (2.0 * dq);
-                d[i][j] = -(gp[i] - gm[i]) / (2.0 * dv);
+                k[(i, j)] = -(fp[i] - fm[i]) / (2.0 * dq);
+                d[(i, j)] = -(gp[i] - gm[i]) / (2.0 * dv);
             }
         }
         (k, d)

@@ -180,20 +180,20 @@ mod tests {
                 pv.velocity_m_s[j] += dv;
                 mv.velocity_m_s[j] -= dv;
                 let (gp, gm) = (table.force(&pv), table.force(&mv));
-                let kscale = ka.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
-                let dscale = da.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+                let kscale = ka.amax();
+                let dscale = da.amax();
                 for i in 0..2 {
                     let kf = -(fp[i] - fm[i]) / (2.0 * dq);
                     let df = -(gp[i] - gm[i]) / (2.0 * dv);
                     assert!(
-                        (ka[i][j] - kf).abs() < 1e-4 * kscale,
+                        (ka[(i, j)] - kf).abs() < 1e-4 * kscale,
                         "ε {eps}: k[{i}][{j}] {} vs {kf}",
-                        ka[i][j]
+                        ka[(i, j)]
                     );
                     assert!(
-                        (da[i][j] - df).abs() < 1e-4 * dscale,
+                        (da[(i, j)] - df).abs() < 1e-4 * dscale,
                         "ε {eps}: c[{i}][{j}] {} vs {df}",
-                        da[i][j]
+                        da[(i, j)]
                     );
                 }
             }

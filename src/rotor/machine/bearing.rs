@@ -6,9 +6,10 @@
 use super::rules::Rules;
 use super::LubricantSpec;
 use crate::film::{
-    BearingGeometry, FilmCoefficients, FilmGrid, FluidInertia, Lubricant, WaltherLaw,
+    matrix2, BearingGeometry, FilmCoefficients, FilmGrid, FluidInertia, Lubricant, WaltherLaw,
 };
 use crate::rotor::ConfigError;
+use nalgebra::Matrix2;
 use serde::{Deserialize, Serialize};
 
 /// A film bearing at most this many diameters long (the film model's own bound).
@@ -146,10 +147,11 @@ pub struct SupportSpec {
     /// Pedestal mass (kg), greater than zero.
     pub mass_kg: f64,
     /// `[[kxx, kxy], [kyx, kyy]]` to the ground (N/m).
-    pub stiffness_n_per_m: [[f64; 2]; 2],
+    #[serde(with = "crate::film::rows")]
+    pub stiffness_n_per_m: Matrix2<f64>,
     /// `[[cxx, cxy], [cyx, cyy]]` to the ground (N·s/m).
-    #[serde(default)]
-    pub damping_n_s_per_m: [[f64; 2]; 2],
+    #[serde(default, with = "crate::film::rows")]
+    pub damping_n_s_per_m: Matrix2<f64>,
 }
 
 impl BearingSpec {
@@ -339,33 +341,34 @@ impl RawBearingSpec {
                 "is required for a linear bearing",
             ));
         };
+        let k = matrix2(&k);
         rules.finite_matrix(field("stiffness_n_per_m"), &k)?;
-        let c = self.damping_n_s_per_m.unwrap_or_default();
+        let c = matrix2(&self.damping_n_s_per_m.unwrap_or_default());
         rules.finite_matrix(field("damping_n_s_per_m"), &c)?;
         // a support that pushes the journal away (or holds it not at all) carries no rotor
         for d in 0..2 {
-            if k[d][d] <= 0.0 {
+            if k[(d, d)] <= 0.0 {
                 return Err(rules.error(
                     format!("bearings[{i}].stiffness_n_per_m[{d}][{d}]"),
-                    k[d][d],
+                    k[(d, d)],
                     "a direct stiffness must be greater than zero (a linear bearing with none, or a negative one, cannot carry the rotor)",
                 ));
             }
-            if c[d][d] < 0.0 {
+            if c[(d, d)] < 0.0 {
                 return Err(rules.error(
                     format!("bearings[{i}].damping_n_s_per_m[{d}][{d}]"),
-                    c[d][d],
+                    c[(d, d)],
                     "a direct damping must be zero or more (a negative one feeds energy into the rotor)",
                 ));
             }
         }
-        let m = self.added_mass_kg.unwrap_or_default();
+        let m = matrix2(&self.added_mass_kg.unwrap_or_default());
         rules.finite_matrix(field("added_mass_kg"), &m)?;
         for d in 0..2 {
-            if m[d][d] < 0.0 {
+            if m[(d, d)] < 0.0 {
                 return Err(rules.error(
                     format!("bearings[{i}].added_mass_kg[{d}][{d}]"),
-                    m[d][d],
+                    m[(d, d)],
                     "a direct added mass must be zero or more",
                 ));
             }

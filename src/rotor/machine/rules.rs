@@ -1,6 +1,7 @@
 //! The field rules of a machine file, one place: each names the field and the value it refuses.
 
 use crate::rotor::ConfigError;
+use nalgebra::Matrix2;
 use std::fmt::Display;
 
 /// Longest name of a bearing or probe station (characters); names appear in topics, warnings
@@ -65,10 +66,10 @@ impl Rules<'_> {
     }
 
     /// Every entry of the 2 × 2 matrix `m` is finite (the bad one is named by its indices).
-    pub fn finite_matrix(&self, field: String, m: &[[f64; 2]; 2]) -> Result<(), ConfigError> {
-        for (i, row) in m.iter().enumerate() {
-            for (j, v) in row.iter().enumerate() {
-                self.finite(format!("{field}[{i}][{j}]"), *v)?;
+    pub fn finite_matrix(&self, field: String, m: &Matrix2<f64>) -> Result<(), ConfigError> {
+        for i in 0..2 {
+            for j in 0..2 {
+                self.finite(format!("{field}[{i}][{j}]"), m[(i, j)])?;
             }
         }
         Ok(())
