@@ -358,8 +358,11 @@ fn coefficients_up_to_the_wall() {
             let mut e = 0.0_f64;
             for i in 0..2 {
                 for j in 0..2 {
-                    let (ka, kb) = (a.stiffness_n_per_m[i][j], b.stiffness_n_per_m[i][j]);
-                    let (ca, cb) = (a.damping_n_s_per_m[i][j] * w, b.damping_n_s_per_m[i][j] * w);
+                    let (ka, kb) = (a.stiffness_n_per_m[(i, j)], b.stiffness_n_per_m[(i, j)]);
+                    let (ca, cb) = (
+                        a.damping_n_s_per_m[(i, j)] * w,
+                        b.damping_n_s_per_m[(i, j)] * w,
+                    );
                     scale = scale.max(ka.abs()).max(ca.abs());
                     e = e.max((ka - kb).abs()).max((ca - cb).abs());
                 }

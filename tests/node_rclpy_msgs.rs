@@ -32,10 +32,9 @@ fn rclpy_reads_and_writes_our_types_and_the_hashes_are_rosidls() {
         String::from_utf8_lossy(&run.stderr),
         std::fs::read_to_string(out.join("node.err")).unwrap_or_default()
     );
-    let report: Value = serde_json::from_str(
-        &std::fs::read_to_string(out.join("report.json")).unwrap_or_default(),
-    )
-    .unwrap_or_else(|e| panic!("no report.json ({e}):\n{said}"));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap_or_default())
+            .unwrap_or_else(|e| panic!("no report.json ({e}):\n{said}"));
     let checks = report["checks"].as_array().expect("checks");
     // 9 decode checks, the warning, the latched warning, the 1X phases, the residuals, the
     // hashes and 4 recording counts
