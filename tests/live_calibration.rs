@@ -127,7 +127,10 @@ impl Rig {
                 }
                 // the node's route (ros/model.rs): blocks finished once their closing event came
                 let newest = self.driver.newest_sample_ns().unwrap_or(i64::MIN);
-                while let Some(b) = self.blocks.take_ready(self.driver.keyphasor_events(), newest) {
+                while let Some(b) = self
+                    .blocks
+                    .take_ready(self.driver.keyphasor_events(), newest)
+                {
                     self.calibration.add(&b, true);
                     out.push(b);
                 }

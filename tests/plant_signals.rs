@@ -377,7 +377,9 @@ struct Delivered {
 fn bursty_stream(seconds: f64, seed: u64) -> Vec<Delivered> {
     let mut rng = seed;
     let mut uniform = move || {
-        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (rng >> 11) as f64 / (1u64 << 53) as f64
     };
     let (t0, psi0, beta) = (1_000_000_000i64, 2.345, 50f64.to_radians());
@@ -395,7 +397,11 @@ fn bursty_stream(seconds: f64, seed: u64) -> Vec<Delivered> {
     let mut k = 1.0;
     while (TAU * k - psi0) / W8000 < seconds {
         let t = at((TAU * k - psi0) / W8000);
-        push(t, (uniform() * 0.030e9) as i64, Input::Keyphasor { stamp_ns: t });
+        push(
+            t,
+            (uniform() * 0.030e9) as i64,
+            Input::Keyphasor { stamp_ns: t },
+        );
         k += 1.0;
     }
     let n = (seconds / t_rev * 16.0) as usize;
@@ -414,7 +420,15 @@ fn bursty_stream(seconds: f64, seed: u64) -> Vec<Delivered> {
     }
     for j in 0..((seconds * 100.0) as i64) {
         let t = t0 + j * 10_000_000;
-        push(t, 0, Input::Speed { speed_rad_s: W8000, accel_rad_s2: 0.0, stamp_ns: t });
+        push(
+            t,
+            0,
+            Input::Speed {
+                speed_rad_s: W8000,
+                accel_rad_s2: 0.0,
+                stamp_ns: t,
+            },
+        );
     }
     // bursts: each message waits for the first release at or after its sending time
     out.sort_by_key(|m| m.received_ns);
@@ -424,7 +438,10 @@ fn bursty_stream(seconds: f64, seed: u64) -> Vec<Delivered> {
         while release < m.received_ns {
             release += (0.3e6 + uniform() * uniform() * 40.7e6) as i64;
         }
-        delivered.push(Delivered { received_ns: release, ..m });
+        delivered.push(Delivered {
+            received_ns: release,
+            ..m
+        });
     }
     delivered
 }
@@ -456,7 +473,11 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
     };
     let (mut got, mut twin_angle) = (Vec::new(), Vec::new());
     let stream = bursty_stream(1.5, 7);
-    let spread = stream.iter().map(|m| m.received_ns - m.stamp_ns).max().unwrap();
+    let spread = stream
+        .iter()
+        .map(|m| m.received_ns - m.stamp_ns)
+        .max()
+        .unwrap();
     assert!(spread > 40_000_000, "late by up to {spread} ns");
     let mut last_fed = i64::MIN;
     for m in stream {
@@ -477,12 +498,18 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
     }
     assert!(stale.is_empty(), "{stale:?}");
     let locked: Vec<_> = got.iter().filter(|b| b.null_reason.is_none()).collect();
-    assert!(locked.len() >= 15 && locked.len() + 2 >= got.len(), "{got:#?}");
+    assert!(
+        locked.len() >= 15 && locked.len() + 2 >= got.len(),
+        "{got:#?}"
+    );
     for b in &locked {
         for (j, want) in [95.0, 185.0].into_iter().enumerate() {
             let d = lag_gap(b.measured[j].phase_lag_deg, want);
             assert!(d.abs() < 2.0, "axis {j}: {:?}", b.measured[j]);
-            assert!((b.measured[j].amplitude_m / 2e-6 - 1.0).abs() < 0.02, "{b:?}");
+            assert!(
+                (b.measured[j].amplitude_m / 2e-6 - 1.0).abs() < 0.02,
+                "{b:?}"
+            );
         }
     }
     // the session 8 rule: the same samples against the twin's angle, 8 revolutions at a time
@@ -490,13 +517,21 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
     for chunk in twin_angle.chunks(8 * 16).skip(2) {
         let (s, c) = 45f64.to_radians().sin_cos();
         let v = rotor_twin::signals::one_x_vector(
-            chunk.iter().map(|q| (q.angle_rad, q.measured_m[0] * c + q.measured_m[1] * s)),
+            chunk
+                .iter()
+                .map(|q| (q.angle_rad, q.measured_m[0] * c + q.measured_m[1] * s)),
             chunk.len(),
         );
         if let Some(v) = v {
             worst = worst.max(lag_gap(v.phase_lag_deg, 95.0).abs());
         }
     }
-    println!("{} blocks, the twin-angle rule off by up to {worst:.1}°", got.len());
-    assert!(worst > 5.0, "the stream is not bursty enough to matter: {worst}°");
+    println!(
+        "{} blocks, the twin-angle rule off by up to {worst:.1}°",
+        got.len()
+    );
+    assert!(
+        worst > 5.0,
+        "the stream is not bursty enough to matter: {worst}°"
+    );
 }

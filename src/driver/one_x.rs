@@ -205,7 +205,12 @@ impl OneXBlocks {
             predicted_m: c.predicted_m,
         };
         // a sample delivered out of stamp order goes to its place (rare: one search from the end)
-        let at = g.samples.len() - g.samples.iter().rev().take_while(|q| q.time_ns > c.time_ns).count();
+        let at = g.samples.len()
+            - g.samples
+                .iter()
+                .rev()
+                .take_while(|q| q.time_ns > c.time_ns)
+                .count();
         g.samples.insert(at, sample);
         if c.angle_rad - g.start_angle_rad < ONE_X_BLOCK_REVS as f64 * TAU {
             return;
@@ -219,7 +224,8 @@ impl OneXBlocks {
         let closing = g.waiting.pop().unwrap_or(sample);
         let end = g.waiting.last().map_or(closing, |q| *q);
         let w = end.speed_rad_s.max(1e-3);
-        g.deadline_ns = end.time_ns + seconds_to_ns(KEYPHASOR_STOP_REVS * TAU / w + KEYPHASOR_JITTER_S);
+        g.deadline_ns =
+            end.time_ns + seconds_to_ns(KEYPHASOR_STOP_REVS * TAU / w + KEYPHASOR_JITTER_S);
         g.samples.clear();
         g.samples.push(closing);
         g.start_angle_rad = closing.angle_rad;
@@ -238,7 +244,14 @@ impl OneXBlocks {
                 continue;
             }
             let give_up = newest_ns > g.deadline_ns;
-            let b = finish(k, self.axes[k], &g.waiting, g.waiting_reason, events, give_up);
+            let b = finish(
+                k,
+                self.axes[k],
+                &g.waiting,
+                g.waiting_reason,
+                events,
+                give_up,
+            );
             if b.is_some() || give_up {
                 g.waiting.clear();
             }
@@ -302,9 +315,7 @@ fn finish(
     let p = [twin(predicted, axes[0])?, twin(predicted, axes[1])?];
     let xy = [vector(measured, 0.0)?, vector(measured, FRAC_PI_2)?];
     let psi = |q: &BlockSample| match plant_ok {
-        true => events
-            .angle_at_or_after(q.time_ns)
-            .unwrap_or(q.angle_rad),
+        true => events.angle_at_or_after(q.time_ns).unwrap_or(q.angle_rad),
         false => q.angle_rad,
     };
     let mean = [0, 1].map(|j| s.iter().map(|q| q.measured_m[j]).sum::<f64>() / n as f64);

@@ -168,7 +168,9 @@ impl Driver {
     /// plus `KEYPHASOR_STOP_REVS` − 1 revolutions late never counts as a stop.
     fn stop_judged_at(&self, now_ns: i64) -> i64 {
         let floor = now_ns - seconds_to_ns(KEYPHASOR_JITTER_S);
-        self.signals.newest_sample_ns.map_or(floor, |s| s.max(floor))
+        self.signals
+            .newest_sample_ns
+            .map_or(floor, |s| s.max(floor))
     }
 
     /// A keyphasor event stamped `stamp_ns`, received at `now_ns`: checked against the speed,

@@ -432,7 +432,10 @@ impl ModelLoop {
             self.one_x.add(c, events);
         }
         let newest = self.driver.newest_sample_ns().unwrap_or(i64::MIN);
-        while let Some(block) = self.one_x.take_ready(self.driver.keyphasor_events(), newest) {
+        while let Some(block) = self
+            .one_x
+            .take_ready(self.driver.keyphasor_events(), newest)
+        {
             let name = self
                 .driver
                 .rotor()

@@ -127,7 +127,9 @@ impl KeyphasorEvents {
                 let (a, b) = (self.stamp(self.len - 2), self.stamp(self.len - 1));
                 let u = (t_ns - b) as f64 / (b - a) as f64;
                 let k = (self.count - 1) as f64;
-                (u < 1.0).then_some(TAU * (k + u)).ok_or(Unbracketed::Pending)
+                (u < 1.0)
+                    .then_some(TAU * (k + u))
+                    .ok_or(Unbracketed::Pending)
             }
             r => r,
         }

@@ -70,7 +70,10 @@ pub fn one_x_vector(
     if ql - p0 < TAU * (1.0 - 1e-9) {
         return None;
     }
-    let (a, span) = (p0 - 0.5 * (p1 - p0), (ql + 0.5 * (ql - q1)) - (p0 - 0.5 * (p1 - p0)));
+    let (a, span) = (
+        p0 - 0.5 * (p1 - p0),
+        (ql + 0.5 * (ql - q1)) - (p0 - 0.5 * (p1 - p0)),
+    );
     let mut next = psi.skip(1);
     let mut prev = p0 - (p1 - p0);
     // Σ w q s e^{−iψ}, Σ w q e^{−iψ}, Σ w q, Σ q s, Σ q
@@ -118,7 +121,12 @@ pub fn keyphasor_one_x(
         false => events.angle_at(t),
     };
     let first = samples.clone().next().ok_or(Unbracketed::Missing)?.0;
-    let last = samples.clone().take(n).last().ok_or(Unbracketed::Missing)?.0;
+    let last = samples
+        .clone()
+        .take(n)
+        .last()
+        .ok_or(Unbracketed::Missing)?
+        .0;
     angle(last)?;
     angle(first)?;
     // referenced at both ends, so every stamp in between is (the stamps increase)
@@ -164,7 +172,9 @@ mod tests {
         let mut pts = Vec::new();
         let mut rng = 12345u64;
         let mut rand = || {
-            rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (rng >> 11) as f64 / (1u64 << 53) as f64
         };
         for i in 0..(8 * 16) {
@@ -174,7 +184,10 @@ mod tests {
             if (i / 16) % 2 == 1 && (3..7).contains(&(i % 16)) {
                 continue;
             }
-            pts.push((psi, 7e-6 + a * (psi - phi).cos() + 0.5 * a * (0.43 * psi).cos()));
+            pts.push((
+                psi,
+                7e-6 + a * (psi - phi).cos() + 0.5 * a * (0.43 * psi).cos(),
+            ));
         }
         let v = one_x_vector(pts.iter().copied(), pts.len()).unwrap();
         let d = (v.phase_lag_deg - phi_deg + 180.0).rem_euclid(360.0) - 180.0;
@@ -216,10 +229,15 @@ mod tests {
         let pts: Vec<(i64, f64)> = (0..n)
             .map(|i| {
                 let t = end * (i as f64 + 0.5) / n as f64;
-                ((t * 1e9).round() as i64, 3e-6 * (angle(t) - 95f64.to_radians()).cos())
+                (
+                    (t * 1e9).round() as i64,
+                    3e-6 * (angle(t) - 95f64.to_radians()).cos(),
+                )
             })
             .collect();
-        let v = keyphasor_one_x(pts.iter().copied(), n, &ev, false).unwrap().unwrap();
+        let v = keyphasor_one_x(pts.iter().copied(), n, &ev, false)
+            .unwrap()
+            .unwrap();
         assert!((v.phase_lag_deg - 95.0).abs() < 0.3, "{v:?}");
         let mut short = KeyphasorEvents::default();
         for k in 0..8 {
