@@ -263,6 +263,19 @@ impl OneXBlocks {
     }
 }
 
+/// Each sample of `s` with its point `pick` projected on the axis at angle `a` (rad).
+fn along_axis(
+    s: &[BlockSample],
+    pick: fn(&BlockSample) -> [f64; 2],
+    a: f64,
+) -> impl Iterator<Item = (&BlockSample, f64)> + Clone {
+    let (sn, cs) = a.sin_cos();
+    s.iter().map(move |q| {
+        let p = pick(q);
+        (q, p[0] * cs + p[1] * sn)
+    })
+}
+
 /// The 1X vectors of a gathered block `s` (whole revolutions of the twin's angle): measured
 /// against the plant's angle from `events`, predicted against the twin's. None while its
 /// closing event is pending (unless `give_up`: then its measured phases are null).
@@ -277,26 +290,11 @@ fn finish(
     let n = s.len();
     let end = s.last()?;
     let plant = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
-        let (sn, cs) = a.sin_cos();
-        keyphasor_one_x(
-            s.iter().map(move |q| {
-                let p = pick(q);
-                (q.time_ns, p[0] * cs + p[1] * sn)
-            }),
-            n,
-            events,
-            give_up,
-        )
+        let along = along_axis(s, pick, a).map(|(q, v)| (q.time_ns, v));
+        keyphasor_one_x(along, n, events, give_up)
     };
     let twin = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
-        let (sn, cs) = a.sin_cos();
-        one_x_vector(
-            s.iter().map(move |q| {
-                let p = pick(q);
-                (q.angle_rad, p[0] * cs + p[1] * sn)
-            }),
-            n,
-        )
+        one_x_vector(along_axis(s, pick, a).map(|(q, v)| (q.angle_rad, v)), n)
     };
     let measured = |q: &BlockSample| q.measured_m;
     let predicted = |q: &BlockSample| q.predicted_m;
