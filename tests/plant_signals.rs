@@ -468,6 +468,8 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
         if let Outgoing::Warning(w) = o {
             if w.kind == "stale_input" {
                 stale.push(w.evidence);
+            } else if w.kind == "bad_input" {
+                println!("bad input: {}", w.evidence);
             }
         }
     };
@@ -479,10 +481,17 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
         .max()
         .unwrap();
     assert!(spread > 40_000_000, "late by up to {spread} ns");
-    let mut last_fed = i64::MIN;
+    let (mut last_fed, mut newest_event, mut receive_gap) = (i64::MIN, None, 0i64);
     for m in stream {
         let t = m.received_ns.max(last_fed);
         last_fed = t;
+        // session 8 judged a stop by receive time against the last event's stamp
+        if let Some(e) = newest_event {
+            receive_gap = receive_gap.max(t - e);
+        }
+        if let Input::Keyphasor { stamp_ns } = m.input {
+            newest_event = Some(stamp_ns);
+        }
         driver.advance_to(t, usize::MAX, &mut emit);
         let fed = driver.feed(t, m.input, &mut emit);
         if let Fed::Compared(c) = &fed {
@@ -496,7 +505,20 @@ fn bursty_late_keyphasor_and_probe_signals_give_the_true_live_lags() {
             got.push(b);
         }
     }
+    println!(
+        "compared {} (station 1), counts {:?}, events newest {:?}, newest sample {:?}",
+        twin_angle.len(),
+        driver.counts(),
+        driver.keyphasor_events().newest_ns(),
+        driver.newest_sample_ns()
+    );
     assert!(stale.is_empty(), "{stale:?}");
+    // that rule (3 revolutions) would have warned on this stream
+    let gap_revs = receive_gap as f64 * 1e-9 * W8000 / TAU;
+    assert!(
+        gap_revs > 3.0,
+        "{gap_revs} revolutions between receive and the last event"
+    );
     let locked: Vec<_> = got.iter().filter(|b| b.null_reason.is_none()).collect();
     assert!(
         locked.len() >= 15 && locked.len() + 2 >= got.len(),
