@@ -394,14 +394,12 @@ fn bursty_stream(seconds: f64, seed: u64) -> Vec<Delivered> {
     };
     let t_rev = TAU / W8000;
     // events where ψ = ψ0 + Ω t = 2πk
-    let mut k = 1.0;
+    // (sent in order, as one DDS writer's samples are delivered)
+    let (mut k, mut sent) = (1.0, 0);
     while (TAU * k - psi0) / W8000 < seconds {
         let t = at((TAU * k - psi0) / W8000);
-        push(
-            t,
-            (uniform() * 0.030e9) as i64,
-            Input::Keyphasor { stamp_ns: t },
-        );
+        sent = (t + (uniform() * 0.030e9) as i64).max(sent);
+        push(t, sent - t, Input::Keyphasor { stamp_ns: t });
         k += 1.0;
     }
     let n = (seconds / t_rev * 16.0) as usize;
