@@ -184,8 +184,10 @@ impl OneXBlocks {
         let Some(g) = self.stations.get_mut(c.station) else {
             return;
         };
-        let last = g.samples.last().map(|s| s.angle_rad);
-        if last.is_some_and(|a| c.angle_rad < a - PI || c.angle_rad > a + TAU) {
+        // a gap by the stamps (a burst delivered late jumps the twin's angle, not the stamps)
+        let rev_ns = TAU / c.speed_rad_s.max(1e-3) * 1e9;
+        let last = g.samples.last().map(|s| (s.angle_rad, s.time_ns));
+        if last.is_some_and(|(a, t)| c.angle_rad < a - PI || (c.time_ns - t) as f64 > rev_ns) {
             g.samples.clear();
         }
         if g.samples.len() >= ONE_X_BLOCK_CAPACITY {
