@@ -100,10 +100,16 @@ impl Rig {
                     &mut |_| {},
                 );
                 if let Fed::Compared(c) = fed {
-                    if let Some(b) = self.blocks.add(&c) {
-                        self.calibration.add(&b, true);
-                        out.push(b);
-                    }
+                    self.blocks.add(&c, self.driver.keyphasor_events());
+                }
+                // the node's route (ros/model.rs): blocks finished once their closing event came
+                let newest = self.driver.newest_sample_ns().unwrap_or(i64::MIN);
+                while let Some(b) = self
+                    .blocks
+                    .take_ready(self.driver.keyphasor_events(), newest)
+                {
+                    self.calibration.add(&b, true);
+                    out.push(b);
                 }
             }
         }

@@ -506,6 +506,11 @@ impl Driver {
             self.warn_off_clock(now_ns, k, off_ns, emit);
             now_ns
         };
+        let newest = self
+            .signals
+            .newest_sample_ns
+            .map_or(time_ns, |n| n.max(time_ns));
+        self.signals.newest_sample_ns = Some(newest);
         let Some(s) = self.session.as_ref() else {
             return Fed::Unused;
         };

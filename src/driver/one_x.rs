@@ -3,16 +3,22 @@
 //! `replay::compare::BLOCK_REVS`), and at each block's end the 1X vector of the measured and
 //! of the predicted signal along each of the station's two probe axes, by the one 1X rule of
 //! [`crate::signals::one_x_vector`] (Hann-windowed DFT at order 1, phase lag in the API 670 /
-//! Bently convention), as the replay computes them. The phase lags are null, with the reason,
-//! unless every sample of the block was referenced to a locked keyphasor
-//! ([`crate::signals::PhaseReference::null_reason`]); the amplitudes do not depend on the phase reference.
+//! Bently convention). The measured vectors are read against the plant's own angle, interpolated
+//! between the keyphasor events that bracket each sample's stamp ([`OneXBlocks`]), the
+//! predicted ones against the twin's. The phase lags are null, with the reason, unless every
+//! sample of the block was referenced to a locked keyphasor
+//! ([`crate::signals::PhaseReference::null_reason`]) and the events bracket the whole block; the
+//! amplitudes do not depend on the phase reference.
 //!
 //! A block also gives, per machine axis, the measured 1X vector and mean position that the live
 //! calibration uses ([`crate::calibrate`]'s convention: a = Re(X e^{iθ})), and how much of the
 //! measured motion the 1X and the mean leave (a whirl makes that large).
 
-use super::ProbeComparison;
-use crate::signals::{one_x_vector, OneXVector};
+use super::{seconds_to_ns, ProbeComparison};
+use crate::signals::{
+    keyphasor_one_x, one_x_vector, KeyphasorEvents, OneXVector, Unbracketed, KEYPHASOR_JITTER_S,
+    KEYPHASOR_STOP_REVS,
+};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Revolutions of one block: 8, the replay's (`replay::compare::BLOCK_REVS`).
@@ -26,6 +32,7 @@ pub const ONE_X_BLOCK_CAPACITY: usize = 32_768;
 /// One sample of a block.
 #[derive(Debug, Clone, Copy, Default)]
 struct BlockSample {
+    time_ns: i64,
     angle_rad: f64,
     speed_rad_s: f64,
     measured_m: [f64; 2],
@@ -108,15 +115,37 @@ impl OneXBlock {
     }
 }
 
-/// The block being gathered at one station.
+/// Why the measured phase lags of a block are null although the twin was locked: the
+/// keyphasor event after its last sample did not come within the wait.
+pub const NO_CLOSING_EVENT: &str = "the keyphasor stopped: no event within a revolution of the block's end (waited 3 revolutions + 0.1 s of sample stamps)";
+
+/// Why the measured phase lags of a block are null: no kept keyphasor event before its first
+/// sample (the events started, or broke at a refused one, within the block).
+pub const NO_OPENING_EVENT: &str =
+    "no keyphasor event before the block's first sample (none yet, or a refused event broke the reference)";
+
+/// The block being gathered at one station, and the one gathered before it while it waits for
+/// the keyphasor event after its last sample.
 #[derive(Debug, Clone)]
 struct Gathering {
     samples: Vec<BlockSample>,
     start_angle_rad: f64,
     reason: Option<&'static str>,
+    waiting: Vec<BlockSample>,
+    waiting_reason: Option<&'static str>,
+    /// the stamp time after which the waiting block is finished without its closing event
+    deadline_ns: i64,
+    /// a block finished without its closing event because the next one was complete
+    done: Option<OneXBlock>,
 }
 
-/// The blocks of every probe station.
+/// The blocks of every probe station. Samples are gathered by the twin's angle into blocks of
+/// [`ONE_X_BLOCK_REVS`] revolutions; a gathered block waits for the keyphasor event after its
+/// last sample (at most [`KEYPHASOR_STOP_REVS`] revolutions + [`KEYPHASOR_JITTER_S`] of sample
+/// stamps after it), and its measured 1X vectors are then read against the plant's own angle,
+/// interpolated between the events that bracket each sample's stamp
+/// ([`crate::signals::keyphasor_one_x`]): what a sample's angle is does not depend on when it or
+/// the events were delivered. The predicted vectors stay on the twin's angle (its own phase).
 #[derive(Debug, Clone)]
 pub struct OneXBlocks {
     stations: Vec<Gathering>,
@@ -134,6 +163,10 @@ impl OneXBlocks {
                 samples: Vec::with_capacity(ONE_X_BLOCK_CAPACITY),
                 start_angle_rad: 0.0,
                 reason: None,
+                waiting: Vec::with_capacity(ONE_X_BLOCK_CAPACITY),
+                waiting_reason: None,
+                deadline_ns: 0,
+                done: None,
             })
             .collect();
         Self {
@@ -143,13 +176,18 @@ impl OneXBlocks {
         }
     }
 
-    /// Adds a comparison; returns the block it completes, if it does. A twin that restarted
-    /// (its angle went back by more than half a revolution) or a revolution without a sample
-    /// starts a new block.
-    pub fn add(&mut self, c: &ProbeComparison) -> Option<OneXBlock> {
-        let g = self.stations.get_mut(c.station)?;
-        let last = g.samples.last().map(|s| s.angle_rad);
-        if last.is_some_and(|a| c.angle_rad < a - PI || c.angle_rad > a + TAU) {
+    /// Adds a comparison, in stamp order within its block. A twin that restarted (its angle
+    /// went back by more than half a revolution) or a revolution without a sample starts a new
+    /// block; a complete block goes to wait for its closing event ([`OneXBlocks::take_ready`]).
+    pub fn add(&mut self, c: &ProbeComparison, events: &KeyphasorEvents) {
+        let axes = self.axes.get(c.station).copied().unwrap_or_default();
+        let Some(g) = self.stations.get_mut(c.station) else {
+            return;
+        };
+        // a gap by the stamps (a burst delivered late jumps the twin's angle, not the stamps)
+        let rev_ns = TAU / c.speed_rad_s.max(1e-3) * 1e9;
+        let last = g.samples.last().map(|s| (s.angle_rad, s.time_ns));
+        if last.is_some_and(|(a, t)| c.angle_rad < a - PI || (c.time_ns - t) as f64 > rev_ns) {
             g.samples.clear();
         }
         if g.samples.len() >= ONE_X_BLOCK_CAPACITY {
@@ -161,53 +199,132 @@ impl OneXBlocks {
             g.reason = None;
         }
         g.reason = g.reason.or(c.phase_reference.null_reason());
-        g.samples.push(BlockSample {
+        let sample = BlockSample {
+            time_ns: c.time_ns,
             angle_rad: c.angle_rad,
             speed_rad_s: c.speed_rad_s,
             measured_m: c.measured_m,
             predicted_m: c.predicted_m,
-        });
+        };
+        // a sample delivered out of stamp order goes to its place (rare: one search from the end)
+        let at = g.samples.len()
+            - g.samples
+                .iter()
+                .rev()
+                .take_while(|q| q.time_ns > c.time_ns)
+                .count();
+        g.samples.insert(at, sample);
         if c.angle_rad - g.start_angle_rad < ONE_X_BLOCK_REVS as f64 * TAU {
-            return None;
+            return;
         }
-        let block = finish(c.station, c.time_ns, self.axes[c.station], g);
+        if !g.waiting.is_empty() {
+            g.done = finish(c.station, axes, &g.waiting, g.waiting_reason, events, true);
+        }
         // the sample that closed this block opens the next one
-        let last = g.samples[g.samples.len() - 1];
+        std::mem::swap(&mut g.samples, &mut g.waiting);
+        g.waiting_reason = g.reason;
+        let closing = g.waiting.pop().unwrap_or(sample);
+        let end = g.waiting.last().map_or(closing, |q| *q);
+        let w = end.speed_rad_s.max(1e-3);
+        g.deadline_ns =
+            end.time_ns + seconds_to_ns(KEYPHASOR_STOP_REVS * TAU / w + KEYPHASOR_JITTER_S);
         g.samples.clear();
-        g.samples.push(last);
-        g.start_angle_rad = last.angle_rad;
+        g.samples.push(closing);
+        g.start_angle_rad = closing.angle_rad;
         g.reason = c.phase_reference.null_reason();
-        block
+    }
+
+    /// A finished block, if one is ready: one whose closing keyphasor event has come (in
+    /// `events`), or whose wait ended (the newest sample stamped `newest_ns` is past its
+    /// deadline). Call until None after each input.
+    pub fn take_ready(&mut self, events: &KeyphasorEvents, newest_ns: i64) -> Option<OneXBlock> {
+        for (k, g) in self.stations.iter_mut().enumerate() {
+            if let Some(b) = g.done.take() {
+                return Some(b);
+            }
+            if g.waiting.is_empty() {
+                continue;
+            }
+            let give_up = newest_ns > g.deadline_ns;
+            let b = finish(
+                k,
+                self.axes[k],
+                &g.waiting,
+                g.waiting_reason,
+                events,
+                give_up,
+            );
+            if b.is_some() || give_up {
+                g.waiting.clear();
+            }
+            if b.is_some() {
+                return b;
+            }
+        }
+        None
     }
 }
 
-/// The 1X vectors of a gathered block (the last sample, which reached the block's end, is
-/// left out: the block spans whole revolutions).
-fn finish(station: usize, end_ns: i64, axes: [f64; 2], g: &Gathering) -> Option<OneXBlock> {
-    let s = &g.samples[..g.samples.len().saturating_sub(1)];
+/// Each sample of `s` with its point `pick` projected on the axis at angle `a` (rad).
+fn along_axis(
+    s: &[BlockSample],
+    pick: fn(&BlockSample) -> [f64; 2],
+    a: f64,
+) -> impl Iterator<Item = (&BlockSample, f64)> + Clone {
+    let (sn, cs) = a.sin_cos();
+    s.iter().map(move |q| {
+        let p = pick(q);
+        (q, p[0] * cs + p[1] * sn)
+    })
+}
+
+/// The 1X vectors of a gathered block `s` (whole revolutions of the twin's angle): measured
+/// against the plant's angle from `events`, predicted against the twin's. None while its
+/// closing event is pending (unless `give_up`: then its measured phases are null).
+fn finish(
+    station: usize,
+    axes: [f64; 2],
+    s: &[BlockSample],
+    twin_reason: Option<&'static str>,
+    events: &KeyphasorEvents,
+    give_up: bool,
+) -> Option<OneXBlock> {
     let n = s.len();
-    let along = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
-        let (sn, cs) = a.sin_cos();
-        one_x_vector(
-            s.iter().map(move |q| {
-                let p = pick(q);
-                (q.angle_rad, p[0] * cs + p[1] * sn)
-            }),
-            n,
-        )
+    let end = s.last()?;
+    let plant = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
+        let along = along_axis(s, pick, a).map(|(q, v)| (q.time_ns, v));
+        keyphasor_one_x(along, n, events, give_up)
+    };
+    let twin = |pick: fn(&BlockSample) -> [f64; 2], a: f64| {
+        one_x_vector(along_axis(s, pick, a).map(|(q, v)| (q.angle_rad, v)), n)
     };
     let measured = |q: &BlockSample| q.measured_m;
     let predicted = |q: &BlockSample| q.predicted_m;
-    let m = [along(measured, axes[0])?, along(measured, axes[1])?];
-    let p = [along(predicted, axes[0])?, along(predicted, axes[1])?];
-    let xy = [along(measured, 0.0)?, along(measured, FRAC_PI_2)?];
+    let (plant_ok, measured_reason) = match plant(measured, axes[0]) {
+        Ok(_) => (true, None),
+        Err(Unbracketed::Pending) if !give_up => return None,
+        Err(Unbracketed::Pending) => (false, Some(NO_CLOSING_EVENT)),
+        Err(Unbracketed::Missing) => (false, Some(NO_OPENING_EVENT)),
+    };
+    // the plant's angle where every sample is bracketed; the twin's (amplitudes only) where not
+    let vector = |pick: fn(&BlockSample) -> [f64; 2], a: f64| match plant_ok {
+        true => plant(pick, a).ok().flatten(),
+        false => twin(pick, a),
+    };
+    let m = [vector(measured, axes[0])?, vector(measured, axes[1])?];
+    let p = [twin(predicted, axes[0])?, twin(predicted, axes[1])?];
+    let xy = [vector(measured, 0.0)?, vector(measured, FRAC_PI_2)?];
+    let psi = |q: &BlockSample| match plant_ok {
+        true => events.angle_at_or_after(q.time_ns).unwrap_or(q.angle_rad),
+        false => q.angle_rad,
+    };
     let mean = [0, 1].map(|j| s.iter().map(|q| q.measured_m[j]).sum::<f64>() / n as f64);
     let rss: f64 = s
         .iter()
         .map(|q| {
             (0..2)
                 .map(|j| {
-                    let fit = mean[j] + crate::signals::probes::runout_at(&xy[j], q.angle_rad);
+                    let fit = mean[j] + crate::signals::probes::runout_at(&xy[j], psi(q));
                     (q.measured_m[j] - fit).powi(2)
                 })
                 .sum::<f64>()
@@ -215,7 +332,7 @@ fn finish(station: usize, end_ns: i64, axes: [f64; 2], g: &Gathering) -> Option<
         .sum();
     Some(OneXBlock {
         station,
-        end_ns,
+        end_ns: end.time_ns,
         speed_rad_s: s.iter().map(|q| q.speed_rad_s).sum::<f64>() / n as f64,
         revolutions: ONE_X_BLOCK_REVS,
         samples: n,
@@ -225,7 +342,7 @@ fn finish(station: usize, end_ns: i64, axes: [f64; 2], g: &Gathering) -> Option<
         measured_xy: xy,
         measured_mean_m: mean,
         residual_rms_m: (rss / (2 * n) as f64).sqrt(),
-        null_reason: g.reason,
+        null_reason: twin_reason.or(measured_reason),
     })
 }
 
@@ -233,6 +350,21 @@ fn finish(station: usize, end_ns: i64, axes: [f64; 2], g: &Gathering) -> Option<
 mod tests {
     use super::*;
     use crate::signals::PhaseReference;
+
+    /// Keyphasor events where the angle `psi` of [`comparison`] is 2πm, m in 0..revs, at `w`.
+    fn events(w: f64, revs: usize) -> KeyphasorEvents {
+        let mut e = KeyphasorEvents::default();
+        for m in 0..revs {
+            e.push((TAU * m as f64 / w * 1e9) as i64);
+        }
+        e
+    }
+
+    /// Adds `c` and takes the blocks that are ready.
+    fn add(blocks: &mut OneXBlocks, c: &ProbeComparison, ev: &KeyphasorEvents) -> Vec<OneXBlock> {
+        blocks.add(c, ev);
+        std::iter::from_fn(|| blocks.take_ready(ev, c.time_ns)).collect()
+    }
 
     fn comparison(k: usize, psi: f64, w: f64, lag: f64, r: PhaseReference) -> ProbeComparison {
         // a forward 1X circle of 3 µm lagging the mark by `lag`, about a mean of (5, −20) µm;
@@ -260,11 +392,12 @@ mod tests {
         let mut blocks = OneXBlocks::new(vec![axes]);
         let (w, lag) = (800.0, 50f64.to_radians());
         let per_rev = 37; // not a divisor of anything in particular
+        let ev = events(w, 12);
         let mut out = None;
         for k in 0..(9 * per_rev) {
             let psi = TAU * k as f64 / per_rev as f64 + 0.3;
             let c = comparison(k, psi, w, lag, PhaseReference::Locked);
-            if let Some(b) = blocks.add(&c) {
+            if let Some(b) = add(&mut blocks, &c, &ev).pop() {
                 out.get_or_insert(b);
             }
         }
@@ -299,6 +432,7 @@ mod tests {
     fn a_block_not_locked_throughout_has_null_phases_with_the_reason() {
         let mut blocks = OneXBlocks::new(vec![[0.0, FRAC_PI_2]]);
         let lag = 0.2;
+        let ev = events(900.0, 40);
         let mut got = Vec::new();
         for k in 0..(20 * 16) {
             let psi = TAU * k as f64 / 16.0;
@@ -307,7 +441,7 @@ mod tests {
             } else {
                 PhaseReference::Locked
             };
-            got.extend(blocks.add(&comparison(k, psi, 900.0, lag, r)));
+            got.extend(add(&mut blocks, &comparison(k, psi, 900.0, lag, r), &ev));
         }
         assert_eq!(got.len(), 2, "{got:?}");
         assert_eq!(
@@ -326,9 +460,8 @@ mod tests {
         let mut n = 0;
         for k in (0..(6 * 16)).chain(0..(6 * 16)) {
             let psi = TAU * k as f64 / 16.0;
-            n += blocks
-                .add(&comparison(k, psi, 900.0, lag, PhaseReference::Locked))
-                .is_some() as usize;
+            let c = comparison(k, psi, 900.0, lag, PhaseReference::Locked);
+            n += add(&mut blocks, &c, &ev).len();
         }
         assert_eq!(
             n, 0,
@@ -339,7 +472,8 @@ mod tests {
         let mut got = Vec::new();
         for k in (0..(4 * 16)).chain((4 * 16 + 24)..(14 * 16)) {
             let psi = TAU * k as f64 / 16.0;
-            got.extend(blocks.add(&comparison(k, psi, 900.0, lag, PhaseReference::Locked)));
+            let c = comparison(k, psi, 900.0, lag, PhaseReference::Locked);
+            got.extend(add(&mut blocks, &c, &ev));
         }
         assert_eq!(got.len(), 1, "{got:?}");
         assert_eq!(got[0].samples, 8 * 16);

@@ -6,12 +6,11 @@
 use super::{seconds_to_ns, Driver, Fed, ProbeRef, StationRef};
 use crate::session::{input_warning, Outgoing, WarningKind};
 use crate::signals::probes::{check_reading, machine_from_probes, runout_at, SlowRoll};
-use crate::signals::{KeyphasorLock, KeyphasorSettings, OneXVector, PhaseReference};
+use crate::signals::{
+    KeyphasorEvents, KeyphasorLock, KeyphasorSettings, OneXVector, PhaseReference,
+    KEYPHASOR_JITTER_S, KEYPHASOR_STOP_REVS,
+};
 use std::f64::consts::TAU;
-
-/// Revolutions without a keyphasor event, at the speed in force, after which the keyphasor
-/// counts as stopped (and phases are null): 3.
-pub const KEYPHASOR_STOP_REVS: f64 = 3.0;
 
 /// Time constant of the running mean removed from AC-coupled probes (revolutions): 8, the
 /// replay's block. The mean is an exponential average of whole-revolution means (each the
@@ -72,6 +71,10 @@ impl RevolutionMean {
 pub struct SignalState {
     /// The lock.
     pub(super) keyphasor: KeyphasorLock,
+    /// The accepted events since the last refused one: the plant's own angle.
+    events: KeyphasorEvents,
+    /// The newest probe sample's time (ns): the stamp time the keyphasor stop is judged at.
+    pub(super) newest_sample_ns: Option<i64>,
     /// Any event was received.
     seen: bool,
     /// Keyphasor events are known to come (a replayed bag has them): the twin waits for the
@@ -136,13 +139,37 @@ impl Driver {
             .or_else(|| self.signals.measured_runout(k))
     }
 
+    /// The accepted keyphasor events since the last refused one (the plant's own angle, for
+    /// the measured 1X vectors: [`crate::signals::keyphasor_one_x`]).
+    pub fn keyphasor_events(&self) -> &KeyphasorEvents {
+        &self.signals.events
+    }
+
+    /// The newest probe sample's time (ns, its stamp where it is on the driver's clock).
+    pub fn newest_sample_ns(&self) -> Option<i64> {
+        self.signals.newest_sample_ns
+    }
+
+    /// True if no event is stamped within [`KEYPHASOR_STOP_REVS`] revolutions at the speed in
+    /// force plus [`KEYPHASOR_JITTER_S`] before `t_ns` (a stamp time).
     fn keyphasor_stopped(&self, t_ns: i64) -> bool {
         let (Some(last), Some(w)) = (self.signals.keyphasor.last_event_ns(), self.speed_rad_s())
         else {
             return false;
         };
-        let limit_s = KEYPHASOR_STOP_REVS * TAU / w.max(1e-3);
+        let limit_s = KEYPHASOR_STOP_REVS * TAU / w.max(1e-3) + KEYPHASOR_JITTER_S;
         (t_ns - last) as f64 * 1e-9 > limit_s
+    }
+
+    /// The stamp time the keyphasor stop is judged at, at receive time `now_ns`: the newest
+    /// probe sample's, but no earlier than `now_ns` less the jitter (so a keyphasor that stops
+    /// while no sample comes is seen too). An event delivered up to [`KEYPHASOR_JITTER_S`]
+    /// plus `KEYPHASOR_STOP_REVS` − 1 revolutions late never counts as a stop.
+    fn stop_judged_at(&self, now_ns: i64) -> i64 {
+        let floor = now_ns - seconds_to_ns(KEYPHASOR_JITTER_S);
+        self.signals
+            .newest_sample_ns
+            .map_or(floor, |s| s.max(floor))
     }
 
     /// A keyphasor event stamped `stamp_ns`, received at `now_ns`: checked against the speed,
@@ -167,10 +194,18 @@ impl Driver {
             .filter(|s| (now_ns - s.received_ns) <= tolerance)
             .map(|s| s.speed_rad_s);
         let angle = self.session.as_ref().map(|s| s.angle_at(t));
+        let after = self.signals.events.newest_ns().is_none_or(|n| t > n);
         let ev = match self.signals.keyphasor.event(t, angle, topic_speed) {
             Ok(ev) => ev,
-            Err(why) => return Fed::Refused(why),
+            Err(why) => {
+                if after {
+                    // a missed, extra or moved pulse: the plant's angle counts afresh from it
+                    self.signals.events.restart_at(t);
+                }
+                return Fed::Refused(why);
+            }
         };
+        self.signals.events.push(t);
         if let (Some(c), Some(s)) = (ev.correction_rad, self.session.as_mut()) {
             s.shift_angle(c);
         }
@@ -235,7 +270,9 @@ impl Driver {
 
     /// Warns once when the keyphasor stops while the shaft turns; phases are null meanwhile.
     pub(super) fn check_keyphasor_stop(&mut self, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
-        if self.signals.stop_warned || self.session.is_none() || !self.keyphasor_stopped(now_ns) {
+        let judged_at = self.stop_judged_at(now_ns);
+        if self.signals.stop_warned || self.session.is_none() || !self.keyphasor_stopped(judged_at)
+        {
             return;
         }
         self.signals.stop_warned = true;
@@ -243,7 +280,7 @@ impl Driver {
             now_ns,
             WarningKind::StaleInput,
             format!(
-                "keyphasor stopped: no event for {KEYPHASOR_STOP_REVS} revolutions; 1X phases are null until it is back, the twin carries on with the speed"
+                "keyphasor stopped: no event stamped within {KEYPHASOR_STOP_REVS} revolutions + {KEYPHASOR_JITTER_S} s of the samples; 1X phases are null until it is back, the twin carries on with the speed"
             ),
         ));
     }
@@ -284,6 +321,8 @@ impl Driver {
         } else {
             now_ns
         };
+        let newest = self.signals.newest_sample_ns.map_or(t, |n| n.max(t));
+        self.signals.newest_sample_ns = Some(newest);
         let d = self.compensate_runout(k, t, d);
         if self.signals.stations.len() < self.rotor.probes.len() {
             self.signals.stations = vec![RawStation::default(); self.rotor.probes.len()];

@@ -517,23 +517,28 @@ impl ModelLoop {
     }
 
     /// What the node makes of a fed input beyond the driver's messages: a compared probe sample
-    /// goes into its station's 1X block, and a finished block is published.
+    /// goes into its station's 1X block, and the blocks now finished (their closing keyphasor
+    /// event come, or their wait over) are published.
     fn after_feed(&mut self, fed: &Fed) {
-        let Fed::Compared(c) = fed else {
-            return;
-        };
-        let Some(block) = self.one_x.add(c) else {
-            return;
-        };
-        let name = self
-            .driver
-            .rotor()
-            .probes
-            .get(block.station)
-            .map_or("", |p| p.name.as_str());
-        self.pending.push(Published::OneX(block.to_message(name)));
-        let dc = !self.driver.station_is_ac(block.station);
-        self.calibration.add(&block, dc);
+        let events = self.driver.keyphasor_events();
+        if let Fed::Compared(c) = fed {
+            self.one_x.add(c, events);
+        }
+        let newest = self.driver.newest_sample_ns().unwrap_or(i64::MIN);
+        while let Some(block) = self
+            .one_x
+            .take_ready(self.driver.keyphasor_events(), newest)
+        {
+            let name = self
+                .driver
+                .rotor()
+                .probes
+                .get(block.station)
+                .map_or("", |p| p.name.as_str());
+            self.pending.push(Published::OneX(block.to_message(name)));
+            let dc = !self.driver.station_is_ac(block.station);
+            self.calibration.add(&block, dc);
+        }
     }
 
     /// The live calibration (issue 12): a change of `calibration_apply` acted upon, a finished

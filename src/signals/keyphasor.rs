@@ -14,6 +14,128 @@
 
 use std::f64::consts::{PI, TAU};
 
+/// Revolutions without a keyphasor event, judged by the stamps, after which the keyphasor
+/// counts as stopped (and phases are null): 3, plus [`KEYPHASOR_JITTER_S`].
+pub const KEYPHASOR_STOP_REVS: f64 = 3.0;
+
+/// Delivery jitter the keyphasor rules tolerate (s): 0.1 s. An event stamped right but received
+/// up to this much (plus `KEYPHASOR_STOP_REVS` − 1 revolutions) after the probe samples of its
+/// time neither stops the keyphasor nor leaves a 1X block without its closing event. The rclpy
+/// peer on this loaded machine delivered in bursts of up to 41 ms (6 revolutions at 9,000 rpm).
+pub const KEYPHASOR_JITTER_S: f64 = 0.1;
+
+/// Keyphasor events kept for the plant's angle: 256 (a block of 8 revolutions, the wait for
+/// its closing event and the jitter at 12,000 rpm are 8 + 3 + 20 revolutions).
+pub const KEYPHASOR_EVENTS_KEPT: usize = 256;
+
+/// Why a sample has no plant angle (yet).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unbracketed {
+    /// No event after the sample has arrived yet: wait for it.
+    Pending,
+    /// No kept event at or before the sample (none yet, or the history broke after it).
+    Missing,
+}
+
+/// The last accepted keyphasor events (stamps, ns, increasing) since the last break: the
+/// plant's own shaft angle. Each event is angle 0 of a revolution; between two events the angle
+/// is interpolated linearly in time (the API 670 / ADRE keyphasor reference: the angle of a
+/// sample does not depend on when it, or the event, was delivered). A refused event breaks the
+/// history (a missed or extra pulse would count a revolution wrongly). Allocates nothing.
+#[derive(Debug, Clone)]
+pub struct KeyphasorEvents {
+    stamps: [i64; KEYPHASOR_EVENTS_KEPT],
+    /// index of the oldest kept event in `stamps`
+    head: usize,
+    len: usize,
+    /// events pushed since the last break (the newest is revolution `count − 1`)
+    count: u64,
+}
+
+impl Default for KeyphasorEvents {
+    fn default() -> Self {
+        Self {
+            stamps: [0; KEYPHASOR_EVENTS_KEPT],
+            head: 0,
+            len: 0,
+            count: 0,
+        }
+    }
+}
+
+impl KeyphasorEvents {
+    /// The newest event's stamp (ns).
+    pub fn newest_ns(&self) -> Option<i64> {
+        (self.len > 0).then(|| self.stamp(self.len - 1))
+    }
+
+    fn stamp(&self, j: usize) -> i64 {
+        self.stamps[(self.head + j) % KEYPHASOR_EVENTS_KEPT]
+    }
+
+    /// Adds an event at `t_ns`; one not after the newest is ignored (false).
+    pub fn push(&mut self, t_ns: i64) -> bool {
+        if self.newest_ns().is_some_and(|n| t_ns <= n) {
+            return false;
+        }
+        if self.len == KEYPHASOR_EVENTS_KEPT {
+            self.head = (self.head + 1) % KEYPHASOR_EVENTS_KEPT;
+            self.len -= 1;
+        }
+        self.stamps[(self.head + self.len) % KEYPHASOR_EVENTS_KEPT] = t_ns;
+        self.len += 1;
+        self.count += 1;
+        true
+    }
+
+    /// Breaks the history (a refused event) and starts it again at `t_ns`.
+    pub fn restart_at(&mut self, t_ns: i64) {
+        *self = Self::default();
+        self.push(t_ns);
+    }
+
+    /// The plant's shaft angle at `t_ns` (rad, 2π a revolution, continuous since the last
+    /// break): 2π·(k + (t − t_k)/(t_{k+1} − t_k)) between the events k and k + 1 that bracket it.
+    pub fn angle_at(&self, t_ns: i64) -> Result<f64, Unbracketed> {
+        // first kept event after t_ns, by bisection
+        let (mut lo, mut hi) = (0, self.len);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if self.stamp(mid) > t_ns {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        if lo == self.len {
+            return Err(Unbracketed::Pending);
+        }
+        if lo == 0 {
+            return Err(Unbracketed::Missing);
+        }
+        let (a, b) = (self.stamp(lo - 1), self.stamp(lo));
+        let k = (self.count - self.len as u64 + lo as u64 - 1) as f64;
+        Ok(TAU * (k + (t_ns - a) as f64 / (b - a) as f64))
+    }
+
+    /// As [`KeyphasorEvents::angle_at`], and less than one interval past the newest event,
+    /// extrapolated at the last interval's speed (a block finished without its closing event,
+    /// its last revolution at the last speed, as the lock extrapolates the twin's angle).
+    pub fn angle_at_or_after(&self, t_ns: i64) -> Result<f64, Unbracketed> {
+        match self.angle_at(t_ns) {
+            Err(Unbracketed::Pending) if self.len >= 2 => {
+                let (a, b) = (self.stamp(self.len - 2), self.stamp(self.len - 1));
+                let u = (t_ns - b) as f64 / (b - a) as f64;
+                let k = (self.count - 1) as f64;
+                (u < 1.0)
+                    .then_some(TAU * (k + u))
+                    .ok_or(Unbracketed::Pending)
+            }
+            r => r,
+        }
+    }
+}
+
 /// How the lock follows and checks the events.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KeyphasorSettings {
@@ -261,6 +383,44 @@ mod tests {
         // steady state of e_{k+1} = (1 − g) e_k + 3.6°: e = 3.6°/g = 7.2°
         let last = *errors.last().unwrap();
         assert!((last - 7.2).abs() < 0.01, "steady error {last}°");
+    }
+
+    /// Events at a speed changing by 10 % a revolution, pushed in any delivery order of
+    /// whole bursts: the angle at an event is 2πk, half-way between two events π more, the
+    /// angle after the newest waits (Pending), before the oldest kept is Missing; a break
+    /// forgets the past; the ring keeps the last 256.
+    #[test]
+    fn the_plant_angle_is_interpolated_between_the_bracketing_events() {
+        let mut ev = KeyphasorEvents::default();
+        let mut t = 1_000_000i64;
+        let mut stamps = Vec::new();
+        for k in 0..300 {
+            stamps.push(t);
+            t += (6_000_000.0 / (1.0 + 0.1 * (k % 7) as f64)) as i64;
+        }
+        for &s in &stamps {
+            assert!(ev.push(s));
+        }
+        assert!(!ev.push(stamps[10]), "an old event is ignored");
+        assert_eq!(ev.angle_at(stamps[299] + 1), Err(Unbracketed::Pending));
+        assert_eq!(ev.angle_at(stamps[43]), Err(Unbracketed::Missing));
+        for k in [44usize, 100, 298] {
+            let a = ev.angle_at(stamps[k]).unwrap();
+            assert!((a - TAU * k as f64).abs() < 1e-9, "{k}: {a}");
+            let mid = (stamps[k] + stamps[k + 1]) / 2;
+            let m = ev.angle_at(mid).unwrap();
+            assert!((m - TAU * k as f64 - PI).abs() < 1e-6, "{k}: {m}");
+        }
+        // past the newest by a quarter of the last interval: Pending, or extrapolated
+        let q = stamps[299] + (stamps[299] - stamps[298]) / 4;
+        assert_eq!(ev.angle_at(q), Err(Unbracketed::Pending));
+        let e = ev.angle_at_or_after(q).unwrap();
+        assert!((e - TAU * 299.25).abs() < 1e-6, "{e}");
+        let beyond = stamps[299] + (stamps[299] - stamps[298]) + 1;
+        assert_eq!(ev.angle_at_or_after(beyond), Err(Unbracketed::Pending));
+        ev.restart_at(stamps[299] + 5_000_000);
+        assert_eq!(ev.angle_at(stamps[299]), Err(Unbracketed::Missing));
+        assert_eq!(ev.newest_ns(), Some(stamps[299] + 5_000_000));
     }
 
     #[test]

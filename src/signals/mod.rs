@@ -7,5 +7,8 @@ pub mod keyphasor;
 pub mod phase;
 pub mod probes;
 
-pub use keyphasor::{KeyphasorEvent, KeyphasorLock, KeyphasorSettings, PhaseReference};
-pub use phase::{one_x_vector, OneXVector};
+pub use keyphasor::{
+    KeyphasorEvent, KeyphasorEvents, KeyphasorLock, KeyphasorSettings, PhaseReference, Unbracketed,
+    KEYPHASOR_JITTER_S, KEYPHASOR_STOP_REVS,
+};
+pub use phase::{keyphasor_one_x, one_x_vector, OneXVector};
