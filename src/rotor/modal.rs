@@ -735,3 +735,51 @@ mod eigen_failure_tests {
         }
     }
 }
+
+#[cfg(test)]
+mod balance_tests {
+    use super::*;
+
+    /// A state-like matrix B (random, order 1) disguised as A = S B S⁻¹ with S spanning 10⁻⁶…10⁶
+    /// (the spread of the rotor's state matrix between its order-1 and order-ω² blocks).
+    /// Balancing is a similarity by powers of two: D⁻¹ A D is reproduced exactly from the D it
+    /// returns, and faer's eigenvalues of the balanced A equal faer's eigenvalues of B (a second
+    /// route to the same spectrum) to 1e-9 of the spectral radius.
+    #[test]
+    fn balancing_keeps_the_spectrum_faer_finds_unscaled() {
+        let n = 12;
+        let mut seed = 99u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let b = Mat::<f64>::from_fn(n, n, |_, _| rnd());
+        let s: Vec<f64> = (0..n)
+            .map(|i| 10f64.powf(-6.0 + 12.0 * i as f64 / (n - 1) as f64))
+            .collect();
+        let a = Mat::<f64>::from_fn(n, n, |i, j| s[i] * b[(i, j)] / s[j]);
+        let (balanced, d) = balance(a.clone());
+        for i in 0..n {
+            assert!(
+                d[i].log2().fract() == 0.0,
+                "D[{i}] = {} is not a power of two",
+                d[i]
+            );
+            for j in 0..n {
+                assert_eq!(balanced[(i, j)], a[(i, j)] / d[i] * d[j], "({i}, {j})");
+            }
+        }
+        let spectrum = |m: &Mat<f64>| {
+            let mut v: Vec<faer::c64> = m.eigenvalues().expect("eigenvalues").into_iter().collect();
+            v.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+            v
+        };
+        let (got, want) = (spectrum(&balanced), spectrum(&b));
+        let radius = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((*g - *w).norm() < 1e-9 * radius, "{g:?} vs {w:?}");
+        }
+    }
+}

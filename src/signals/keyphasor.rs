@@ -39,7 +39,9 @@ pub enum Unbracketed {
 
 /// The last accepted keyphasor events (stamps, ns, increasing) since the last break: the
 /// plant's own shaft angle. Each event is angle 0 of a revolution; between two events the angle
-/// is interpolated linearly in time (the API 670 / ADRE keyphasor reference: the angle of a
+/// is interpolated in time, quadratically through a third event (exact at constant
+/// acceleration, where linear interpolation reads up to α·T²/8 off: 0.56° in a run-up that
+/// gains 10 % of its speed in 8 revolutions) (the API 670 / ADRE keyphasor reference: the angle of a
 /// sample does not depend on when it, or the event, was delivered). A refused event breaks the
 /// history (a missed or extra pulse would count a revolution wrongly). Allocates nothing.
 #[derive(Debug, Clone)]
@@ -95,7 +97,9 @@ impl KeyphasorEvents {
     }
 
     /// The plant's shaft angle at `t_ns` (rad, 2π a revolution, continuous since the last
-    /// break): 2π·(k + (t − t_k)/(t_{k+1} − t_k)) between the events k and k + 1 that bracket it.
+    /// break) between the events k and k + 1 that bracket it: the parabola through them and
+    /// event k + 2 (or k − 1 while k + 2 has not come), 2π·(k + (t − t_k)/(t_{k+1} − t_k)) when
+    /// only two are kept.
     pub fn angle_at(&self, t_ns: i64) -> Result<f64, Unbracketed> {
         // first kept event after t_ns, by bisection
         let (mut lo, mut hi) = (0, self.len);
@@ -115,7 +119,20 @@ impl KeyphasorEvents {
         }
         let (a, b) = (self.stamp(lo - 1), self.stamp(lo));
         let k = (self.count - self.len as u64 + lo as u64 - 1) as f64;
-        Ok(TAU * (k + (t_ns - a) as f64 / (b - a) as f64))
+        // a third event, the next one or else the one before, makes the angle quadratic in time
+        let third = if lo + 1 < self.len {
+            Some((self.stamp(lo + 1), 2.0))
+        } else if lo >= 2 {
+            Some((self.stamp(lo - 2), -1.0))
+        } else {
+            None
+        };
+        let (x, xb) = ((t_ns - a) as f64, (b - a) as f64);
+        let u = match third {
+            Some((c, kc)) => through_three(x, xb, (c - a) as f64, kc),
+            None => x / xb,
+        };
+        Ok(TAU * (k + u))
     }
 
     /// As [`KeyphasorEvents::angle_at`], and less than one interval past the newest event,
@@ -134,6 +151,12 @@ impl KeyphasorEvents {
             r => r,
         }
     }
+}
+
+/// The revolution fraction at time x of the parabola through (0, 0), (xb, 1) and (xc, kc)
+/// (Lagrange form; times relative to the first event).
+fn through_three(x: f64, xb: f64, xc: f64, kc: f64) -> f64 {
+    x * (x - xc) / (xb * (xb - xc)) + kc * x * (x - xb) / (xc * (xc - xb))
 }
 
 /// How the lock follows and checks the events.

@@ -9,6 +9,7 @@
 //! over whole revolutions it leaves an exact 1X component unchanged).
 
 use super::keyphasor::{KeyphasorEvents, Unbracketed};
+use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -48,14 +49,17 @@ impl OneXVector {
 /// signal), or None with fewer than 8 samples, less than one revolution or an angle that is not
 /// finite. Allocates nothing.
 ///
-/// The window and the sums go by angle, not by sample index, so that samples spaced unevenly
+/// The window and the weights go by angle, not by sample index, so that samples spaced unevenly
 /// in angle (a probe sample lost, a speed that changes within the block, a DAQ that does not
 /// sample synchronously) weigh by the angle they stand for: each sample is the midpoint of a
 /// cell from half-way to its predecessor to half-way to its successor (the end cells mirrored),
 /// its quadrature weight q the cell's width, the Hann window w = ½ − ½ cos 2π(ψ − ψ_a)/(ψ_b − ψ_a)
-/// over the cells' span [ψ_a, ψ_b], the mean s̄ = Σ q s / Σ q and
-/// X = 2 Σ w q (s − s̄) e^{−iψ} / Σ w q. For samples evenly spaced in angle, q is constant and
-/// the window at sample i is ½ − ½ cos 2π(i + ½)/n: the index-based Hann DFT exactly.
+/// over the cells' span [ψ_a, ψ_b]. The vector is the weighted least-squares fit of
+/// s ≈ m + a cos ψ + b sin ψ with weights w q (X = a − i b): exact for a mean and a 1X however
+/// the samples fall, so a gap in the angle (a burst lost) does not bias it. For samples evenly
+/// spaced in angle over whole revolutions the normal equations are diagonal (the window and
+/// the 1X and 2X terms are orthogonal there) and the fit is the index-based Hann DFT,
+/// X = 2 Σ w (s − s̄) e^{−iψ} / Σ w, exactly.
 pub fn one_x_vector(
     samples: impl Iterator<Item = (f64, f64)> + Clone,
     n: usize,
@@ -76,31 +80,26 @@ pub fn one_x_vector(
     );
     let mut next = psi.skip(1);
     let mut prev = p0 - (p1 - p0);
-    // Σ w q s e^{−iψ}, Σ w q e^{−iψ}, Σ w q, Σ q s, Σ q
-    let (mut ws, mut we, mut wq, mut qs, mut qq) = ([0.0; 2], [0.0; 2], 0.0, 0.0, 0.0);
+    // the normal equations of the fit in (m, a, b): Σ w q φ φᵀ and Σ w q s φ, φ = (1, cos, sin)
+    let (mut normal, mut rhs) = (Matrix3::<f64>::zeros(), Vector3::<f64>::zeros());
     for (p, s) in samples.take(n) {
         let nx = next.next().unwrap_or(2.0 * p - prev);
         // a sample whose angle does not advance (a repeated or a going-back angle) weighs nothing
         let q = (0.5 * (nx - prev)).max(0.0);
-        if !q.is_finite() {
+        if !q.is_finite() || !s.is_finite() {
             return None;
         }
         prev = p;
         let w = q * (0.5 - 0.5 * (TAU * (p - a) / span).cos());
         let (sn, cs) = p.sin_cos();
-        ws = [ws[0] + w * s * cs, ws[1] - w * s * sn];
-        we = [we[0] + w * cs, we[1] - w * sn];
-        wq += w;
-        qs += q * s;
-        qq += q;
+        let phi = Vector3::new(1.0, cs, sn);
+        normal += w * phi * phi.transpose();
+        rhs += (w * s) * phi;
     }
-    let mean = qs / qq;
-    (wq > 0.0).then(|| {
-        OneXVector::from_phasor_m([
-            2.0 * (ws[0] - mean * we[0]) / wq,
-            2.0 * (ws[1] - mean * we[1]) / wq,
-        ])
-    })
+    let fit = normal.lu().solve(&rhs)?;
+    fit.iter()
+        .all(|v| v.is_finite())
+        .then(|| OneXVector::from_phasor_m([fit[1], -fit[2]]))
 }
 
 /// The measured 1X vector of `n` samples (t: stamp, ns, increasing; s: the signal) referenced
