@@ -162,14 +162,14 @@ impl Driver {
     }
 
     /// The stamp time the keyphasor stop is judged at, at receive time `now_ns`: the newest
-    /// probe sample's, but no earlier than `now_ns` less the jitter (so a keyphasor that stops
-    /// while no sample comes is seen too). An event delivered up to [`KEYPHASOR_JITTER_S`]
+    /// probe sample's, but no earlier than `now_ns` (so a keyphasor that stops while no sample
+    /// comes is seen too; the limit of [`Self::keyphasor_stopped`] already allows
+    /// [`KEYPHASOR_JITTER_S`] of delivery delay, once). An event delivered up to that jitter
     /// plus `KEYPHASOR_STOP_REVS` − 1 revolutions late never counts as a stop.
     fn stop_judged_at(&self, now_ns: i64) -> i64 {
-        let floor = now_ns - seconds_to_ns(KEYPHASOR_JITTER_S);
         self.signals
             .newest_sample_ns
-            .map_or(floor, |s| s.max(floor))
+            .map_or(now_ns, |s| s.max(now_ns))
     }
 
     /// A keyphasor event stamped `stamp_ns`, received at `now_ns`: checked against the speed,

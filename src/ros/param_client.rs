@@ -54,7 +54,7 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
         let getter: Client<GetParametersRequest, GetParametersResponse> = peer
             .client(&mut me, "get_parameters", "GetParameters")
             .await?;
-        match call {
+        let result = match call {
             ParamCall::Get(names) => {
                 let values = peer.get(&getter, names.clone()).await?;
                 for (name, value) in names.iter().zip(values) {
@@ -74,7 +74,14 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
                 let outcomes = response.results.iter();
                 report_set(&items, outcomes.map(|r| (r.successful, r.reason.as_str())))
             }
-        }
+        };
+        // A one-shot command: the DDS participant is not dropped. RustDDS 0.15's teardown can
+        // run its last drop on its own discovery thread, which then joins itself and panics
+        // ("failed to join thread: Resource deadlock avoided", seen once in node_namespaces
+        // after a correct answer); the process ends right after, and the OS frees the rest.
+        std::mem::forget(me);
+        std::mem::forget(context);
+        result
     })
 }
 

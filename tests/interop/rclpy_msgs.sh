@@ -31,7 +31,13 @@ unshare -n env OUT="$out" BIN="$bin" SECONDS_RUN="$seconds" SWITCH_S="$((seconds
   "$BIN" node --config "$OUT/machine.yaml" --record "$OUT/bag" --ros-args -p keyphasor_type:=keyphasor \
     -p calibration_period_s:=2.0 -p forecast_period_s:=3.0 > "$OUT/node.out" 2> "$OUT/node.err" &
   node=$!
-  sleep 1
+  # the node subscribes once its film tables are ready (built on a first run: up to a minute
+  # under load): the peer starts when the node says it is up
+  for _ in $(seq 1 600); do
+    grep -q " up on ROS domain" "$OUT/node.err" 2>/dev/null && break
+    sleep 0.2
+  done
+  sleep 0.5
   env AMENT_PREFIX_PATH="$VENV" PATH="$VENV/bin:$PATH" RMW_IMPLEMENTATION=rmw_fastrtps_cpp \
     LD_LIBRARY_PATH="$LIBS" PYTHONPATH="$SITE" _ROS_WHEELS_BOOTSTRAP_COMPLETE=1 \
     ROS_LOG_DIR="$OUT/ros_log" timeout 120 "$VENV/bin/python" "$HERE/rclpy_msgs_peer.py" \
