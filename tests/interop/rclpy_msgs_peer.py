@@ -8,7 +8,9 @@ in our own types serialised by rosidl's typesupport (not by rotor-twin's code):
   one Unbalance (reliable),
   Keyphasor (best effort, one a revolution), ProbeSignal for probe_outboard_x/_y (best effort,
   16 a revolution: the gap in µm, 1000 less a forward 1X circle of 2 µm lagging the keyphasor by
-  50°) and ProbeDisplacement at probe_outboard (the same circle in the machine frame, m);
+  50°) and ProbeDisplacement at the other station, probe_pulley_end (the same circle in the
+  machine frame, m; one source a station: the raw AC probes' mean is the twin's, a displacement's
+  its own, and mixed in one block they read as a whirl);
 subscribes to every output type of the node; and, SECONDS − 2 s in, creates a late subscriber
 of the latched warning. Prints one JSON object: per output topic the count, NaN and infinite
 fields, the first message's key fields, the type hashes the graph reports; the Rust-free judge
@@ -96,10 +98,12 @@ class Seen:
                 t["first"] = fields
             t["last"] = fields
             if t["type"] == "OneXVectors" and len(msg.measured_phase_lags_deg) == 2:
-                t.setdefault("phase_lags_deg", []).append(plain(msg.measured_phase_lags_deg))
+                t.setdefault("phase_lags_deg", {}).setdefault(msg.station, []).append(
+                    plain(msg.measured_phase_lags_deg))
             if t["type"] == "OrbitResidual":
-                t["max_abs_residual"] = max(t.get("max_abs_residual", 0.0),
-                                            abs(msg.residual_x), abs(msg.residual_y))
+                m = t.setdefault("max_abs_residual", {})
+                m[msg.station] = max(m.get(msg.station, 0.0), abs(msg.residual_x),
+                                     abs(msg.residual_y))
             if t["type"] == "InstabilityWarning":
                 t.setdefault("kinds", [])
                 if msg.kind not in t["kinds"]:
@@ -187,7 +191,7 @@ def main():
             sent["probe_signal"] += 1
         d = ProbeDisplacement()
         d.header.stamp = stamp(now)
-        d.header.frame_id = d.station = "probe_outboard"
+        d.header.frame_id = d.station = "probe_pulley_end"
         d.x, d.y = 2e-6 * math.cos(psi - lag), 2e-6 * math.sin(psi - lag)
         probe_w.publish(d)
         sent["probe"] += 1
