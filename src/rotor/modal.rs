@@ -747,14 +747,10 @@ mod balance_tests {
     /// route to the same spectrum) to 1e-9 of the spectral radius.
     #[test]
     fn balancing_keeps_the_spectrum_faer_finds_unscaled() {
+        use rand::{Rng, SeedableRng};
         let n = 12;
-        let mut seed = 99u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
+        let mut rnd = || rng.random_range(-0.5..0.5);
         let b = Mat::<f64>::from_fn(n, n, |_, _| rnd());
         let s: Vec<f64> = (0..n)
             .map(|i| 10f64.powf(-6.0 + 12.0 * i as f64 / (n - 1) as f64))
