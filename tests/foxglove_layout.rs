@@ -176,6 +176,116 @@ fn check_layout(v: &Value) {
     assert!(ids.iter().all(|i| configs.contains_key(i)));
 }
 
+/// The configuration keys each panel type reads, from Lichtblick's panel config types
+/// (lichtblick-suite/lichtblick, packages/suite-base/src/panels/: Plot/utils/config.ts
+/// `PlotConfig`, `PlotPath`, `BasePlotPath`, `PlotXAxisVal`; RawMessages/types.ts
+/// `RawMessagesPanelConfig`; diagnostics/types.ts `DiagnosticSummaryConfig`; util/layout.ts
+/// `PANEL_TITLE_CONFIG_KEY` = `lichtblickPanelTitle`; util/time.ts `TimestampMethod`), plus
+/// Foxglove's title key `foxglovePanelTitle` (Foxglove Studio's `PANEL_TITLE_CONFIG_KEY`,
+/// ../shared/notes/foxglove-lichtblick.md). Read through the search tool, not run: a key outside
+/// these lists is silently ignored by the viewer (as `title` was).
+const TITLE_KEYS: [&str; 2] = ["lichtblickPanelTitle", "foxglovePanelTitle"];
+const PLOT_KEYS: &[&str] = &[
+    "paths",
+    "minXValue",
+    "maxXValue",
+    "minYValue",
+    "maxYValue",
+    "showLegend",
+    "legendDisplay",
+    "showPlotValuesInLegend",
+    "showXAxisLabels",
+    "showYAxisLabels",
+    "isSynced",
+    "xAxisVal",
+    "xAxisPath",
+    "followingViewWidth",
+    "sidebarDimension",
+];
+const PLOT_PATH_KEYS: &[&str] = &[
+    "value",
+    "enabled",
+    "color",
+    "label",
+    "timestampMethod",
+    "showLine",
+    "lineSize",
+];
+const X_AXIS_PATH_KEYS: &[&str] = &["value", "enabled"];
+const X_AXIS_VALUES: &[&str] = &["timestamp", "index", "custom", "currentCustom"];
+const TIMESTAMP_METHODS: &[&str] = &["receiveTime", "headerStamp"];
+const RAW_MESSAGES_KEYS: &[&str] = &[
+    "diffEnabled",
+    "diffMethod",
+    "diffTopicPath",
+    "expansion",
+    "showFullMessageForDiff",
+    "topicPath",
+    "fontSize",
+];
+const DIAGNOSTIC_SUMMARY_KEYS: &[&str] = &[
+    "minLevel",
+    "pinnedIds",
+    "topicToRender",
+    "hardwareIdFilter",
+    "sortByLevel",
+    "secondsUntilStale",
+];
+
+/// Every key of `obj` is in `known`.
+fn keys_known(what: &str, obj: &Value, known: &[&str]) {
+    for key in obj.as_object().unwrap().keys() {
+        assert!(
+            known.contains(&key.as_str()) || TITLE_KEYS.contains(&key.as_str()),
+            "{what}: `{key}` is not read by the panel"
+        );
+    }
+}
+
+fn check_panel_keys(v: &Value) {
+    for (id, cfg) in v["configById"].as_object().unwrap() {
+        let (kind, _) = id.split_once('!').expect("panel id Type!name");
+        match kind {
+            "Plot" => {
+                keys_known(id, cfg, PLOT_KEYS);
+                for p in cfg["paths"].as_array().unwrap() {
+                    keys_known(id, p, PLOT_PATH_KEYS);
+                    let method = p["timestampMethod"].as_str().unwrap();
+                    assert!(TIMESTAMP_METHODS.contains(&method), "{id}: {method}");
+                    assert_eq!(p["enabled"], true, "{id}");
+                }
+                if let Some(x) = cfg.get("xAxisPath") {
+                    keys_known(id, x, X_AXIS_PATH_KEYS);
+                }
+                let x = cfg["xAxisVal"].as_str().unwrap();
+                assert!(X_AXIS_VALUES.contains(&x), "{id}: xAxisVal {x}");
+                assert!(cfg["showLegend"].is_boolean(), "{id}");
+            }
+            "RawMessages" => {
+                keys_known(id, cfg, RAW_MESSAGES_KEYS);
+                assert!(["all", "none"].contains(&cfg["expansion"].as_str().unwrap_or("")));
+            }
+            "DiagnosticSummary" => {
+                keys_known(id, cfg, DIAGNOSTIC_SUMMARY_KEYS);
+                // diagnostic_msgs/DiagnosticStatus levels: 0 OK … 3 STALE
+                assert!((0..=3).contains(&cfg["minLevel"].as_u64().unwrap()), "{id}");
+                assert!(cfg["hardwareIdFilter"].is_string() && cfg["pinnedIds"].is_array());
+            }
+            other => panic!("{id}: panel type {other} not checked"),
+        }
+    }
+}
+
+#[test]
+fn every_panel_key_is_one_the_viewer_reads() {
+    check_panel_keys(&load("config/foxglove_layout.json"));
+    check_panel_keys(&load("config/foxglove_layout_replay.json"));
+    // the check itself: a key the viewer ignores is refused
+    let mut bad = load("config/foxglove_layout.json");
+    bad["configById"]["Plot!spectrum"]["title"] = "Spectrum".into();
+    assert!(std::panic::catch_unwind(|| check_panel_keys(&bad)).is_err());
+}
+
 /// Topic names are ROS 2 name tokens whatever the bearing is called.
 #[test]
 fn bearing_orbit_topics_are_ros_names() {

@@ -156,12 +156,58 @@ fn check_parameters(p: &Value) {
     );
     assert_eq!(p["atomic"][0], false, "{}", p["atomic"]);
     assert!(p["atomic"][1].as_str().unwrap().contains("min_speed_rpm"));
+    assert_eq!(p["set_one"], serde_json::json!([[true, ""]]));
+    assert_eq!(p["atomic_two"], serde_json::json!([true, ""]));
     let got = &p["get"];
     assert_eq!(
         got[0],
-        serde_json::json!([3, 50.0, ""]),
-        "25.0 of the refused atomic set not applied"
+        serde_json::json!([3, 40.0, ""]),
+        "40.0 of the accepted atomic set, 25.0 of the refused one not applied"
     );
     assert_eq!(got[1][1], 1000.0, "{got}");
     assert_eq!(got[2][2], "float64", "{got}");
+    check_parameter_events(&p["parameter_events"]);
+}
+
+/// /parameter_events as rclcpp publishes them (rclcpp node_parameters.cpp): a plain set of N
+/// values is N atomic sets of one, so one event per accepted value (the set of three had one
+/// accepted); `ros2 param set` of one value, one event; an atomic set of two, ONE event with both;
+/// a refused atomic set, none. Every stamp is the node's clock, i.e. the peer's /clock (1000 s +
+/// elapsed) within 0.3 s (clock period 10 ms + delivery); ros2-client's own events were one per
+/// value, stamped 0 under use_sim_time.
+fn check_parameter_events(e: &Value) {
+    let changed = |label: &str| -> Vec<Value> {
+        let events = e[label]
+            .as_array()
+            .unwrap_or_else(|| panic!("{label}: {e}"));
+        for ev in events {
+            let (stamp, at) = (
+                ev["stamp"].as_f64().unwrap(),
+                ev["sim_at"].as_f64().unwrap(),
+            );
+            assert!(
+                (at - stamp).abs() < 0.3,
+                "{label}: stamp {stamp} at {at}: {ev}"
+            );
+            assert_eq!(ev["new"], serde_json::json!([]), "{label}: {ev}");
+            assert_eq!(ev["deleted"], serde_json::json!([]), "{label}: {ev}");
+        }
+        events.iter().map(|ev| ev["changed"].clone()).collect()
+    };
+    assert_eq!(
+        changed("set_three"),
+        [serde_json::json!([["state_rate_hz", 50.0]])]
+    );
+    assert_eq!(
+        changed("set_one"),
+        [serde_json::json!([["input_timeout_s", 2.0]])]
+    );
+    assert_eq!(
+        changed("atomic_two"),
+        [serde_json::json!([
+            ["state_rate_hz", 40.0],
+            ["pressure_map_rate_hz", 5.0]
+        ])]
+    );
+    assert!(changed("atomic_refused").is_empty(), "{e}");
 }

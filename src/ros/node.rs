@@ -215,12 +215,11 @@ async fn run_async(
         Arc::new(Mutex::new(params.clone())),
         Arc::new(std::sync::atomic::AtomicU64::new(0)),
     );
-    let live_params = live.0.clone();
     let mut node = context
         .new_node(
             NodeName::new(&ros.namespace, &ros.node_name)
                 .map_err(|e| anyhow::anyhow!("node name {}: {e:?}", ros.fully_qualified_name()))?,
-            node_options(&params, &live),
+            node_options(),
         )
         .map_err(|e| anyhow::anyhow!("node: {e:?}"))?;
     let publishers = Publishers::create(&mut node, &ros, &rotor)?;
@@ -240,7 +239,7 @@ async fn run_async(
     let mut model = model::ModelLoop::new(
         rotor.clone(),
         params.clone(),
-        live,
+        live.clone(),
         inbox.clone(),
         clock.clone(),
     );
@@ -254,7 +253,7 @@ async fn run_async(
 
     let route = InputRoute {
         inbox,
-        clock,
+        clock: clock.clone(),
         rec,
         counters: counters.clone(),
         model: model_thread.thread().clone(),
@@ -262,14 +261,18 @@ async fn run_async(
     subscribe_inputs(&mut node, &ros, &params, &rotor, &route)?;
     drop(route);
     // no ros2-client Spinner: it would add a builtin_interfaces/Time reader on /clock
-    let services = param_services::ParameterServices::create(
+    let store = param_services::ParameterStore::declare(
         &mut node,
         &ros.fully_qualified_name(),
-        live_params,
+        declared_parameters(&params),
+        live,
+        clock,
     )?;
+    let services =
+        param_services::ParameterServices::create(&mut node, &ros.fully_qualified_name(), store)?;
     log::to_rosout(node.logging_handle(), &ros.fully_qualified_name());
     announce_up(&ros, domain, started);
-    until_stopped(&services, &node, &counters, &recorder_thread).await?;
+    until_stopped(&services, &counters, &recorder_thread).await?;
     log::info("shutting down");
     drop(services);
     stop.store(true, Ordering::Relaxed);
@@ -309,12 +312,11 @@ fn join_reporting_panic(thread: std::thread::JoinHandle<()>, name: &str) {
 /// is an ERROR, and the twin keeps running: the bus still gets its outputs.
 async fn until_stopped(
     services: &param_services::ParameterServices,
-    node: &ros2_client::Node,
     counters: &model::NodeCounters,
     recorder_thread: &Option<std::thread::JoinHandle<anyhow::Result<PathBuf>>>,
 ) -> anyhow::Result<()> {
     let watch = watch_recording(counters, recorder_thread);
-    let serve = services.serve(node);
+    let serve = services.serve();
     tokio::pin!(serve);
     let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?;
     tokio::select! {
@@ -422,33 +424,17 @@ pub(super) fn parameter_text(v: &ParameterValue) -> Option<String> {
     }
 }
 
-/// The node's options: every parameter declared with its value, changes at run time checked
-/// by [`NodeParams::set_at_runtime`] and handed to the model thread through `live`.
-fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
-    let validator_params = live.0.clone();
-    let (action_params, action_version) = (live.0.clone(), live.1.clone());
-    let mut options = NodeOptions::new()
+/// The node's options: /rosout on, no parameter services of ros2-client's and no parameters in
+/// its store (ours are in [`param_services::ParameterStore`], declared by
+/// [`declared_parameters`]).
+fn node_options() -> NodeOptions {
+    NodeOptions::new()
         .enable_rosout(true)
         .start_parameter_services(false)
-        .parameter_validator(Box::new(move |name, value| {
-            let text = parameter_text(value)
-                .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
-            let mut trial = validator_params
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .clone();
-            trial.set_at_runtime(name, &text)
-        }))
-        .parameter_set_action(Box::new(move |name, value| {
-            let text = parameter_text(value)
-                .ok_or_else(|| format!("parameter {name}: unsupported type"))?;
-            action_params
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .set_at_runtime(name, &text)?;
-            action_version.fetch_add(1, Ordering::SeqCst);
-            Ok(())
-        }));
+}
+
+/// Every parameter of the node with its start value, in declaration order.
+fn declared_parameters(params: &NodeParams) -> Vec<(&'static str, ParameterValue)> {
     let probe_points = params
         .probe_point_topics
         .iter()
@@ -456,7 +442,7 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
         .collect::<Vec<_>>()
         .join(",");
     let text = |s: String| ParameterValue::String(s);
-    for (name, value) in [
+    let mut declared = vec![
         ("model", text(params.model.to_string())),
         ("delta", ParameterValue::Double(params.delta)),
         ("film", text(params.film_text().into())),
@@ -490,16 +476,10 @@ fn node_options(params: &NodeParams, live: &model::LiveParams) -> NodeOptions {
             "warning_amplitude_ratio",
             ParameterValue::Double(params.warning_amplitude_ratio),
         ),
-    ] {
-        options = options.declare_parameter(name, value);
-    }
-    for (name, value) in forecast_parameters(params) {
-        options = options.declare_parameter(name, value);
-    }
-    for (name, value) in plant_signal_parameters(params) {
-        options = options.declare_parameter(name, value);
-    }
-    options
+    ];
+    declared.extend(forecast_parameters(params));
+    declared.extend(plant_signal_parameters(params));
+    declared
 }
 
 /// The plant-signal parameters (issue 12) as declared.

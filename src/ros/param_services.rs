@@ -1,17 +1,28 @@
-//! The node's six parameter services (rcl_interfaces: get, get types, set, set atomically, list,
-//! describe), served here instead of by ros2-client's `Spinner`. The spinner also creates a
-//! reader of `builtin_interfaces/msg/Time` on `/clock`, beside the node's own
-//! `rosgraph_msgs/msg/Clock` reader: /clock then has two types in the graph and `ros2 bag record`
-//! refuses it (issue 13). Serving the services ourselves removes that reader and lets
-//! `describe_parameters` answer with the descriptors of [`super::params::PARAMETER_DOCS`].
+//! The node's parameters as rclcpp's `NodeParameters` keeps them, and its six parameter services
+//! (rcl_interfaces: get, get types, set, set atomically, list, describe), served here instead of
+//! by ros2-client's `Spinner`. The spinner also creates a reader of `builtin_interfaces/msg/Time`
+//! on `/clock`, beside the node's own `rosgraph_msgs/msg/Clock` reader: /clock then has two types
+//! in the graph and `ros2 bag record` refuses it (issue 13). Serving the services ourselves removes
+//! that reader and lets `describe_parameters` answer with the descriptors of
+//! [`super::params::PARAMETER_DOCS`].
 //!
-//! Values live in ros2-client's parameter store (the node's validator and set action apply, and
-//! `/parameter_events` is published by it); only the answering is ours.
+//! Values live in [`ParameterStore`], not in ros2-client's store: that one publishes one
+//! `/parameter_events` message per value, stamped with a simulation time only its Spinner keeps
+//! (0 here under `use_sim_time`). Ours publishes as rclcpp does
+//! (rclcpp/src/rclcpp/node_interfaces/node_parameters.cpp): one event per declared parameter at
+//! start (`new_parameters`), one per atomic set with all its values (`changed_parameters`), a plain
+//! set of N values as N atomic sets of one; `node` = the fully qualified name, stamp = the node's
+//! clock (the /clock value under `use_sim_time`, like every other stamp of the node), QoS
+//! rmw_qos_profile_parameter_events (reliable, volatile, keep last 1000). ros2-client's own
+//! /parameter_events writer (made by its `Node::new`, no option omits it) stays in the graph but
+//! never writes: nothing is set in its store.
 
-use super::params::{parameter_doc, NodeParams, ParamDoc};
+use super::model::{LiveParams, NodeClock};
+use super::params::{parameter_doc, ParamDoc};
 use futures::StreamExt;
+use ros2_client::builtin_interfaces::Time;
 use ros2_client::parameters::raw;
-use ros2_client::qos::History;
+use ros2_client::qos::{Durability, History};
 use ros2_client::rcl_interfaces::{
     DescribeParametersRequest, DescribeParametersResponse, GetParameterTypesRequest,
     GetParameterTypesResponse, GetParametersRequest, GetParametersResponse, ListParametersRequest,
@@ -19,10 +30,155 @@ use ros2_client::rcl_interfaces::{
     SetParametersRequest, SetParametersResponse,
 };
 use ros2_client::{
-    Message, Name, Node, Parameter, ParameterValue, QosProfile, Server, ServiceMapping,
-    ServiceTypeName,
+    Message, MessageTypeName, Name, Node, Parameter, ParameterValue, Publisher, QosProfile, Server,
+    ServiceMapping, ServiceTypeName,
 };
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
+
+/// rmw_qos_profile_parameter_events (rmw/qos_profiles.h): reliable, volatile, keep last 1000.
+const EVENTS_DEPTH: usize = 1000;
+
+/// The node's parameter values in declaration order, the model thread's copy they are handed to,
+/// and the writer of `/parameter_events`.
+pub struct ParameterStore {
+    values: Mutex<Vec<(String, ParameterValue)>>,
+    live: LiveParams,
+    events: Publisher<raw::ParameterEvent>,
+    fqn: String,
+    clock: Arc<NodeClock>,
+}
+
+impl ParameterStore {
+    /// Declares `declared` (name, initial value) on node `fqn` and publishes one event per
+    /// parameter with it in `new_parameters`, as rclcpp's `declare_parameter` does.
+    pub fn declare(
+        node: &mut Node,
+        fqn: &str,
+        declared: Vec<(&str, ParameterValue)>,
+        live: LiveParams,
+        clock: Arc<NodeClock>,
+    ) -> anyhow::Result<Self> {
+        let qos = QosProfile::publisher_default()
+            .durability(Durability::Volatile)
+            .history(History::KeepLast {
+                depth: EVENTS_DEPTH,
+            });
+        let name = Name::new("/", "parameter_events").map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let topic = node
+            .create_topic(
+                &name,
+                MessageTypeName::new("rcl_interfaces", "ParameterEvent"),
+                &qos,
+            )
+            .map_err(|e| anyhow::anyhow!("topic /parameter_events: {e:?}"))?;
+        let events = node
+            .create_publisher(&topic, Some(qos))
+            .map_err(|e| anyhow::anyhow!("publisher /parameter_events: {e:?}"))?;
+        let store = Self {
+            values: Mutex::new(vec![]),
+            live,
+            events,
+            fqn: fqn.to_string(),
+            clock,
+        };
+        for (name, value) in declared {
+            let p = Parameter {
+                name: name.to_string(),
+                value,
+            };
+            store.lock().push((p.name.clone(), p.value.clone()));
+            store.publish(store.event(vec![p], vec![]));
+        }
+        Ok(store)
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<(String, ParameterValue)>> {
+        self.values.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The value of `name`, if declared.
+    pub fn get(&self, name: &str) -> Option<ParameterValue> {
+        self.lock()
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+    }
+
+    /// The declared names in declaration order.
+    pub fn names(&self) -> Vec<String> {
+        self.lock().iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// SetParametersAtomically: every value tried on a copy of the parameters first; all are set
+    /// (and published as ONE event) only if all pass, else none.
+    pub fn set_atomically(&self, params: Vec<Parameter>) -> raw::SetParametersResult {
+        let mut values = self.lock();
+        let mut live = self.live.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut trial = live.clone();
+        for p in &params {
+            if let Err(reason) = check_type(current(&values, &p.name), p)
+                .and_then(|text| trial.set_at_runtime(&p.name, &text))
+            {
+                return refused(reason);
+            }
+        }
+        *live = trial;
+        self.live.1.fetch_add(1, Ordering::SeqCst);
+        drop(live);
+        for p in &params {
+            if let Some(slot) = values.iter_mut().find(|(n, _)| *n == p.name) {
+                slot.1 = p.value.clone();
+            }
+        }
+        drop(values);
+        self.publish(self.event(vec![], params));
+        raw::SetParametersResult {
+            successful: true,
+            reason: String::new(),
+        }
+    }
+
+    /// SetParameters as rclcpp answers it: each value an atomic set of its own (one event each).
+    pub fn set_each(&self, params: Vec<Parameter>) -> Vec<raw::SetParametersResult> {
+        params
+            .into_iter()
+            .map(|p| self.set_atomically(vec![p]))
+            .collect()
+    }
+
+    /// An event of this node stamped with the node's clock now (0 before the first /clock under
+    /// `use_sim_time`, as rclcpp's ROS time reads before any /clock).
+    pub fn event(&self, new: Vec<Parameter>, changed: Vec<Parameter>) -> raw::ParameterEvent {
+        parameter_event(&self.fqn, self.clock.now_ns().unwrap_or(0), new, changed)
+    }
+
+    fn publish(&self, event: raw::ParameterEvent) {
+        if let Err(e) = self.events.publish(event) {
+            super::log::warn(&format!("/parameter_events not published: {e:?}"));
+        }
+    }
+}
+
+/// A ParameterEvent of node `fqn` at `stamp_ns` (ns since the epoch).
+pub fn parameter_event(
+    fqn: &str,
+    stamp_ns: i64,
+    new: Vec<Parameter>,
+    changed: Vec<Parameter>,
+) -> raw::ParameterEvent {
+    raw::ParameterEvent {
+        stamp: Time::from_nanos(stamp_ns),
+        node: fqn.to_string(),
+        new_parameters: new.into_iter().map(raw::Parameter::from).collect(),
+        changed_parameters: changed.into_iter().map(raw::Parameter::from).collect(),
+        deleted_parameters: vec![],
+    }
+}
+
+fn current<'a>(values: &'a [(String, ParameterValue)], name: &str) -> Option<&'a ParameterValue> {
+    values.iter().find(|(n, _)| n == name).map(|(_, v)| v)
+}
 
 /// The six servers, named `<node>/get_parameters` etc. as rclcpp names them.
 pub struct ParameterServices {
@@ -33,8 +189,8 @@ pub struct ParameterServices {
     set_atomically: Server<SetParametersRequest, SetParametersAtomicallyResponse>,
     list: Server<ListParametersRequest, ListParametersResponse>,
     describe: Server<DescribeParametersRequest, DescribeParametersResponse>,
-    /// The node's parameters as the model thread has them (for the atomic set's trial).
-    live: Arc<Mutex<NodeParams>>,
+    /// The values the services read and set.
+    store: ParameterStore,
 }
 
 fn server<Req, Resp>(
@@ -62,11 +218,7 @@ where
 
 impl ParameterServices {
     /// Creates the servers of node `fqn` (its fully qualified name).
-    pub fn create(
-        node: &mut Node,
-        fqn: &str,
-        live: Arc<Mutex<NodeParams>>,
-    ) -> anyhow::Result<Self> {
+    pub fn create(node: &mut Node, fqn: &str, store: ParameterStore) -> anyhow::Result<Self> {
         Ok(Self {
             get: server(node, fqn, "get_parameters", "GetParameters")?,
             get_types: server(node, fqn, "get_parameter_types", "GetParameterTypes")?,
@@ -79,13 +231,13 @@ impl ParameterServices {
             )?,
             list: server(node, fqn, "list_parameters", "ListParameters")?,
             describe: server(node, fqn, "describe_parameters", "DescribeParameters")?,
-            live,
+            store,
         })
     }
 
     /// Answers requests until the future is dropped. A request that cannot be read or answered
     /// is counted out with a log line; the services carry on.
-    pub async fn serve(&self, node: &Node) {
+    pub async fn serve(&self) {
         let mut get = self.get.receive_request_stream();
         let mut get_types = self.get_types.receive_request_stream();
         let mut set = self.set.receive_request_stream();
@@ -96,37 +248,37 @@ impl ParameterServices {
             let sent = futures::select! {
                 r = get.select_next_some() => match r {
                     Ok((id, req)) => self.get.async_send_response(id, GetParametersResponse {
-                        values: req.names.iter().map(|n| value_of(node, n)).collect(),
+                        values: req.names.iter().map(|n| self.value_of(n)).collect(),
                     }).await,
                     Err(e) => { bad_request("get_parameters", &e); continue }
                 },
                 r = get_types.select_next_some() => match r {
                     Ok((id, req)) => self.get_types.async_send_response(id, GetParameterTypesResponse {
-                        values: req.names.iter().map(|n| value_of(node, n).ptype).collect(),
+                        values: req.names.iter().map(|n| self.value_of(n).ptype).collect(),
                     }).await,
                     Err(e) => { bad_request("get_parameter_types", &e); continue }
                 },
                 r = set.select_next_some() => match r {
                     Ok((id, req)) => self.set.async_send_response(id, SetParametersResponse {
-                        results: req.parameter.into_iter().map(|p| set_one(node, p)).collect(),
+                        results: self.store.set_each(req.parameter.into_iter().map(Parameter::from).collect()),
                     }).await,
                     Err(e) => { bad_request("set_parameters", &e); continue }
                 },
                 r = set_atomically.select_next_some() => match r {
                     Ok((id, req)) => self.set_atomically.async_send_response(id, SetParametersAtomicallyResponse {
-                        result: self.set_all(node, req.parameter),
+                        result: self.store.set_atomically(req.parameter.into_iter().map(Parameter::from).collect()),
                     }).await,
                     Err(e) => { bad_request("set_parameters_atomically", &e); continue }
                 },
                 r = list.select_next_some() => match r {
                     Ok((id, req)) => self.list.async_send_response(id, ListParametersResponse {
-                        result: list_names(&node.list_parameters(), &req.prefixes, req.depth),
+                        result: list_names(&self.store.names(), &req.prefixes, req.depth),
                     }).await,
                     Err(e) => { bad_request("list_parameters", &e); continue }
                 },
                 r = describe.select_next_some() => match r {
                     Ok((id, req)) => self.describe.async_send_response(id, DescribeParametersResponse {
-                        values: req.names.iter().map(|n| descriptor(n, &value_of(node, n))).collect(),
+                        values: req.names.iter().map(|n| descriptor(n, &self.value_of(n))).collect(),
                     }).await,
                     Err(e) => { bad_request("describe_parameters", &e); continue }
                 },
@@ -137,27 +289,12 @@ impl ParameterServices {
         }
     }
 
-    /// SetParametersAtomically: every value tried on a copy of the parameters first; all are set
-    /// only if all pass, else none.
-    fn set_all(&self, node: &Node, params: Vec<raw::Parameter>) -> raw::SetParametersResult {
-        let params: Vec<Parameter> = params.into_iter().map(Parameter::from).collect();
-        let mut trial = self.live.lock().unwrap_or_else(|e| e.into_inner()).clone();
-        for p in &params {
-            if let Err(reason) =
-                check_type(node, p).and_then(|text| trial.set_at_runtime(&p.name, &text))
-            {
-                return refused(reason);
-            }
-        }
-        for p in params {
-            if let Err(reason) = node.set_parameter(&p.name, p.value) {
-                return refused(reason);
-            }
-        }
-        raw::SetParametersResult {
-            successful: true,
-            reason: String::new(),
-        }
+    /// The value of `name` on the wire; NOT_SET for an unknown name (as rclcpp answers).
+    fn value_of(&self, name: &str) -> raw::ParameterValue {
+        self.store
+            .get(name)
+            .unwrap_or(ParameterValue::NotSet)
+            .into()
     }
 }
 
@@ -174,32 +311,11 @@ fn refused(reason: String) -> raw::SetParametersResult {
     }
 }
 
-/// The value of `name` on the wire; NOT_SET for an unknown name (as rclcpp answers).
-fn value_of(node: &Node, name: &str) -> raw::ParameterValue {
-    node.get_parameter(name)
-        .unwrap_or(ParameterValue::NotSet)
-        .into()
-}
-
-/// One SetParameters item: the node's store checks the type and runs the node's rules.
-fn set_one(node: &Node, p: raw::Parameter) -> raw::SetParametersResult {
-    let p = Parameter::from(p);
-    match check_type(node, &p).and_then(|_| node.set_parameter(&p.name, p.value)) {
-        Ok(()) => raw::SetParametersResult {
-            successful: true,
-            reason: String::new(),
-        },
-        Err(reason) => refused(reason),
-    }
-}
-
-/// The value as the text [`NodeParams::set`] reads, if `p` is declared with the same type
+/// The value as the text [`super::params::NodeParams::set`] reads, if `p` is declared with the same type
 /// (rclcpp refuses a change of type unless the descriptor allows dynamic typing, which none of
 /// ours does).
-fn check_type(node: &Node, p: &Parameter) -> Result<String, String> {
-    let current = node
-        .get_parameter(&p.name)
-        .ok_or_else(|| format!("parameter '{}' is not declared", p.name))?;
+fn check_type(current: Option<&ParameterValue>, p: &Parameter) -> Result<String, String> {
+    let current = current.ok_or_else(|| format!("parameter '{}' is not declared", p.name))?;
     if current.to_parameter_type() as u8 != p.value.to_parameter_type() as u8 {
         return Err(format!(
             "parameter {} is of type {:?}, not {:?} (write 50.0, not 50, for a double)",
