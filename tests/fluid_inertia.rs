@@ -120,7 +120,17 @@ fn orc(inertia: FluidInertia) -> Rotor {
 fn eigen_growth(rotor: &Rotor, rpm: f64) -> f64 {
     let statics = static_solution(rotor).unwrap();
     let points = campbell(rotor, &statics, &[rpm], 12).unwrap();
-    let modes = damped_modes(rotor, rpm * PI / 30.0, &points[0].coefficients).unwrap();
+    least_damped_growth(rotor, rpm, &points[0].coefficients)
+}
+
+/// The least-damped sub-synchronous mode's growth per revolution at `rpm` with the bearing
+/// coefficients `coefficients`.
+fn least_damped_growth(
+    rotor: &Rotor,
+    rpm: f64,
+    coefficients: &[rotor_twin::film::FilmCoefficients],
+) -> f64 {
+    let modes = damped_modes(rotor, rpm * PI / 30.0, coefficients).unwrap();
     let least = modes
         .iter()
         .filter(|m| m.frequency_hz < rpm / 60.0)
@@ -420,14 +430,7 @@ fn eigen_growth_following(rotor: &Rotor, rpm: f64) -> f64 {
         coefficients[i].stiffness_n_per_m += dk;
         coefficients[i].damping_n_s_per_m += dc;
     }
-    let modes = damped_modes(rotor, w, &coefficients).unwrap();
-    let least = modes
-        .iter()
-        .filter(|m| m.frequency_hz < rpm / 60.0)
-        .min_by(|a, b| a.log_dec.total_cmp(&b.log_dec))
-        .copied()
-        .unwrap();
-    -least.log_dec * least.frequency_hz / (rpm / 60.0)
+    least_damped_growth(rotor, rpm, &coefficients)
 }
 
 /// Check (d): the time integration with `full` (eq. I1's force and Jacobian at every Newton
@@ -445,13 +448,11 @@ fn eigen_growth_following(rotor: &Rotor, rpm: f64) -> f64 {
 #[test]
 fn the_time_step_and_the_eigenvalues_agree_on_the_convective_inertia() {
     let (bare, full) = (orc(FluidInertia::None), orc(FluidInertia::Full));
-    let e0 = eigen_growth(&bare, 9000.0);
-    let e2 = eigen_growth(&full, 9000.0);
+    let [e0, e2] = [&bare, &full].map(|r| eigen_growth(r, 9000.0));
     let e3 = eigen_growth_following(&full, 9000.0);
-    let direct = FilmEvaluation::Direct;
-    let t2 = transient_growth(&full, 9000.0, Coupling::Linear, direct);
-    let n0 = transient_growth(&bare, 9000.0, Coupling::Nonlinear, direct);
-    let n2 = transient_growth(&full, 9000.0, Coupling::Nonlinear, direct);
+    let run = |r: &Rotor, coupling| transient_growth(r, 9000.0, coupling, FilmEvaluation::Direct);
+    let t2 = run(&full, Coupling::Linear);
+    let [n0, n2] = [&bare, &full].map(|r| run(r, Coupling::Nonlinear));
     println!(
         "9000 rpm growth/rev with full: eigen {e0:.5} → {e2:.5} (zone and κ following: {e3:.5}), \
          linear {t2:.5}, nonlinear {n0:.5} → {n2:.5}"

@@ -17,11 +17,11 @@
 //! pressures alike (for a uniform h the inertia pressure is ρh²/(12µ) times the squeeze pressure,
 //! at any length), so the short form's added mass is scaled by the ratio of the finite film's own
 //! squeeze damping to the short form's at the same state, κ = tr c_film / tr c_short ≤ 1.
-//! What this leaves out, stated: the convective inertia (of the same order as the temporal at
-//! Re* ≈ 1 but smaller in the added mass of a whirling journal, San Andrés & Vance), the
-//! h-weighting of the finite film's circumferential flow beyond κ, and the inertia's dependence
-//! on velocity (only the acceleration term is kept). An option for studies (machine file
-//! `fluid_inertia: temporal`), not the default: the seed's model has no film inertia.
+//! `temporal` leaves out the convective inertia and the inertia's dependence on velocity (only
+//! the acceleration term is kept); `full` adds them (eq. I1: the linear analyses' coefficients,
+//! the transient's force). Both leave out the h-weighting of the finite film's circumferential
+//! flow beyond κ. Options for studies (machine file `fluid_inertia`), not the default: the
+//! seed's model has no film inertia.
 
 use super::BearingGeometry;
 use super::{FilmCoefficients, FilmResult};
@@ -263,13 +263,12 @@ impl FilmInertia {
         speed_rad_s: f64,
         kappa: f64,
     ) -> InertiaForce {
-        let Some((start, span)) = active_zone(film) else {
-            return InertiaForce::default();
-        };
         let c = self.clearance_m;
-        let pos = [position_m[0] / c, position_m[1] / c];
-        let vel = [velocity_m_s[0] / c, velocity_m_s[1] / c];
-        let z = transient_integrals(pos, vel, speed_rad_s, start, span);
+        let (pos, vel) = (position_m.map(|x| x / c), velocity_m_s.map(|x| x / c));
+        let z = match active_zone(film) {
+            Some((start, span)) => transient_integrals(pos, vel, speed_rad_s, start, span),
+            None => return InertiaForce::default(),
+        };
         // ρ R L³ / 12 = mass_scale · c; the derivatives in X = d / c carry 1 / c
         let s = kappa * self.mass_scale() * c;
         InertiaForce {
@@ -302,13 +301,8 @@ fn transient_integrals(
     start: f64,
     span: f64,
 ) -> InertiaForce {
-    let d = span / ZONE_PANELS as f64;
-    let (sd, cd) = d.sin_cos();
-    let (mut s, mut co) = start.sin_cos();
     let mut out = InertiaForce::default();
-    for k in 0..=ZONE_PANELS {
-        let wt = simpson_weight(k) * d / 3.0;
-        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+    simpson_nodes(pos, start, span, |wt, co, s, h| {
         let h_t = pos[0] * s - pos[1] * co; // ∂h̄/∂θ
         let h_tt = pos[0] * co + pos[1] * s; // ∂²h̄/∂θ²
         let hd = -(vel[0] * co + vel[1] * s); // ∂h̄/∂t
@@ -328,8 +322,7 @@ fn transient_integrals(
                 out.damping_n_s_per_m[(i, j)] += wt * n[i] * df_dv;
             }
         }
-        (s, co) = (s * cd + co * sd, co * cd - s * sd);
-    }
+    });
     out
 }
 
@@ -375,13 +368,8 @@ struct ConvectiveIntegrals {
 
 /// Simpson's rule over `ZONE_PANELS` panels, as [`zone_integrals`].
 fn convective_integrals(pos: [f64; 2], start: f64, span: f64) -> ConvectiveIntegrals {
-    let d = span / ZONE_PANELS as f64;
-    let (sd, cd) = d.sin_cos();
-    let (mut s, mut co) = start.sin_cos();
     let mut out = ConvectiveIntegrals::default();
-    for k in 0..=ZONE_PANELS {
-        let w = simpson_weight(k) * d / 3.0;
-        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+    simpson_nodes(pos, start, span, |w, co, s, h| {
         let h_t = pos[0] * s - pos[1] * co; // ∂h̄/∂θ
         let h_tt = 1.0 - h; // ∂²h̄/∂θ²
         let g = h_tt - 2.4 * h_t * h_t / h;
@@ -402,8 +390,7 @@ fn convective_integrals(pos: [f64; 2], start: f64, span: f64) -> ConvectiveInteg
                 out.damping[(i, j)] += w * n[i] * db[j] / h;
             }
         }
-        (s, co) = (s * cd + co * sd, co * cd - s * sd);
-    }
+    });
     out
 }
 
@@ -428,32 +415,32 @@ fn active_zone(film: &FilmResult) -> Option<(f64, f64)> {
     Some((film.film_start_rad, span))
 }
 
-/// Simpson's rule over `ZONE_PANELS` panels of [start, start + span], the nodes' cos and sin
-/// advanced by one rotation each (no trigonometric call inside the loop).
+/// Simpson's rule over `ZONE_PANELS` panels of [start, start + span] ([`simpson_nodes`]).
 fn zone_integrals(pos: [f64; 2], start: f64, span: f64) -> ZoneIntegrals {
-    let d = span / ZONE_PANELS as f64;
-    let (sd, cd) = d.sin_cos();
-    let (mut s, mut co) = start.sin_cos();
     let mut out = ZoneIntegrals::default();
-    for k in 0..=ZONE_PANELS {
-        let w = if k == 0 || k == ZONE_PANELS {
-            1.0
-        } else if k % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        } * d
-            / 3.0;
-        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+    simpson_nodes(pos, start, span, |w, co, s, h| {
         let (wi, ws) = (w / h, w / (h * h * h));
         let nn = [co * co, co * s, s * s];
         for m in 0..3 {
             out.inertia[m] += wi * nn[m];
             out.squeeze[m] += ws * nn[m];
         }
+    });
+    out
+}
+
+/// Simpson's rule's nodes over `ZONE_PANELS` panels of [start, start + span]: `f(weight, cos θ,
+/// sin θ, h̄)` at each, h̄ = 1 − X cos θ − Y sin θ at `pos` (floored at 1e-6), the nodes' cos and
+/// sin advanced by one rotation each (no trigonometric call inside the loop).
+fn simpson_nodes(pos: [f64; 2], start: f64, span: f64, mut f: impl FnMut(f64, f64, f64, f64)) {
+    let d = span / ZONE_PANELS as f64;
+    let (sd, cd) = d.sin_cos();
+    let (mut s, mut co) = start.sin_cos();
+    for k in 0..=ZONE_PANELS {
+        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+        f(simpson_weight(k) * d / 3.0, co, s, h);
         (s, co) = (s * cd + co * sd, co * cd - s * sd);
     }
-    out
 }
 
 #[cfg(test)]
