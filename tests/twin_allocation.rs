@@ -4,6 +4,7 @@
 //! viscosity (a live oil temperature) among them.
 
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
+use rotor_twin::film::FluidInertia;
 use rotor_twin::rotor::{MachineDescription, Rotor};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -28,11 +29,14 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-fn allocations_in_steps(film: FilmEvaluation, inertia: bool, warmup: usize, steps: usize) -> usize {
+fn allocations_in_steps(
+    film: FilmEvaluation,
+    inertia: FluidInertia,
+    warmup: usize,
+    steps: usize,
+) -> usize {
     let mut rotor = Rotor::from_description(&MachineDescription::builtin_default());
-    if inertia {
-        rotor.set_fluid_inertia(rotor_twin::film::FluidInertia::Temporal);
-    }
+    rotor.set_fluid_inertia(inertia);
     let omega = 9000.0 * std::f64::consts::PI / 30.0;
     let config = TwinConfig {
         film,
@@ -62,17 +66,27 @@ fn allocations_in_steps(film: FilmEvaluation, inertia: bool, warmup: usize, step
 #[test]
 fn the_time_step_allocates_nothing() {
     assert_eq!(
-        allocations_in_steps(FilmEvaluation::Direct, false, 10, 1000),
+        allocations_in_steps(FilmEvaluation::Direct, FluidInertia::None, 10, 1000),
         0
     );
     // 500 revolutions into the whip (the journal touches the wall), then a thousand steps
     assert_eq!(
-        allocations_in_steps(FilmEvaluation::Table, false, 500 * 128, 1000),
+        allocations_in_steps(FilmEvaluation::Table, FluidInertia::None, 500 * 128, 1000),
         0
     );
     // with the film's fluid inertia (added mass at every iteration)
     assert_eq!(
-        allocations_in_steps(FilmEvaluation::Table, true, 300 * 128, 1000),
+        allocations_in_steps(
+            FilmEvaluation::Table,
+            FluidInertia::Temporal,
+            300 * 128,
+            1000
+        ),
+        0
+    );
+    // with its convective inertia too (eq. I1's force and Jacobian at every iteration)
+    assert_eq!(
+        allocations_in_steps(FilmEvaluation::Table, FluidInertia::Full, 300 * 128, 1000),
         0
     );
 }

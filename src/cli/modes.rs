@@ -30,7 +30,7 @@ pub struct ModesArgs {
     #[arg(long)]
     fluid_inertia: bool,
     /// As --fluid-inertia, plus the convective inertia of the rotating film as stiffness and
-    /// damping (`fluid_inertia: full`; linear analyses only).
+    /// damping (`fluid_inertia: full`).
     #[arg(long, conflicts_with = "fluid_inertia")]
     fluid_inertia_full: bool,
     /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the

@@ -33,6 +33,10 @@ pub(crate) struct RunOptions {
     /// whatever the machine file's `fluid_inertia` says.
     #[arg(long)]
     fluid_inertia: bool,
+    /// As --fluid-inertia, plus the convective and velocity-dependent inertia of the rotating
+    /// film (eq. I1 of `src/film/inertia.rs`, `fluid_inertia: full`) as a force at every step.
+    #[arg(long, conflicts_with = "fluid_inertia")]
+    fluid_inertia_full: bool,
     /// Revolutions to simulate.
     #[arg(long, default_value_t = 200)]
     revs: usize,
@@ -93,6 +97,9 @@ impl RunOptions {
         let mut rotor = Rotor::from_description(&desc);
         if self.fluid_inertia {
             rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
+        }
+        if self.fluid_inertia_full {
+            rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
         }
         Ok((desc, rotor))
     }

@@ -2,8 +2,8 @@
 //! and the contact with the bearing wall when the film can no longer hold the journal.
 
 use crate::film::{
-    FilmCoefficients, FilmError, FilmInertia, FilmModel, FilmResult, JournalKinematics,
-    ViscosityScaledFilm,
+    equilibrium_with_inertia, Equilibrium, FilmCoefficients, FilmError, FilmInertia, FilmModel,
+    FilmResult, JournalKinematics, ViscosityScaledFilm,
 };
 use nalgebra::{Matrix2, Vector2};
 
@@ -92,6 +92,9 @@ pub(crate) struct BearingLink {
     pub previous_raw: Option<FilmCoefficients>,
     /// The film's fluid inertia, if the bearing carries it.
     pub inertia: Option<FilmInertia>,
+    /// The inertia's length factor κ of the last evaluation with coefficients (the iterations
+    /// without coefficients keep it).
+    pub kappa: f64,
     /// The last evaluation.
     pub last: LinkEvaluation,
 }
@@ -115,6 +118,74 @@ impl BearingLink {
             Some(inertia) => inertia.add_to(coef, d, film, self.viscosity(), speed_rad_s),
             None => coef,
         }
+    }
+
+    /// Puts the linear reference at the film's equilibrium under `load` (N) at `speed_rad_s`
+    /// (with `fluid_inertia: full` the film carries the steady convective force too: the
+    /// reference force is the total, −load) and returns it with that total force (N).
+    pub fn linearise(
+        &mut self,
+        load: [f64; 2],
+        speed_rad_s: f64,
+    ) -> Result<(Equilibrium, [f64; 2]), FilmError> {
+        let mu = self.viscosity();
+        let eq = equilibrium_with_inertia(&mut self.film, self.inertia, mu, load, speed_rad_s)?;
+        let coefficients =
+            self.with_added_mass(eq.coefficients, eq.position_m, &eq.film, speed_rad_s);
+        let mut force_n = eq.film.force_n;
+        if let Some(inertia) = self.inertia {
+            let f = inertia.convective_force_at(&eq, mu, speed_rad_s);
+            force_n = [force_n[0] + f[0], force_n[1] + f[1]];
+            let damping = &eq.coefficients.damping_n_s_per_m;
+            self.kappa = inertia.length_factor(eq.position_m, &eq.film, damping, mu);
+        }
+        self.linear_reference = Some(LinearReference {
+            position_m: eq.position_m,
+            force_n,
+            coefficients,
+        });
+        Ok((eq, force_n))
+    }
+
+    /// `coef` with the temporal added mass of the film `film` at relative position `d` (m), if
+    /// the bearing carries its fluid inertia; keeps the length factor κ.
+    fn with_temporal_mass(
+        &mut self,
+        coef: FilmCoefficients,
+        d: [f64; 2],
+        film: &FilmResult,
+    ) -> FilmCoefficients {
+        let Some(inertia) = self.inertia else {
+            return coef;
+        };
+        let (mu, damping) = (self.viscosity(), &coef.damping_n_s_per_m);
+        self.kappa = inertia.length_factor(d, film, damping, mu);
+        FilmCoefficients {
+            added_mass_kg: inertia.added_mass(d, film, damping, mu),
+            ..coef
+        }
+    }
+
+    /// With `fluid_inertia: full`, eq. I1's force beyond the added mass (N) at the journal's
+    /// state (relative position `d`, velocity `v`, speed `speed`) on the zone of `film`; its
+    /// derivatives join `coef` (the Newton iteration's Jacobian: the force is ≈ 4 % of the load
+    /// and its slopes 3–9 % of the film's, too much to leave explicit without slowing Newton's
+    /// quadratic convergence, which the step's acceptance test relies on).
+    fn convective_inertia(
+        &self,
+        coef: &mut FilmCoefficients,
+        d: [f64; 2],
+        v: [f64; 2],
+        film: &FilmResult,
+        speed: f64,
+    ) -> [f64; 2] {
+        let Some(inertia) = self.inertia.filter(|i| i.convective) else {
+            return [0.0; 2];
+        };
+        let f = inertia.transient_force(d, v, film, speed, self.kappa);
+        coef.stiffness_n_per_m += f.stiffness_n_per_m;
+        coef.damping_n_s_per_m += f.damping_n_s_per_m;
+        f.force_n
     }
 
     /// Number of condensed DOFs of this bearing (journal, and pedestal if any).
@@ -151,9 +222,9 @@ impl BearingLink {
             velocity_m_s: v,
             speed_rad_s: speed,
         };
-        let (film, coef) = if with_coefficients {
+        let (film, mut coef) = if with_coefficients {
             let (film, coef) = self.film.solve_with_coefficients(&kin)?;
-            (film, self.with_added_mass(coef, d_film, &film, speed))
+            (film, self.with_temporal_mass(coef, d_film, &film))
         } else {
             // the added mass of the iteration before (prehistory keeps its matrix for the step)
             let mass = self.last.added_mass_kg;
@@ -163,8 +234,12 @@ impl BearingLink {
             };
             (self.film.solve(&kin)?, coef)
         };
+        let inertia_force = self.convective_inertia(&mut coef, d_film, v, &film, speed);
         let mut out = LinkEvaluation {
-            force_n: film.force_n,
+            force_n: [
+                film.force_n[0] + inertia_force[0],
+                film.force_n[1] + inertia_force[1],
+            ],
             stiffness: coef.stiffness_n_per_m,
             damping: coef.damping_n_s_per_m,
             film_stiffness: coef.stiffness_n_per_m,

@@ -17,11 +17,11 @@
 //! pressures alike (for a uniform h the inertia pressure is ρh²/(12µ) times the squeeze pressure,
 //! at any length), so the short form's added mass is scaled by the ratio of the finite film's own
 //! squeeze damping to the short form's at the same state, κ = tr c_film / tr c_short ≤ 1.
-//! What this leaves out, stated: the convective inertia (of the same order as the temporal at
-//! Re* ≈ 1 but smaller in the added mass of a whirling journal, San Andrés & Vance), the
-//! h-weighting of the finite film's circumferential flow beyond κ, and the inertia's dependence
-//! on velocity (only the acceleration term is kept). An option for studies (machine file
-//! `fluid_inertia: temporal`), not the default: the seed's model has no film inertia.
+//! `temporal` leaves out the convective inertia and the inertia's dependence on velocity (only
+//! the acceleration term is kept); `full` adds them (eq. I1: the linear analyses' coefficients,
+//! the transient's force). Both leave out the h-weighting of the finite film's circumferential
+//! flow beyond κ. Options for studies (machine file `fluid_inertia`), not the default: the
+//! seed's model has no film inertia.
 
 use super::BearingGeometry;
 use super::{FilmCoefficients, FilmResult};
@@ -43,10 +43,11 @@ pub enum FluidInertia {
     None,
     /// The temporal inertia of the squeeze flow as added-mass coefficients (this module).
     Temporal,
-    /// The temporal added mass plus, for linear analyses (`modes`, `response`, the linear
-    /// coupling), the first-order convective and velocity-dependent inertia of the rotating film
-    /// as stiffness and damping corrections ([`FilmInertia::convective_coefficients`]). The
-    /// nonlinear transient refuses it (its force is not built).
+    /// The temporal added mass plus the first-order convective and velocity-dependent inertia
+    /// of the rotating film (eq. I1): for linear analyses (`modes`, `response`, the linear
+    /// coupling) as stiffness and damping corrections ([`FilmInertia::convective_coefficients`]),
+    /// in the nonlinear transient and the twin as a force at the journal's state
+    /// ([`FilmInertia::transient_force`]).
     Full,
 }
 
@@ -137,7 +138,7 @@ impl FilmInertia {
 
     /// κ = tr c_film / tr c_short (≤ 1): the finite length's correction of the short form, the
     /// finite film's own squeeze damping `damping` over the short form's at the same state.
-    fn length_factor(
+    pub fn length_factor(
         &self,
         position_m: [f64; 2],
         film: &FilmResult,
@@ -241,6 +242,120 @@ impl FilmInertia {
     }
 }
 
+impl FilmInertia {
+    /// The whole of eq. I1 but its ∂²h/∂t² term (the added mass, [`Self::added_mass`]) as a force
+    /// (N) on the journal at `position_m` (m) moving at `velocity_m_s` (m/s) at shaft speed
+    /// `speed_rad_s`, on the pressure zone of `film` (held), length factor `kappa`, with its
+    /// exact derivatives −∂F/∂d and −∂F/∂ḋ at that state (the Newton iteration's Jacobian):
+    ///
+    ///   F = ρ R L³ / 12 ∫ n B / h dθ,  B = ω ∂ḣ/∂θ + (ω²/4) ∂²h/∂θ² − (12/5) G² / h,
+    ///   G = (ω/2) ∂h/∂θ + ḣ.
+    ///
+    /// At rest it is [`Self::convective_static_force`], its slopes there are
+    /// [`Self::convective_coefficients`]; with ω = 0 only the −(12/5) ḣ²/h term is left, quadratic
+    /// in the velocity. The ω̇ ∂h/∂θ / 2 term of ∂G/∂t (speed changes) is left out: ω̇ ≪ ω² here.
+    /// Allocates nothing.
+    pub fn transient_force(
+        &self,
+        position_m: [f64; 2],
+        velocity_m_s: [f64; 2],
+        film: &FilmResult,
+        speed_rad_s: f64,
+        kappa: f64,
+    ) -> InertiaForce {
+        let c = self.clearance_m;
+        let (pos, vel) = (position_m.map(|x| x / c), velocity_m_s.map(|x| x / c));
+        let z = match active_zone(film) {
+            Some((start, span)) => transient_integrals(pos, vel, speed_rad_s, start, span),
+            None => return InertiaForce::default(),
+        };
+        // ρ R L³ / 12 = mass_scale · c; the derivatives in X = d / c carry 1 / c
+        let s = kappa * self.mass_scale() * c;
+        InertiaForce {
+            force_n: z.force_n.map(|v| s * v),
+            stiffness_n_per_m: z.stiffness_n_per_m * (-s / c),
+            damping_n_s_per_m: z.damping_n_s_per_m * (-s / c),
+        }
+    }
+}
+
+/// The force of the film's inertia beyond the added mass on a moving journal (eq. I1), and its
+/// derivatives.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InertiaForce {
+    /// Force on the journal (N).
+    pub force_n: [f64; 2],
+    /// −∂F/∂d (N/m).
+    pub stiffness_n_per_m: Matrix2<f64>,
+    /// −∂F/∂ḋ (N·s/m).
+    pub damping_n_s_per_m: Matrix2<f64>,
+}
+
+/// Simpson's rule over `ZONE_PANELS` panels of eq. I1's integrand B̄/h̄ (h̄ = h/c, B̄ = B/c in
+/// 1/s²) at dimensionless position `pos` and velocity `vel` (1/s), speed `w`: ∫ n B̄/h̄ and its
+/// derivatives ∫ n ∂(B̄/h̄)/∂X_j, ∫ n ∂(B̄/h̄)/∂V_j (unscaled, no sign change).
+fn transient_integrals(
+    pos: [f64; 2],
+    vel: [f64; 2],
+    w: f64,
+    start: f64,
+    span: f64,
+) -> InertiaForce {
+    let mut out = InertiaForce::default();
+    simpson_nodes(pos, start, span, |wt, co, s, h| {
+        let h_t = pos[0] * s - pos[1] * co; // ∂h̄/∂θ
+        let h_tt = pos[0] * co + pos[1] * s; // ∂²h̄/∂θ²
+        let hd = -(vel[0] * co + vel[1] * s); // ∂h̄/∂t
+        let hd_t = vel[0] * s - vel[1] * co; // ∂²h̄/∂θ∂t
+        let g = 0.5 * w * h_t + hd;
+        let b = w * hd_t + 0.25 * w * w * h_tt - 2.4 * g * g / h;
+        // ∂/∂X_j: h̄ by dh, h̄_θ by dh_t, h̄_θθ by −dh; ∂/∂V_j: ḣ̄ by dh, ∂ḣ̄/∂θ by dh_t
+        let (n, dh, dh_t) = ([co, s], [-co, -s], [s, -co]);
+        for i in 0..2 {
+            out.force_n[i] += wt * n[i] * b / h;
+            for j in 0..2 {
+                let db_dx =
+                    -0.25 * w * w * dh[j] - 2.4 * (w * g * dh_t[j] / h - g * g * dh[j] / (h * h));
+                let df_dx = db_dx / h - b * dh[j] / (h * h);
+                let df_dv = (w * dh_t[j] - 4.8 * g * dh[j] / h) / h;
+                out.stiffness_n_per_m[(i, j)] += wt * n[i] * df_dx;
+                out.damping_n_s_per_m[(i, j)] += wt * n[i] * df_dv;
+            }
+        }
+    });
+    out
+}
+
+/// The static equilibrium of film `s` (running viscosity `viscosity_pa_s`) under `load` (N) at
+/// `speed_rad_s`; with a convective `inertia` the film carries the load plus the steady
+/// convective inertia force (fixed point: the force is ≈ 4 % of the load in the seed case, each
+/// pass shrinks the change by about that ratio; stops at 1e-9 of `clearance_m`). The one home of
+/// this equilibrium for the linear analyses and the twin.
+pub fn equilibrium_with_inertia(
+    s: &mut dyn super::FilmModel,
+    inertia: Option<FilmInertia>,
+    viscosity_pa_s: f64,
+    load: [f64; 2],
+    speed_rad_s: f64,
+) -> Result<super::Equilibrium, super::FilmError> {
+    let mut eq = super::equilibrium_under_load(s, viscosity_pa_s, load, speed_rad_s)?;
+    let Some(inertia) = inertia.filter(|i| i.convective) else {
+        return Ok(eq);
+    };
+    for _ in 0..30 {
+        let f = inertia.convective_force_at(&eq, viscosity_pa_s, speed_rad_s);
+        let carried = [load[0] + f[0], load[1] + f[1]];
+        let next = super::equilibrium_under_load(s, viscosity_pa_s, carried, speed_rad_s)?;
+        let moved =
+            (next.position_m[0] - eq.position_m[0]).hypot(next.position_m[1] - eq.position_m[1]);
+        eq = next;
+        if moved < 1e-9 * inertia.clearance_m {
+            break;
+        }
+    }
+    Ok(eq)
+}
+
 /// The zone integrals of eq. I1's convective terms (dimensionless, h̄ = h/c): the force
 /// ∫ n g/h̄, its derivatives ∫ n_i ∂(g/h̄)/∂X_j (stiffness) and ∫ n_i (∂B/∂Ẋ_j)/(ω h̄) (damping),
 /// g = h̄_θθ − (12/5) h̄_θ²/h̄.
@@ -253,13 +368,8 @@ struct ConvectiveIntegrals {
 
 /// Simpson's rule over `ZONE_PANELS` panels, as [`zone_integrals`].
 fn convective_integrals(pos: [f64; 2], start: f64, span: f64) -> ConvectiveIntegrals {
-    let d = span / ZONE_PANELS as f64;
-    let (sd, cd) = d.sin_cos();
-    let (mut s, mut co) = start.sin_cos();
     let mut out = ConvectiveIntegrals::default();
-    for k in 0..=ZONE_PANELS {
-        let w = simpson_weight(k) * d / 3.0;
-        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+    simpson_nodes(pos, start, span, |w, co, s, h| {
         let h_t = pos[0] * s - pos[1] * co; // ∂h̄/∂θ
         let h_tt = 1.0 - h; // ∂²h̄/∂θ²
         let g = h_tt - 2.4 * h_t * h_t / h;
@@ -280,8 +390,7 @@ fn convective_integrals(pos: [f64; 2], start: f64, span: f64) -> ConvectiveInteg
                 out.damping[(i, j)] += w * n[i] * db[j] / h;
             }
         }
-        (s, co) = (s * cd + co * sd, co * cd - s * sd);
-    }
+    });
     out
 }
 
@@ -306,32 +415,32 @@ fn active_zone(film: &FilmResult) -> Option<(f64, f64)> {
     Some((film.film_start_rad, span))
 }
 
-/// Simpson's rule over `ZONE_PANELS` panels of [start, start + span], the nodes' cos and sin
-/// advanced by one rotation each (no trigonometric call inside the loop).
+/// Simpson's rule over `ZONE_PANELS` panels of [start, start + span] ([`simpson_nodes`]).
 fn zone_integrals(pos: [f64; 2], start: f64, span: f64) -> ZoneIntegrals {
-    let d = span / ZONE_PANELS as f64;
-    let (sd, cd) = d.sin_cos();
-    let (mut s, mut co) = start.sin_cos();
     let mut out = ZoneIntegrals::default();
-    for k in 0..=ZONE_PANELS {
-        let w = if k == 0 || k == ZONE_PANELS {
-            1.0
-        } else if k % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        } * d
-            / 3.0;
-        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+    simpson_nodes(pos, start, span, |w, co, s, h| {
         let (wi, ws) = (w / h, w / (h * h * h));
         let nn = [co * co, co * s, s * s];
         for m in 0..3 {
             out.inertia[m] += wi * nn[m];
             out.squeeze[m] += ws * nn[m];
         }
+    });
+    out
+}
+
+/// Simpson's rule's nodes over `ZONE_PANELS` panels of [start, start + span]: `f(weight, cos θ,
+/// sin θ, h̄)` at each, h̄ = 1 − X cos θ − Y sin θ at `pos` (floored at 1e-6), the nodes' cos and
+/// sin advanced by one rotation each (no trigonometric call inside the loop).
+fn simpson_nodes(pos: [f64; 2], start: f64, span: f64, mut f: impl FnMut(f64, f64, f64, f64)) {
+    let d = span / ZONE_PANELS as f64;
+    let (sd, cd) = d.sin_cos();
+    let (mut s, mut co) = start.sin_cos();
+    for k in 0..=ZONE_PANELS {
+        let h = (1.0 - pos[0] * co - pos[1] * s).max(1e-6);
+        f(simpson_weight(k) * d / 3.0, co, s, h);
         (s, co) = (s * cd + co * sd, co * cd - s * sd);
     }
-    out
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@ pub use error::FilmError;
 pub use finite::FiniteFilm;
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
 pub use heating::{effective_temperature, EffectiveTemperature, OilHeating};
-pub use inertia::{FilmInertia, FluidInertia};
+pub use inertia::{equilibrium_with_inertia, FilmInertia, FluidInertia, InertiaForce};
 pub use short::ShortFilm;
 pub use table::{
     disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,

@@ -120,22 +120,7 @@ impl FilmBearing {
         speed_rad_s: f64,
     ) -> Result<crate::film::Equilibrium, crate::film::FilmError> {
         let mu = self.viscosity_pa_s();
-        let mut eq = crate::film::equilibrium_under_load(s, mu, load, speed_rad_s)?;
-        let Some(inertia) = self.inertia.filter(|i| i.convective) else {
-            return Ok(eq);
-        };
-        for _ in 0..30 {
-            let f = inertia.convective_force_at(&eq, mu, speed_rad_s);
-            let carried = [load[0] + f[0], load[1] + f[1]];
-            let next = crate::film::equilibrium_under_load(s, mu, carried, speed_rad_s)?;
-            let moved = (next.position_m[0] - eq.position_m[0])
-                .hypot(next.position_m[1] - eq.position_m[1]);
-            eq = next;
-            if moved < 1e-9 * self.geometry.radial_clearance_m {
-                break;
-            }
-        }
-        Ok(eq)
+        crate::film::equilibrium_with_inertia(s, self.inertia, mu, load, speed_rad_s)
     }
 
     /// A film solver at the running viscosity (each user owns one: it carries the warm start).

@@ -1,12 +1,12 @@
 //! Building the twin: reduced matrices, film links, and the static equilibrium it starts from.
 
 use super::{State, Twin, HELD};
-use crate::dynamics::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
+use crate::dynamics::bearing_link::{BearingLink, LinkEvaluation};
 use crate::dynamics::linear::{SparseRows, StepFactor};
 use crate::dynamics::{
     BearingState, Coupling, FilmEvaluation, ProbeState, StepOutput, TwinConfig, TwinError,
 };
-use crate::film::{equilibrium_under_load, solve2, FilmCoefficients};
+use crate::film::{solve2, FilmCoefficients};
 use crate::rotor::{static_solution, BearingModel, Rotor};
 use faer::linalg::solvers::Solve;
 use faer::Mat;
@@ -217,14 +217,6 @@ fn film_links(
         if let Some(p) = pedestal {
             b_dofs.extend(p);
         }
-        if f.inertia.is_some_and(|i| i.convective) {
-            return Err(TwinError::Setup(format!(
-                "bearing '{}': fluid_inertia: full (convective inertia) is built for the linear \
-                 analyses (modes, response) only; the twin and its transient take \
-                 fluid_inertia: temporal",
-                b.name
-            )));
-        }
         // the linear coupling evaluates films only to re-linearise: direct
         let film = match (config.film, config.coupling) {
             (FilmEvaluation::Direct, _) | (_, Coupling::Linear) => f.reference_solver(),
@@ -244,6 +236,7 @@ fn film_links(
             linear_reference: None,
             previous_raw: None,
             inertia: f.inertia,
+            kappa: 1.0,
             last: LinkEvaluation::default(),
         });
     }
@@ -312,24 +305,19 @@ impl BearingLink {
         load: [f64; 2],
         speed_rad_s: f64,
     ) -> Result<[f64; 2], TwinError> {
-        let mu = self.viscosity();
-        let eq =
-            equilibrium_under_load(&mut self.film, mu, load, speed_rad_s).map_err(|cause| {
-                TwinError::Film {
-                    bearing: self.name.clone(),
-                    time_s: 0.0,
-                    cause,
-                }
+        let (eq, force_n) = self
+            .linearise(load, speed_rad_s)
+            .map_err(|cause| TwinError::Film {
+                bearing: self.name.clone(),
+                time_s: 0.0,
+                cause,
             })?;
-        let coefficients =
-            self.with_added_mass(eq.coefficients, eq.position_m, &eq.film, speed_rad_s);
-        self.linear_reference = Some(LinearReference {
-            position_m: eq.position_m,
-            force_n: eq.film.force_n,
-            coefficients,
-        });
+        let coefficients = self
+            .linear_reference
+            .map(|r| r.coefficients)
+            .unwrap_or_default();
         self.last = LinkEvaluation {
-            force_n: eq.film.force_n,
+            force_n,
             stiffness: eq.coefficients.stiffness_n_per_m,
             damping: eq.coefficients.damping_n_s_per_m,
             film_stiffness: eq.coefficients.stiffness_n_per_m,

@@ -1,10 +1,10 @@
 //! The time step: Newmark predictor, condensed Newton iteration on the bearing DOFs, update.
 
 use super::{Twin, HELD};
-use crate::dynamics::bearing_link::{LinearReference, LinkEvaluation};
+use crate::dynamics::bearing_link::LinkEvaluation;
 use crate::dynamics::linear::solve_small;
 use crate::dynamics::{Coupling, StepInput, StepOutput, TwinError};
-use crate::film::{equilibrium_under_load, FilmCoefficients};
+use crate::film::FilmCoefficients;
 use crate::rotor::unbalance_force;
 use nalgebra::{Matrix2, Vector2};
 
@@ -98,17 +98,8 @@ impl Twin {
     pub(super) fn relinearise_films(&mut self, speed: f64) {
         for l in &mut self.links {
             if let Some(r) = l.linear_reference {
-                let load = [-r.force_n[0], -r.force_n[1]];
-                let mu = l.viscosity();
-                if let Ok(eq) = equilibrium_under_load(&mut l.film, mu, load, speed) {
-                    let coefficients =
-                        l.with_added_mass(eq.coefficients, eq.position_m, &eq.film, speed);
-                    l.linear_reference = Some(LinearReference {
-                        position_m: eq.position_m,
-                        force_n: eq.film.force_n,
-                        coefficients,
-                    });
-                }
+                // on failure the reference stays where it was
+                let _ = l.linearise([-r.force_n[0], -r.force_n[1]], speed);
             }
         }
     }
