@@ -20,7 +20,7 @@ pub use inputs::{
     SpeedUnit, StationRef,
 };
 pub use one_x::{OneXBlock, OneXBlocks};
-pub use plant_signals::SignalState;
+pub use plant_signals::{SignalState, StationSource, PAIR_TOLERANCE_REVS};
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 
 use crate::dynamics::StepInput;
@@ -92,6 +92,9 @@ pub struct DriverCounts {
     /// Raw probe readings never paired with their station's other probe (the next reading of
     /// the same probe came first: the other probe's reading was lost or stamped too far off).
     pub readings_unpaired: u64,
+    /// Probe samples refused because another source feeds their station (raw probes and a
+    /// `ProbeDisplacement` topic for one station: [`StationSource`]).
+    pub second_source_refused: u64,
 }
 
 /// The latest accepted speed input.
@@ -277,7 +280,7 @@ impl Driver {
                 x_m,
                 y_m,
                 stamp_ns,
-            } => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+            } => self.take_displacement(now_ns, &station, [x_m, y_m], stamp_ns, emit),
             Input::OilTemperature { temperature_k, .. } => self.take_oil_temperature(temperature_k),
             Input::Keyphasor { stamp_ns } => self.take_keyphasor(now_ns, stamp_ns, emit),
             Input::ProbeSignal {
@@ -476,6 +479,25 @@ impl Driver {
                 }
                 Fed::Taken
             }
+            Err(why) => Fed::Refused(why),
+        }
+    }
+
+    /// A `ProbeDisplacement` pair: its station claimed for this source, then compared.
+    fn take_displacement(
+        &mut self,
+        now_ns: i64,
+        station: &StationRef,
+        measured: [f64; 2],
+        stamp_ns: i64,
+        emit: &mut impl FnMut(Outgoing),
+    ) -> Fed {
+        let claimed = self
+            .limits
+            .station(station)
+            .and_then(|k| self.claim_station(k, StationSource::Displacement, now_ns));
+        match claimed {
+            Ok(()) => self.compare_probe(now_ns, station, measured, stamp_ns, emit),
             Err(why) => Fed::Refused(why),
         }
     }
