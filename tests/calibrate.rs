@@ -125,34 +125,7 @@ fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
 /// the fit would give the phase from the plant's angle zero, 123° away.
 #[test]
 fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
-    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_kp_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let (ok, _, err) = common::run_cli(&[
-        "synth-bag",
-        "--out",
-        dir.to_str().unwrap(),
-        "--from-rpm",
-        "8000",
-        "--to-rpm",
-        "8000",
-        "--hold-start",
-        "1.5",
-        "--ramp",
-        "0.01",
-        "--hold-end",
-        "0.01",
-        "--keyphasor-deg",
-        "123",
-    ]);
-    assert!(ok, "{err}");
-    let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
-    let published = bag
-        .messages()
-        .find(|m| bag.topics[m.topic].name == rotor_twin::topics::UNBALANCE)
-        .map(|m| {
-            rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(m.payload()).unwrap()
-        })
-        .expect("the bag publishes its unbalance");
+    let (dir, bag, published) = bag_at_8000_rpm("kp", &[]);
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, _) =
         rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
@@ -178,37 +151,7 @@ fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
 /// is larger than the 1X motion, so the test can fail.
 #[test]
 fn replay_calibrate_takes_raw_probes_with_runout() {
-    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_raw_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let (ok, _, err) = common::run_cli(&[
-        "synth-bag",
-        "--out",
-        dir.to_str().unwrap(),
-        "--from-rpm",
-        "8000",
-        "--to-rpm",
-        "8000",
-        "--hold-start",
-        "1.5",
-        "--ramp",
-        "0.01",
-        "--hold-end",
-        "0.01",
-        "--keyphasor-deg",
-        "123",
-        "--raw-probes",
-        "--runout-um",
-        "5",
-    ]);
-    assert!(ok, "{err}");
-    let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
-    let published = bag
-        .messages()
-        .find(|m| bag.topics[m.topic].name == rotor_twin::topics::UNBALANCE)
-        .map(|m| {
-            rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(m.payload()).unwrap()
-        })
-        .expect("the bag publishes its unbalance");
+    let (dir, bag, published) = bag_at_8000_rpm("raw", &["--raw-probes", "--runout-um", "5"]);
     let rotor = Rotor::from_description(&builtin_with_raw_probes(5e-6));
     let (cal, _) =
         rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
@@ -247,4 +190,48 @@ fn replay_calibrate_takes_raw_probes_with_runout() {
         "{q:?}"
     );
     std::fs::remove_dir_all(dir).ok();
+}
+
+/// A synthetic bag (`synth-bag`, 1.5 s at 8,000 rpm, keyphasor mark 123° from the plant's angle
+/// zero, and `extra` arguments) in a scratch directory named by `tag`, read back, with the
+/// unbalance it publishes (the plant's, phase from the mark).
+fn bag_at_8000_rpm(
+    tag: &str,
+    extra: &[&str],
+) -> (
+    std::path::PathBuf,
+    rotor_twin::bag::Bag,
+    rotor_twin::messages::Unbalance,
+) {
+    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_{tag}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut args = vec![
+        "synth-bag",
+        "--out",
+        dir.to_str().unwrap(),
+        "--from-rpm",
+        "8000",
+        "--to-rpm",
+        "8000",
+        "--hold-start",
+        "1.5",
+        "--ramp",
+        "0.01",
+        "--hold-end",
+        "0.01",
+        "--keyphasor-deg",
+        "123",
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = common::run_cli(&args);
+    assert!(ok, "{err}");
+    let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
+    let published = bag
+        .messages()
+        .find(|m| bag.topics[m.topic].name == rotor_twin::topics::UNBALANCE)
+        .map(|m| {
+            rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(m.payload()).unwrap()
+        })
+        .expect("the bag publishes its unbalance");
+    (dir, bag, published)
 }

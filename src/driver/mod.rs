@@ -280,7 +280,10 @@ impl Driver {
                 x_m,
                 y_m,
                 stamp_ns,
-            } => self.take_displacement(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+            } => match self.claim_displacement(now_ns, &station) {
+                Ok(()) => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+                Err(why) => Fed::Refused(why),
+            },
             Input::OilTemperature { temperature_k, .. } => self.take_oil_temperature(temperature_k),
             Input::Keyphasor { stamp_ns } => self.take_keyphasor(now_ns, stamp_ns, emit),
             Input::ProbeSignal {
@@ -483,23 +486,10 @@ impl Driver {
         }
     }
 
-    /// A `ProbeDisplacement` pair: its station claimed for this source, then compared.
-    fn take_displacement(
-        &mut self,
-        now_ns: i64,
-        station: &StationRef,
-        measured: [f64; 2],
-        stamp_ns: i64,
-        emit: &mut impl FnMut(Outgoing),
-    ) -> Fed {
-        let claimed = self
-            .limits
-            .station(station)
-            .and_then(|k| self.claim_station(k, StationSource::Displacement, now_ns));
-        match claimed {
-            Ok(()) => self.compare_probe(now_ns, station, measured, stamp_ns, emit),
-            Err(why) => Fed::Refused(why),
-        }
+    /// Claims the station of a `ProbeDisplacement` pair for that source ([`StationSource`]).
+    fn claim_displacement(&mut self, now_ns: i64, station: &StationRef) -> Result<(), String> {
+        let k = self.limits.station(station)?;
+        self.claim_station(k, StationSource::Displacement, now_ns)
     }
 
     fn compare_probe(
