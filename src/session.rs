@@ -11,6 +11,10 @@ use crate::monitor::{
 };
 use crate::rotor::Rotor;
 
+mod history;
+use history::ProbeHistory;
+pub use history::{PREDICTION_HISTORY_MAX_STEPS, PREDICTION_HISTORY_S};
+
 /// Time a milder warning (state or level) must hold before the warning steps down to it (s of
 /// model time). A worse one is announced at once: an alarm is never delayed. One second is
 /// the time scale an operator reads a panel on and the order of the alarm delays of
@@ -168,10 +172,8 @@ pub struct Session {
     milder_since_s: Option<f64>,
     milder_worst: (u8, RotorState),
     last_warning_s: f64,
-    /// probe displacements (m) and time (s) before the last step, for interpolation
-    previous_probes: Vec<[f64; 2]>,
-    previous_time_s: f64,
-    previous_angle_rad: f64,
+    /// the last steps' probe displacements and angles, for a sample's prediction at its stamp
+    history: ProbeHistory,
 }
 
 impl Session {
@@ -200,8 +202,12 @@ impl Session {
         let names = twin.bearing_names().map(str::to_string).collect();
         let clearances = twin.bearing_clearances_m();
         let o = twin.output();
-        let previous_probes = o.probes.iter().map(|p| p.displacement_m).collect();
-        let (previous_time_s, previous_angle_rad) = (o.time_s, o.angle_rad);
+        let mut history = ProbeHistory::new(o.probes.len(), config.time_step_s);
+        history.push(
+            o.time_s,
+            o.angle_rad,
+            o.probes.iter().map(|p| p.displacement_m),
+        );
         let mut s = Self {
             twin,
             monitor,
@@ -222,9 +228,7 @@ impl Session {
             milder_since_s: None,
             milder_worst: (InstabilityWarning::OK, RotorState::Stable),
             last_warning_s: f64::NEG_INFINITY,
-            previous_probes,
-            previous_time_s,
-            previous_angle_rad,
+            history,
         };
         s.set_settings(settings);
         Ok(s)
@@ -273,7 +277,7 @@ impl Session {
     pub fn shift_angle(&mut self, delta_rad: f64) {
         if delta_rad.is_finite() {
             self.twin.shift_angle(delta_rad);
-            self.previous_angle_rad += delta_rad;
+            self.history.shift_angles(delta_rad);
         }
     }
 
@@ -292,15 +296,12 @@ impl Session {
         input: &StepInput,
         emit: &mut impl FnMut(Outgoing),
     ) -> Result<(), TwinError> {
+        self.twin.step(input)?;
         {
             let o = self.twin.output();
-            for (p, q) in self.previous_probes.iter_mut().zip(&o.probes) {
-                *p = q.displacement_m;
-            }
-            self.previous_time_s = o.time_s;
-            self.previous_angle_rad = o.angle_rad;
+            let probes = o.probes.iter().map(|p| p.displacement_m);
+            self.history.push(o.time_s, o.angle_rad, probes);
         }
-        self.twin.step(input)?;
         self.step_index += 1;
         let stamp = self.stamp_ns();
         if self.step_index.is_multiple_of(self.decimation) {
@@ -312,23 +313,12 @@ impl Session {
         Ok(())
     }
 
-    /// The predicted displacement (m) of probe station `station` at model time `time_s`, linear
-    /// between the last two steps (clamped to them), and the shaft angle (rad) there.
+    /// The predicted displacement (m) of probe station `station` at model time `time_s`, and
+    /// the shaft angle (rad) there: linear between the two kept steps that bracket it (the last
+    /// [`PREDICTION_HISTORY_S`]), clamped to the oldest and the newest, so a sample delivered
+    /// late is compared with the twin at its own stamp.
     pub fn predicted_probe(&self, station: usize, time_s: f64) -> Option<([f64; 2], f64)> {
-        let o = self.twin.output();
-        let now = o.probes.get(station)?.displacement_m;
-        let before = self.previous_probes.get(station)?;
-        let span = o.time_s - self.previous_time_s;
-        let a = if span > 0.0 {
-            ((time_s - self.previous_time_s) / span).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        let lerp = |u: f64, v: f64| u + a * (v - u);
-        Some((
-            [lerp(before[0], now[0]), lerp(before[1], now[1])],
-            lerp(self.previous_angle_rad, o.angle_rad),
-        ))
+        self.history.at(station, time_s)
     }
 
     /// The residual message for a measured displacement (m) at station `station` stamped

@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::calibration::{plant_rotor, twin_rotor};
+use common::calibration::{builtin_with_raw_probes, plant_rotor, twin_rotor};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rotor_twin::calibrate::{
@@ -104,7 +104,7 @@ fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
     let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, calibrated) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], [0.0, 4.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.0, 4.5]).unwrap();
     eprintln!("{cal:?}");
     assert!(
         (cal.viscosity.scale / 1.05 - 1.0).abs() < 0.03,
@@ -125,9 +125,87 @@ fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
 /// the fit would give the phase from the plant's angle zero, 123° away.
 #[test]
 fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
-    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_kp_{}", std::process::id()));
+    let (dir, bag, published) = bag_at_8000_rpm("kp", &[]);
+    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let (cal, _) =
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+    let p = cal.unbalance.planes[0];
+    assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
+    let dphi = (p.phase_deg - published.phase.to_degrees() + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(
+        dphi.abs() < 10.0,
+        "{p:?} against {:.1}°",
+        published.phase.to_degrees()
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `replay --calibrate` on the plant's own signals (issue 12): a synthetic bag (`synth-bag
+/// --raw-probes --runout-um 5 --keyphasor-deg 123`; 1.5 s at 8,000 rpm, oil 5 % more viscous,
+/// films on 90 × 15) whose probes are raw readings at 45°/135° in volts, DC-coupled, with 5 µm
+/// of runout (high spot 30° from the mark) and 0.3 µm of noise. The machine file names the raw
+/// probes and their runout vectors; the fit pairs the readings, subtracts the runout and gives
+/// the unbalance within 10 % and 10° of the published 140 g·mm (phase from the mark) and the
+/// viscosity within 3 % of × 1.05 (the DC gap keeps the mean position). The same bag with the
+/// runout not subtracted (the machine file without it) misses the unbalance: the 5 µm runout
+/// is larger than the 1X motion, so the test can fail.
+#[test]
+fn replay_calibrate_takes_raw_probes_with_runout() {
+    let (dir, bag, published) = bag_at_8000_rpm("raw", &["--raw-probes", "--runout-um", "5"]);
+    let rotor = Rotor::from_description(&builtin_with_raw_probes(5e-6));
+    let (cal, _) =
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+    let p = cal.unbalance.planes[0];
+    let v = &cal.viscosity;
+    println!(
+        "raw probes: {} windows; viscosity × {:.4} ± {:.4}; unbalance {:.1} g·mm at {:.1}° (published 140 at {:.1}°)",
+        cal.windows_used,
+        v.scale,
+        v.scale_std,
+        p.magnitude_g_mm,
+        p.phase_deg,
+        published.phase.to_degrees()
+    );
+    let gap = |a: f64, b: f64| (a - b + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(cal.windows_used >= 4, "{cal:?}");
+    assert!((v.scale / 1.05 - 1.0).abs() < 0.03, "{v:?}");
+    assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
+    assert!(
+        gap(p.phase_deg, published.phase.to_degrees()).abs() < 10.0,
+        "{p:?}"
+    );
+    // the runout left in: the fit reads the runout as unbalance
+    let no_runout = Rotor::from_description(&builtin_with_raw_probes(0.0));
+    let (cal0, _) =
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &no_runout, &[], &[], [0.3, 1.5])
+            .unwrap();
+    let q = cal0.unbalance.planes[0];
+    println!(
+        "runout not subtracted: {:.1} g·mm at {:.1}°",
+        q.magnitude_g_mm, q.phase_deg
+    );
+    assert!(
+        (q.magnitude_g_mm / 140.0 - 1.0).abs() > 0.10
+            || gap(q.phase_deg, published.phase.to_degrees()).abs() > 10.0,
+        "{q:?}"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A synthetic bag (`synth-bag`, 1.5 s at 8,000 rpm, keyphasor mark 123° from the plant's angle
+/// zero, and `extra` arguments) in a scratch directory named by `tag`, read back, with the
+/// unbalance it publishes (the plant's, phase from the mark).
+fn bag_at_8000_rpm(
+    tag: &str,
+    extra: &[&str],
+) -> (
+    std::path::PathBuf,
+    rotor_twin::bag::Bag,
+    rotor_twin::messages::Unbalance,
+) {
+    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_{tag}_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let (ok, _, err) = common::run_cli(&[
+    let mut args = vec![
         "synth-bag",
         "--out",
         dir.to_str().unwrap(),
@@ -143,7 +221,9 @@ fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
         "0.01",
         "--keyphasor-deg",
         "123",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = common::run_cli(&args);
     assert!(ok, "{err}");
     let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
     let published = bag
@@ -153,16 +233,5 @@ fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
             rotor_twin::messages::from_cdr::<rotor_twin::messages::Unbalance>(m.payload()).unwrap()
         })
         .expect("the bag publishes its unbalance");
-    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
-    let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], [0.3, 1.5]).unwrap();
-    let p = cal.unbalance.planes[0];
-    assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
-    let dphi = (p.phase_deg - published.phase.to_degrees() + 180.0).rem_euclid(360.0) - 180.0;
-    assert!(
-        dphi.abs() < 10.0,
-        "{p:?} against {:.1}°",
-        published.phase.to_degrees()
-    );
-    std::fs::remove_dir_all(dir).ok();
+    (dir, bag, published)
 }

@@ -601,9 +601,14 @@ fn run_calibrated(
         .time_span_ns()
         .map_or(0.0, |(a, b)| (b - a) as f64 * 1e-9);
     let window = args.calibrate_window.map_or([0.0, span], |(a, b)| [a, b]);
-    let (cal, calibrated) =
-        crate::replay::calibration::calibrate_bag(bag, rotor, &options.remaps, window)
-            .context("calibration")?;
+    let (cal, calibrated) = crate::replay::calibration::calibrate_bag(
+        bag,
+        rotor,
+        &options.remaps,
+        &options.probe_signals,
+        window,
+    )
+    .context("calibration")?;
     let (before, _) = replay(bag, rotor, options, &mut |_| {})?;
     let mut after_options = options.clone();
     after_options.out_bag = None;

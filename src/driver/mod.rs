@@ -20,7 +20,7 @@ pub use inputs::{
     SpeedUnit, StationRef,
 };
 pub use one_x::{OneXBlock, OneXBlocks};
-pub use plant_signals::SignalState;
+pub use plant_signals::{SignalState, StationSource, PAIR_TOLERANCE_REVS};
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
 
 use crate::dynamics::StepInput;
@@ -92,6 +92,9 @@ pub struct DriverCounts {
     /// Raw probe readings never paired with their station's other probe (the next reading of
     /// the same probe came first: the other probe's reading was lost or stamped too far off).
     pub readings_unpaired: u64,
+    /// Probe samples refused because another source feeds their station (raw probes and a
+    /// `ProbeDisplacement` topic for one station: [`StationSource`]).
+    pub second_source_refused: u64,
 }
 
 /// The latest accepted speed input.
@@ -277,7 +280,10 @@ impl Driver {
                 x_m,
                 y_m,
                 stamp_ns,
-            } => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+            } => match self.claim_displacement(now_ns, &station) {
+                Ok(()) => self.compare_probe(now_ns, &station, [x_m, y_m], stamp_ns, emit),
+                Err(why) => Fed::Refused(why),
+            },
             Input::OilTemperature { temperature_k, .. } => self.take_oil_temperature(temperature_k),
             Input::Keyphasor { stamp_ns } => self.take_keyphasor(now_ns, stamp_ns, emit),
             Input::ProbeSignal {
@@ -478,6 +484,12 @@ impl Driver {
             }
             Err(why) => Fed::Refused(why),
         }
+    }
+
+    /// Claims the station of a `ProbeDisplacement` pair for that source ([`StationSource`]).
+    fn claim_displacement(&mut self, now_ns: i64, station: &StationRef) -> Result<(), String> {
+        let k = self.limits.station(station)?;
+        self.claim_station(k, StationSource::Displacement, now_ns)
     }
 
     fn compare_probe(

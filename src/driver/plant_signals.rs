@@ -90,6 +90,29 @@ pub struct SignalState {
     /// Runout per raw probe: measured below the slow-roll speed (or the file's).
     slow_roll: Vec<SlowRoll>,
     measured_runout: Vec<Option<OneXVector>>,
+    /// The source that feeds each probe station, and when it last spoke (receive time, ns).
+    sources: Vec<Option<(StationSource, i64)>>,
+}
+
+/// What feeds a probe station: its raw probes (`ProbeSignal` or `std_msgs/Float64`, one
+/// reading per probe) or `ProbeDisplacement` pairs. One source a station: mixed in one 1X block
+/// the two are two different signals (an AC raw station's mean is the twin's own, the
+/// displacement's its own), so every block reads as a whirl and calibrates nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StationSource {
+    /// Raw probe readings, paired into orbit points.
+    Raw,
+    /// `ProbeDisplacement` pairs.
+    Displacement,
+}
+
+impl StationSource {
+    fn describe(self) -> &'static str {
+        match self {
+            StationSource::Raw => "raw probe signals (ProbeSignal on /rotor_twin/probe_signal, or std_msgs/Float64 by remap)",
+            StationSource::Displacement => "ProbeDisplacement (/rotor_twin/probe)",
+        }
+    }
 }
 
 impl SignalState {
@@ -108,6 +131,42 @@ impl SignalState {
 }
 
 impl Driver {
+    /// One source a probe station ([`StationSource`]): the first to feed station `station`
+    /// keeps it while it speaks (within `input_timeout_s` of receive time); a sample of the
+    /// other source meanwhile is refused with the station and both sources named, and counted
+    /// ([`super::DriverCounts::second_source_refused`]). After that silence the other may take
+    /// the station over.
+    pub(super) fn claim_station(
+        &mut self,
+        station: usize,
+        source: StationSource,
+        now_ns: i64,
+    ) -> Result<(), String> {
+        let n = self.rotor.probes.len();
+        if self.signals.sources.len() < n {
+            self.signals.sources = vec![None; n];
+        }
+        let timeout = seconds_to_ns(self.settings.input_timeout_s);
+        let slot = &mut self.signals.sources[station];
+        if let Some((owner, last)) = *slot {
+            if owner != source && now_ns.saturating_sub(last) <= timeout {
+                self.counts.second_source_refused += 1;
+                let name = self
+                    .rotor
+                    .probes
+                    .get(station)
+                    .map_or("", |p| p.name.as_str());
+                return Err(format!(
+                    "probe station '{name}' takes {}; a sample of {} refused: one source a station (mixed, every 1X block reads as a whirl); give the second source a station of its own",
+                    owner.describe(),
+                    source.describe()
+                ));
+            }
+        }
+        *slot = Some((source, now_ns));
+        Ok(())
+    }
+
     /// Whether 1X phases at `t_ns` are referenced to the keyphasor, and if not why.
     pub fn phase_reference(&self, t_ns: i64) -> PhaseReference {
         let s = &self.signals;
@@ -315,6 +374,9 @@ impl Driver {
             Ok(d) => d,
             Err(why) => return Fed::Refused(why),
         };
+        if let Err(why) = self.claim_station(station, StationSource::Raw, now_ns) {
+            return Fed::Refused(why);
+        }
         let tolerance = seconds_to_ns(self.settings.input_timeout_s);
         let t = if stamp_ns != 0 && (stamp_ns - now_ns).abs() <= tolerance {
             stamp_ns
