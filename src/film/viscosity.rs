@@ -263,6 +263,9 @@ impl ViscosityTable {
 }
 
 /// The oil's viscosity–temperature law: Walther's (ASTM D341) through two points, or a table.
+/// The table is held in place (792 bytes, one per film bearing), so the law stays `Copy` and
+/// reading it allocates nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ViscosityLaw {
     /// Walther / ASTM D341-09 through two kinematic viscosities, with the density.

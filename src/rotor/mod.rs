@@ -47,7 +47,9 @@ use crate::film::{
 use crate::units::rpm_to_rad_s;
 use faer::Mat;
 
-/// How a bearing acts on its journal.
+/// How a bearing acts on its journal (a film bearing carries its viscosity table in place, see
+/// [`crate::film::ViscosityLaw`]: under 1 kB a bearing).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum BearingModel {
     /// A fluid film (finite-length Reynolds or short bearing).
