@@ -98,20 +98,30 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
             "valid_range_c: [10.0, 120.0]",
             "valid_range_c: [.nan, 120.0]",
         )),
-        "bearings[0].lubricant.viscosity_temperature.(law)",
-        "range",
+        "bearings[0].lubricant.viscosity_temperature.valid_range_c",
+        "NaN",
         "finite",
     );
-    // one oil supply: a second bearing with another law is refused, not silently ignored
+    // one oil supply reaches every film: a film bearing without a law beside one with a law is
+    // refused, not silently left at the machine file's viscosity (each may have its own law)
     says(
         &error_of(&with(
+            "      viscosity_temperature:  # as bearing_pulley_end's (one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.60]\n        design_supply_temperature_c: 40.0\n        valid_range_c: [10.0, 120.0]\n",
+            "",
+        )),
+        "bearings[1].lubricant.viscosity_temperature",
+        "(missing)",
+        "every film bearing needs one",
+    );
+    // a second bearing with a law of its own is taken (one scale per bearing)
+    assert!(MachineDescription::from_yaml(
+        &with(
             "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.60]",
             "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.50]",
-        )),
-        "bearings[1].lubricant",
-        "0.5",
-        "one oil supply",
-    );
+        ),
+        "own law"
+    )
+    .is_ok());
     says(
         &error_of(&with(
             "angles_deg: [45.0, 135.0]",

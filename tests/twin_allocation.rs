@@ -54,8 +54,13 @@ fn allocations_in_steps(
     for k in 0..steps {
         if k % 250 == 100 {
             // a live oil temperature changes the films' viscosity (issue 12): no allocation
-            twin.set_viscosity_scale(if k % 500 == 100 { 1.05 } else { 1.0 })
-                .unwrap();
+            // one scale per film bearing (each its own law or effective temperature)
+            let scales = if k % 500 == 100 {
+                [1.05, 0.98]
+            } else {
+                [1.0, 1.0]
+            };
+            twin.set_viscosity_scales(&scales).unwrap();
         }
         twin.step(&input).unwrap();
     }

@@ -279,7 +279,7 @@ fn temperature_of(
 }
 
 /// The design supply temperature (K): where the law gives the reference viscosity.
-fn law_design_k(f: &crate::rotor::FilmBearing, law: &crate::film::WaltherLaw) -> Option<f64> {
+fn law_design_k(f: &crate::rotor::FilmBearing, law: &crate::film::ViscosityLaw) -> Option<f64> {
     let target = f.lubricant.viscosity_pa_s;
     let [mut lo, mut hi] = law.range_k();
     if !(law.viscosity_pa_s(lo) >= target && law.viscosity_pa_s(hi) <= target) {

@@ -165,22 +165,33 @@ impl From<&messages::Keyphasor> for Input {
     }
 }
 
-/// The viscosity scale (µ(T) / µ_reference) an oil supply temperature `t_k` (K) gives through the
-/// first film bearing's law that `rotor` has (one oil supply), or why the temperature is refused:
-/// not finite, outside the law's range, or no law in the machine file.
-pub fn oil_viscosity_scale(rotor: &Rotor, t_k: f64) -> Result<f64, String> {
-    let Some((law, reference)) = rotor.bearings.iter().find_map(|b| match &b.model {
-        crate::rotor::BearingModel::Film(f) => f.viscosity_law.map(|l| (l, f.lubricant)),
+/// The viscosity scale µ_i(T) / µ_reference,i an oil supply temperature `t_k` (K) gives each
+/// film bearing of `rotor` through its own law, written into `out` (one per film bearing, in
+/// their order; allocates nothing), or why the temperature is refused: not finite, outside a
+/// law's range, or no law in the machine file (which gives every film bearing a law once one
+/// has: one oil supply).
+pub fn oil_viscosity_scales(rotor: &Rotor, t_k: f64, out: &mut [f64]) -> Result<(), String> {
+    let films = rotor.bearings.iter().filter_map(|b| match &b.model {
+        crate::rotor::BearingModel::Film(f) => Some((b, f)),
         _ => None,
-    }) else {
-        return Err(
-            "an oil temperature needs a viscosity–temperature law (lubricant.viscosity_temperature in the machine file); this machine has none"
-                .into(),
-        );
-    };
-    let mu = law.checked_viscosity_pa_s(t_k)?;
-    let scale = mu / reference.viscosity_pa_s;
-    crate::film::check_viscosity_scale(scale).map_err(|e| format!("oil temperature: {e}"))
+    });
+    let mut n = 0;
+    for ((b, f), slot) in films.zip(out.iter_mut()) {
+        let Some(law) = f.viscosity_law else {
+            return Err(
+                "an oil temperature needs a viscosity–temperature law (lubricant.viscosity_temperature in the machine file); this machine has none"
+                    .into(),
+            );
+        };
+        let mu = law.checked_viscosity_pa_s(t_k)?;
+        *slot = crate::film::check_viscosity_scale(mu / f.lubricant.viscosity_pa_s)
+            .map_err(|e| format!("oil temperature, bearing {}: {e}", b.name))?;
+        n += 1;
+    }
+    if n == 0 {
+        return Err("an oil temperature needs a film bearing with a viscosity–temperature law; this machine has none".into());
+    }
+    Ok(())
 }
 // --- end oil supply temperature ---
 impl From<&messages::Header> for Input {

@@ -9,6 +9,7 @@
 pub mod calibration;
 mod clock;
 pub mod inputs;
+mod oil;
 pub mod one_x;
 mod plant_signals;
 pub mod settings;
@@ -19,6 +20,7 @@ pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,
 };
+pub use oil::{FilmOil, HEAT_BALANCE_SPEED_STEP, HEAT_BALANCE_TEMPERATURE_STEP_K};
 pub use one_x::{OneXBlock, OneXBlocks};
 pub use plant_signals::{SignalState, StationSource, PAIR_TOLERANCE_REVS};
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};
@@ -153,6 +155,8 @@ pub struct Driver {
     /// temperature's scale when it was applied (1 without a temperature), so later temperatures
     /// still move the viscosity
     viscosity_correction: Option<f64>,
+    /// each film bearing's oil: law and heated scales, effective temperatures (issue 12)
+    oil: oil::OilState,
 }
 
 impl Driver {
@@ -160,6 +164,7 @@ impl Driver {
     pub fn new(rotor: Rotor, settings: DriverSettings) -> Self {
         let limits = InputLimits::of(&rotor);
         let gate = SpeedGate::new(limits.max_speed_rad_s, settings.input_timeout_s);
+        let oil = oil::OilState::of(&rotor);
         Self {
             unbalance: vec![None; rotor.unbalance.len()],
             rotor,
@@ -182,6 +187,7 @@ impl Driver {
             calibration: None,
             oil_scale: None,
             viscosity_correction: None,
+            oil,
         }
     }
 
@@ -264,6 +270,7 @@ impl Driver {
     pub fn feed(&mut self, now_ns: i64, input: Input, emit: &mut impl FnMut(Outgoing)) -> Fed {
         self.advance_to(now_ns, usize::MAX, emit);
         self.last_input_ns = Some(now_ns);
+        let is_speed = matches!(input, Input::Speed { .. });
         let fed = match input {
             Input::Speed {
                 speed_rad_s,
@@ -292,6 +299,9 @@ impl Driver {
                 stamp_ns,
             } => self.take_probe_signal(now_ns, &probe, value, stamp_ns, emit),
         };
+        if is_speed && matches!(fed, Fed::Taken | Fed::Started { .. }) {
+            self.follow_speed_heating();
+        }
         match &fed {
             Fed::Refused(why) => self.note_refused(now_ns, why, emit),
             Fed::Unused => self.counts.probes_not_compared += 1,
@@ -424,49 +434,6 @@ impl Driver {
         self.counts.starts += 1;
         Fed::Started { speed_rad_s: w }
     }
-
-    // --- oil supply temperature (issue 12) ---
-    /// An oil supply temperature (K): the viscosity scale of its law, applied to the running
-    /// twin and kept for later starts; a refused one leaves the last good value in force.
-    fn take_oil_temperature(&mut self, t_k: f64) -> Fed {
-        let scale = match inputs::oil_viscosity_scale(&self.rotor, t_k) {
-            Ok(s) => s,
-            Err(why) => return Fed::Refused(why),
-        };
-        // a calibrated viscosity in force is a factor on the law: it follows the temperature
-        let law_scale = scale;
-        let scale = match self.viscosity_correction {
-            Some(k) => match crate::film::check_viscosity_scale(scale * k) {
-                Ok(s) => s,
-                Err(e) => {
-                    return Fed::Refused(format!("oil temperature with the calibration: {e}"))
-                }
-            },
-            None => scale,
-        };
-        self.oil_scale = Some(law_scale);
-        self.oil_temperature_k = Some(t_k);
-        if let Err(e) = self.rotor.set_viscosity_scale(scale) {
-            return Fed::Refused(format!("oil temperature: {e}"));
-        }
-        if let Some(s) = self.session.as_mut() {
-            if let Err(e) = s.twin_mut().set_viscosity_scale(scale) {
-                return Fed::Refused(format!("oil temperature: {e}"));
-            }
-        }
-        Fed::Taken
-    }
-
-    /// The last accepted oil supply temperature (K), if any.
-    pub fn oil_temperature_k(&self) -> Option<f64> {
-        self.oil_temperature_k
-    }
-
-    /// The viscosity scale in force (µ / µ_reference of the machine file).
-    pub fn viscosity_scale(&self) -> f64 {
-        self.rotor.viscosity_scale()
-    }
-    // --- end oil supply temperature ---
 
     fn take_unbalance(&mut self, plane: u32, me: f64, phase: f64) -> Fed {
         match check_unbalance(plane, me, phase, self.limits.planes) {

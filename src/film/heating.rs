@@ -21,7 +21,7 @@
 //! whole film (no temperature field, no viscosity varying around or across the film), no heat
 //! into the solids, constant ρ and c_p.
 
-use super::{equilibrium_under_load, Equilibrium, FilmResult, ViscosityScaledFilm, WaltherLaw};
+use super::{equilibrium_under_load, Equilibrium, FilmResult, ViscosityLaw, ViscosityScaledFilm};
 
 /// The effective-temperature option of a film bearing's oil.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,7 +108,7 @@ const TEMPERATURE_TOLERANCE_K: f64 = 1e-9;
 pub fn effective_temperature(
     film: &mut ViscosityScaledFilm,
     reference_viscosity_pa_s: f64,
-    law: &WaltherLaw,
+    law: &ViscosityLaw,
     heating: &OilHeating,
     density_kg_m3: f64,
     supply_k: f64,
@@ -193,7 +193,7 @@ fn done(
     t_k: f64,
     equilibrium: Equilibrium,
     heating: &OilHeating,
-    law: &WaltherLaw,
+    law: &ViscosityLaw,
     density_kg_m3: f64,
     evaluations: usize,
 ) -> EffectiveTemperature {

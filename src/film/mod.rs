@@ -44,8 +44,8 @@ pub use table::{
 pub use table::{FilmTable, TabulatedFilm};
 pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};
 pub use viscosity::{
-    check_viscosity_scale, ViscosityScaledFilm, WaltherLaw, MAX_VISCOSITY_SCALE,
-    MIN_VISCOSITY_SCALE, ZERO_CELSIUS_K,
+    check_viscosity_scale, ViscosityLaw, ViscosityScaledFilm, ViscosityTable, WaltherLaw,
+    MAX_TABLE_POINTS, MAX_VISCOSITY_SCALE, MIN_VISCOSITY_SCALE, ZERO_CELSIUS_K,
 };
 
 /// Position and velocity of the journal centre relative to the bearing centre, and its speed.

@@ -123,7 +123,177 @@ impl WaltherLaw {
 
     /// µ (Pa·s) at `t_k` (K), or why that temperature is refused (not finite, outside the range).
     pub fn checked_viscosity_pa_s(&self, t_k: f64) -> Result<f64, String> {
-        let [lo, hi] = self.range_k;
+        ViscosityLaw::Walther(*self).checked_viscosity_pa_s(t_k)
+    }
+}
+
+/// Most points a viscosity table may hold (the table is kept in place, without allocation).
+pub const MAX_TABLE_POINTS: usize = 32;
+
+/// A viscosity–temperature law given as a table of measured (or chart-read) dynamic
+/// viscosities, interpolated by a monotone piecewise cubic Hermite curve (Fritsch & Carlson
+/// 1980, with the shape-preserving three-point end slopes of Moler's `pchip`) of ln µ against
+/// −1/T: the coordinates of Andrade's law ln µ = A + B/T, in which an oil's curve is nearly
+/// straight, so the interpolant's error between points is small (0.18 % at the mid-points of a
+/// 6-point table of ISO VG 32's Walther law, 0–100 °C; `tests/viscosity_table.rs`). The
+/// viscosities must fall strictly as the temperature rises; the curve is then monotone too. No
+/// extrapolation: the law is used inside the table's span only.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViscosityTable {
+    /// −1/T of each point (1/K), increasing (T increasing)
+    x: [f64; MAX_TABLE_POINTS],
+    /// ln µ (µ in Pa·s), decreasing
+    y: [f64; MAX_TABLE_POINTS],
+    /// dy/dx at each point (the Hermite slopes)
+    m: [f64; MAX_TABLE_POINTS],
+    n: usize,
+    range_k: [f64; 2],
+}
+
+impl ViscosityTable {
+    /// The table through `points` (temperature K, dynamic viscosity Pa·s), in rising
+    /// temperature, used between `range_k[0]` and `range_k[1]` (K; inside the table's span).
+    /// Err names the broken rule and the value.
+    pub fn new(points: &[(f64, f64)], range_k: [f64; 2]) -> Result<Self, String> {
+        if !(2..=MAX_TABLE_POINTS).contains(&points.len()) {
+            return Err(format!(
+                "{} points given: a table needs 2 to {MAX_TABLE_POINTS}",
+                points.len()
+            ));
+        }
+        for (i, &(t, mu)) in points.iter().enumerate() {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(format!(
+                    "temperature {i} ({t} K) must be above absolute zero"
+                ));
+            }
+            if !(mu.is_finite() && mu > 0.0) {
+                return Err(format!("viscosity {i} ({mu} Pa·s) must be above zero"));
+            }
+            if i > 0 {
+                let (t0, mu0) = points[i - 1];
+                if t <= t0 {
+                    return Err(format!(
+                        "temperature {i} ({t} K) must be above temperature {} ({t0} K): the table is in rising temperature",
+                        i - 1
+                    ));
+                }
+                if mu >= mu0 {
+                    return Err(format!(
+                        "viscosity {i} ({mu} Pa·s at {t} K) must be below viscosity {} ({mu0} Pa·s at {t0} K): an oil thins as it warms",
+                        i - 1
+                    ));
+                }
+            }
+        }
+        let (lo, hi) = (points[0].0, points[points.len() - 1].0);
+        if !(range_k[0].is_finite() && range_k[1].is_finite() && range_k[0] < range_k[1])
+            || range_k[0] < lo
+            || range_k[1] > hi
+        {
+            return Err(format!(
+                "the valid range [{}, {}] K must be increasing and inside the table's span [{lo}, {hi}] K (no extrapolation)",
+                range_k[0], range_k[1]
+            ));
+        }
+        let mut table = Self {
+            x: [0.0; MAX_TABLE_POINTS],
+            y: [0.0; MAX_TABLE_POINTS],
+            m: [0.0; MAX_TABLE_POINTS],
+            n: points.len(),
+            range_k,
+        };
+        for (i, &(t, mu)) in points.iter().enumerate() {
+            table.x[i] = -1.0 / t;
+            table.y[i] = mu.ln();
+        }
+        table.set_slopes();
+        Ok(table)
+    }
+
+    /// Fritsch–Carlson slopes: the weighted harmonic mean of the neighbouring secants inside
+    /// (zero where they change sign: never here, the data being monotone), shape-preserving
+    /// three-point slopes at the ends (two points: the secant).
+    fn set_slopes(&mut self) {
+        let n = self.n;
+        let h = |i: usize| self.x[i + 1] - self.x[i];
+        let d = |i: usize| (self.y[i + 1] - self.y[i]) / (self.x[i + 1] - self.x[i]);
+        if n == 2 {
+            self.m[0] = d(0);
+            self.m[1] = d(0);
+            return;
+        }
+        for i in 1..n - 1 {
+            let (d0, d1) = (d(i - 1), d(i));
+            self.m[i] = if d0 * d1 <= 0.0 {
+                0.0
+            } else {
+                let (w1, w2) = (2.0 * h(i) + h(i - 1), h(i) + 2.0 * h(i - 1));
+                (w1 + w2) / (w1 / d0 + w2 / d1)
+            };
+        }
+        let end = |h0: f64, h1: f64, d0: f64, d1: f64| {
+            let s = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+            if s * d0 <= 0.0 {
+                0.0
+            } else if d0 * d1 <= 0.0 && s.abs() > (3.0 * d0).abs() {
+                3.0 * d0
+            } else {
+                s
+            }
+        };
+        self.m[0] = end(h(0), h(1), d(0), d(1));
+        self.m[n - 1] = end(h(n - 2), h(n - 3), d(n - 2), d(n - 3));
+    }
+
+    /// µ (Pa·s) at `t_k` (K), no range check (held at the end values outside the table).
+    pub fn viscosity_pa_s(&self, t_k: f64) -> f64 {
+        let n = self.n;
+        let x = (-1.0 / t_k).clamp(self.x[0], self.x[n - 1]);
+        let i = (1..n - 1).find(|&i| x < self.x[i]).unwrap_or(n - 1) - 1;
+        let h = self.x[i + 1] - self.x[i];
+        let s = (x - self.x[i]) / h;
+        let (s2, s3) = (s * s, s * s * s);
+        let y = (2.0 * s3 - 3.0 * s2 + 1.0) * self.y[i]
+            + (s3 - 2.0 * s2 + s) * h * self.m[i]
+            + (3.0 * s2 - 2.0 * s3) * self.y[i + 1]
+            + (s3 - s2) * h * self.m[i + 1];
+        y.exp()
+    }
+}
+
+/// The oil's viscosity–temperature law: Walther's (ASTM D341) through two points, or a table.
+/// The table is held in place (792 bytes, one per film bearing), so the law stays `Copy` and
+/// reading it allocates nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ViscosityLaw {
+    /// Walther / ASTM D341-09 through two kinematic viscosities, with the density.
+    Walther(WaltherLaw),
+    /// A table of dynamic viscosities.
+    Table(ViscosityTable),
+}
+
+impl ViscosityLaw {
+    /// Dynamic viscosity µ (Pa·s) at `t_k` (K), no range check.
+    pub fn viscosity_pa_s(&self, t_k: f64) -> f64 {
+        match self {
+            Self::Walther(w) => w.viscosity_pa_s(t_k),
+            Self::Table(t) => t.viscosity_pa_s(t_k),
+        }
+    }
+
+    /// The temperatures (K) the law is used at.
+    pub fn range_k(&self) -> [f64; 2] {
+        match self {
+            Self::Walther(w) => w.range_k,
+            Self::Table(t) => t.range_k,
+        }
+    }
+
+    /// µ (Pa·s) at `t_k` (K), or why that temperature is refused (not finite, outside the range).
+    pub fn checked_viscosity_pa_s(&self, t_k: f64) -> Result<f64, String> {
+        let [lo, hi] = self.range_k();
         if !t_k.is_finite() {
             return Err(format!("oil temperature {t_k} K is not a finite number"));
         }

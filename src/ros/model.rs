@@ -727,7 +727,7 @@ impl ModelLoop {
         let t = &self.timing;
         let h = self.driver.settings().twin.time_step_s;
         let rtf = t.steps as f64 * h / t.since.elapsed().as_secs_f64();
-        let values = vec![
+        let mut values = vec![
             kv("real_time_factor", format!("{rtf:.3}")),
             kv("lag_s", format!("{:.4}", t.lag_s)),
             kv("step_overruns", t.overruns.to_string()),
@@ -762,6 +762,7 @@ impl ModelLoop {
                     .to_string(),
             ),
         ];
+        values.extend(self.oil_values());
         let (level, message) = if self.counters.recording_failed.load(Ordering::Relaxed) {
             (
                 DiagnosticStatus::ERROR,
@@ -786,6 +787,30 @@ impl ModelLoop {
             (DiagnosticStatus::OK, "keeping up".into())
         };
         self.status("model", level, message, values)
+    }
+
+    /// The oil in force (issue 12): the supply temperature once one is received, each film
+    /// bearing's viscosity scale and, with `oil_heating`, its effective temperature.
+    fn oil_values(&self) -> Vec<KeyValue> {
+        let c = |k: f64| k - crate::film::ZERO_CELSIUS_K;
+        let mut values = Vec::new();
+        if let Some(t) = self.driver.oil_temperature_k() {
+            values.push(kv("oil_supply_temperature_c", format!("{:.2}", c(t))));
+        }
+        for f in self.driver.film_oil() {
+            let name = &f.name;
+            values.push(kv(
+                &format!("viscosity_scale {name}"),
+                format!("{:.5}", f.viscosity_scale),
+            ));
+            if let Some(t) = f.effective_temperature_k {
+                values.push(kv(
+                    &format!("effective_temperature_c {name}"),
+                    format!("{:.3}", c(t)),
+                ));
+            }
+        }
+        values
     }
 
     /// `<node>: forecast`: the last and longest forecast duration, forecasts done, cycles skipped

@@ -25,8 +25,8 @@ pub use machine::{
     AlarmLevelsSpec, BearingModelSpec, BearingSpec, DiscSpec, FilmSpec, GroovesSpec, LubricantSpec,
     MachineDescription, MachineDescriptionOf, MaterialSpec, OilHeatingModel, OilHeatingSpec,
     ProbeSpec, ProximityProbeSpec, RawBearingSpec, RunoutSpec, ShaftSection, SupportSpec,
-    UnbalanceSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER, DEFAULT_MACHINE_NAME,
-    DEFAULT_MACHINE_YAML, MAX_SURFACE_SPEED_M_S,
+    UnbalanceSpec, ViscosityTableSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER,
+    DEFAULT_MACHINE_NAME, DEFAULT_MACHINE_YAML, MAX_SURFACE_SPEED_M_S,
 };
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
@@ -47,7 +47,9 @@ use crate::film::{
 use crate::units::rpm_to_rad_s;
 use faer::Mat;
 
-/// How a bearing acts on its journal.
+/// How a bearing acts on its journal (a film bearing carries its viscosity table in place, see
+/// [`crate::film::ViscosityLaw`]: under 1 kB a bearing).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum BearingModel {
     /// A fluid film (finite-length Reynolds or short bearing).
@@ -70,7 +72,7 @@ pub struct FilmBearing {
     /// Short-bearing closed form instead of the finite solver.
     pub short: bool,
     /// The oil's viscosity–temperature law, if the machine file gives one.
-    pub viscosity_law: Option<crate::film::WaltherLaw>,
+    pub viscosity_law: Option<crate::film::ViscosityLaw>,
     /// The law's design supply temperature (K), with the law.
     pub design_supply_temperature_k: Option<f64>,
     /// The bearing's own heating by an effective temperature (`oil_heating` in the machine
@@ -139,6 +141,51 @@ impl Rotor {
     /// Sets the viscosity scale (µ / µ_reference) of every film bearing (checked).
     pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), crate::film::FilmError> {
         let scale = crate::film::check_viscosity_scale(scale)?;
+        self.check_scalable(scale)?;
+        for b in &mut self.bearings {
+            if let BearingModel::Film(f) = &mut b.model {
+                f.viscosity_scale = scale;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets each film bearing's own viscosity scale, `scales` in the order of the film
+    /// bearings (one per film bearing; each checked, none set if one fails; allocates nothing).
+    pub fn set_film_viscosity_scales(
+        &mut self,
+        scales: &[f64],
+    ) -> Result<(), crate::film::FilmError> {
+        let films = self.film_bearing_count();
+        if scales.len() != films {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "viscosity scales (one per film bearing)",
+                value: scales.len() as f64,
+                rule: "must give one scale per film bearing",
+            });
+        }
+        for &s in scales {
+            self.check_scalable(crate::film::check_viscosity_scale(s)?)?;
+        }
+        let films = self.bearings.iter_mut().filter_map(|b| match &mut b.model {
+            BearingModel::Film(f) => Some(f),
+            _ => None,
+        });
+        for (f, &s) in films.zip(scales) {
+            f.viscosity_scale = s;
+        }
+        Ok(())
+    }
+
+    /// The number of film bearings.
+    pub fn film_bearing_count(&self) -> usize {
+        (self.bearings.iter())
+            .filter(|b| matches!(b.model, BearingModel::Film(_)))
+            .count()
+    }
+
+    /// Refuses a scale other than 1 when a film is turbulent (it does not scale with µ).
+    fn check_scalable(&self, scale: f64) -> Result<(), crate::film::FilmError> {
         let turbulent = self.bearings.iter().any(|b| {
             matches!(&b.model, BearingModel::Film(f) if f.flow != crate::film::FlowRegime::Laminar)
         });
@@ -149,11 +196,6 @@ impl Rotor {
                 rule: "a viscosity change does not scale a turbulent film (Re = ρωRc/µ changes \
                        with it); only 1 is accepted with flow: turbulent or auto",
             });
-        }
-        for b in &mut self.bearings {
-            if let BearingModel::Film(f) = &mut b.model {
-                f.viscosity_scale = scale;
-            }
         }
         Ok(())
     }

@@ -3,6 +3,7 @@
 //! balance under its static load ([`crate::film::effective_temperature`]).
 
 use super::{static_solution, BearingModel, Rotor};
+use crate::dynamics::FilmEvaluation;
 use crate::film::EffectiveTemperature;
 
 /// One film bearing's effective temperature.
@@ -37,6 +38,19 @@ impl Rotor {
         speed_rad_s: f64,
         correction: f64,
     ) -> Result<Vec<BearingTemperature>, String> {
+        self.heat_films_with(supply_k, speed_rad_s, correction, FilmEvaluation::Direct)
+    }
+
+    /// [`heat_films`](Self::heat_films) with the film evaluated as `film` says: `Direct` (the
+    /// finite solver, as `bearing` and `modes` do) or `Table` (the tabulated film the running
+    /// twin uses, shared in the process: the live twin's choice when it runs on the table).
+    pub fn heat_films_with(
+        &mut self,
+        supply_k: Option<f64>,
+        speed_rad_s: f64,
+        correction: f64,
+        film: FilmEvaluation,
+    ) -> Result<Vec<BearingTemperature>, String> {
         if !self.has_oil_heating() {
             return Ok(Vec::new());
         }
@@ -54,10 +68,16 @@ impl Rotor {
             let Some(t_s) = supply_k.or(f.design_supply_temperature_k) else {
                 continue;
             };
-            let mut film = f.scaled(f.reference_solver());
+            let inner = match film {
+                FilmEvaluation::Direct => f.reference_solver(),
+                FilmEvaluation::Table => f
+                    .reference_tabulated_solver()
+                    .map_err(|e| format!("bearing {}: tabulated film: {e}", b.name))?,
+            };
+            let mut solver = f.scaled(inner);
             let mu_ref = f.lubricant.viscosity_pa_s;
             let effective = crate::film::effective_temperature(
-                &mut film,
+                &mut solver,
                 mu_ref,
                 &law,
                 &heating,

@@ -187,6 +187,39 @@ impl Twin {
         Ok(())
     }
 
+    /// Sets each film's own viscosity scale (µ_i / µ_reference,i), `scales` in the order of the
+    /// film bearings (one each; all checked before any is set). As
+    /// [`set_viscosity_scale`](Self::set_viscosity_scale): next step, allocates nothing.
+    pub fn set_viscosity_scales(&mut self, scales: &[f64]) -> Result<(), TwinError> {
+        if scales.len() != self.links.len() {
+            return Err(TwinError::InvalidInput {
+                name: "viscosity scales (one per film bearing)",
+                value: scales.len() as f64,
+                rule: "must give one scale per film bearing",
+            });
+        }
+        for &s in scales {
+            crate::film::check_viscosity_scale(s).map_err(|_| TwinError::InvalidInput {
+                name: "viscosity scale (µ / µ_reference)",
+                value: s,
+                rule: "must be finite, between 0.02 and 50",
+            })?;
+        }
+        for (l, &s) in self.links.iter_mut().zip(scales) {
+            // checked above: cannot fail
+            let _ = l.film.set_scale(s);
+        }
+        if self.config.coupling == crate::dynamics::Coupling::Linear {
+            self.relinearise_films(self.state.speed_rad_s);
+        }
+        Ok(())
+    }
+
+    /// The viscosity scale of film `i` (in the order of the film bearings), if it exists.
+    pub fn film_viscosity_scale(&self, i: usize) -> Option<f64> {
+        self.links.get(i).map(|l| l.film.scale())
+    }
+
     /// The viscosity scale of the films (µ / µ_reference; 1 without a film).
     pub fn viscosity_scale(&self) -> f64 {
         self.links.first().map_or(1.0, |l| l.film.scale())

@@ -6,7 +6,7 @@
 use super::rules::Rules;
 use super::LubricantSpec;
 use crate::film::{
-    matrix2, BearingGeometry, FilmCoefficients, FilmGrid, FluidInertia, Lubricant, WaltherLaw,
+    matrix2, BearingGeometry, FilmCoefficients, FilmGrid, FluidInertia, Lubricant, ViscosityLaw,
 };
 use crate::rotor::ConfigError;
 use nalgebra::Matrix2;
@@ -127,7 +127,7 @@ pub struct FilmSpec {
     pub lubricant: Lubricant,
     /// The oil's viscosity–temperature law, when the file gives one (checked against
     /// `lubricant` at the design supply temperature).
-    pub viscosity_law: Option<WaltherLaw>,
+    pub viscosity_law: Option<ViscosityLaw>,
     /// The law's design supply temperature (K), with the law.
     pub design_supply_temperature_k: Option<f64>,
     /// The bearing's own heating by an effective temperature, if the file asks for it.
@@ -168,7 +168,7 @@ impl RawBearingSpec {
     /// The lubricant as written, of a film bearing.
     pub(super) fn film_lubricant(&self) -> Option<LubricantSpec> {
         match self.model {
-            BearingModelName::Finite | BearingModelName::Short => self.lubricant,
+            BearingModelName::Finite | BearingModelName::Short => self.lubricant.clone(),
             BearingModelName::Linear | BearingModelName::Rigid => None,
         }
     }
@@ -301,7 +301,7 @@ impl RawBearingSpec {
             lubricant,
             viscosity_law,
             design_supply_temperature_k: spec
-                .and_then(|l| l.viscosity_temperature)
+                .and_then(|l| l.viscosity_temperature.as_ref())
                 .map(|v| v.design_supply_temperature_c + crate::film::ZERO_CELSIUS_K),
             heating,
             grid,
@@ -311,9 +311,13 @@ impl RawBearingSpec {
     }
 
     /// The lubricant of entry `i`, and its viscosity–temperature law if given.
-    fn oil(&self, i: usize, rules: &Rules) -> Result<(Lubricant, Option<WaltherLaw>), ConfigError> {
+    fn oil(
+        &self,
+        i: usize,
+        rules: &Rules,
+    ) -> Result<(Lubricant, Option<ViscosityLaw>), ConfigError> {
         let field = |name: &str| format!("bearings[{i}].{name}");
-        let Some(lub) = self.lubricant else {
+        let Some(lub) = &self.lubricant else {
             return Err(rules.error(
                 field("lubricant"),
                 "(missing)",
@@ -325,7 +329,7 @@ impl RawBearingSpec {
         let oil = Lubricant::new(lub.density_kg_m3, lub.viscosity_pa_s)
             .map_err(|e| rules.error(field("lubricant"), format!("{lub:?}"), e))?;
         let law = match &lub.viscosity_temperature {
-            Some(spec) => Some(spec.checked_law(&lub, &field("lubricant"), rules)?),
+            Some(spec) => Some(spec.checked_law(lub, &field("lubricant"), rules)?),
             None => None,
         };
         Ok((oil, law))

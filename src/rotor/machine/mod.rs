@@ -19,7 +19,8 @@ pub use bearing::{
     BearingModelSpec, BearingSpec, FilmSpec, GroovesSpec, RawBearingSpec, SupportSpec,
 };
 pub use oil::{
-    LubricantSpec, OilHeatingModel, OilHeatingSpec, ViscosityTemperatureSpec, DEFAULT_CARRY_OVER,
+    LubricantSpec, OilHeatingModel, OilHeatingSpec, ViscosityTableSpec, ViscosityTemperatureSpec,
+    DEFAULT_CARRY_OVER,
 };
 pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 

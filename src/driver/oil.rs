@@ -1,0 +1,209 @@
+//! The oil in the live twin (issue 12): each film bearing's viscosity from the oil supply
+//! temperature in force through its own viscosity–temperature law, and, with `oil_heating` in
+//! the machine file, at its own effective temperature (`Rotor::heat_films`, Raimondi–Boyd's
+//! adiabatic heat balance (H1)–(H2) of `film::heating`).
+//!
+//! The heat balance is not redone per step: only when the speed in force has moved by more than
+//! [`HEAT_BALANCE_SPEED_STEP`] or the supply temperature by more than
+//! [`HEAT_BALANCE_TEMPERATURE_STEP_K`] since the last one (and at the first speed). Between two
+//! balances each film keeps its scale; the step itself only reads the scale (allocates nothing).
+
+use super::{inputs, Driver, Fed};
+
+/// The heat balance is redone when the speed has moved by more than this fraction since the
+/// last one: 1 % (90 rpm at 9,000 rpm) moves the seed case's T_eff by about 0.02 K (ΔT grows
+/// 0.36 K from 8,000 to 9,000 rpm, T_eff by half of it), µ by 0.02 %.
+pub const HEAT_BALANCE_SPEED_STEP: f64 = 0.01;
+
+/// … or when the supply temperature has moved by more than this (K): 0.05 K is 0.05 % of µ on
+/// the built-in law (about −1 %/K).
+pub const HEAT_BALANCE_TEMPERATURE_STEP_K: f64 = 0.05;
+
+/// The oil state the driver keeps, per film bearing (in the order of the film bearings).
+#[derive(Debug, Clone, Default)]
+pub(super) struct OilState {
+    /// µ_i(T_s) / µ_reference,i of the supply temperature in force (1 before one is received:
+    /// the machine file's viscosity)
+    law_scales: Vec<f64>,
+    /// the scales of a temperature being checked
+    scratch: Vec<f64>,
+    /// the scale in force: the heated or the law's, times the calibration's correction
+    scales: Vec<f64>,
+    /// the last heat balance: (T_eff K, µ(T_eff) / µ_reference) where the bearing is heated
+    heated: Vec<Option<(f64, f64)>>,
+    /// (speed rad/s, supply temperature K; None: the law's design one) of the last heat balance
+    balanced_at: Option<(f64, Option<f64>)>,
+    /// why the last heat balance failed, if it did (the scales before it stay in force)
+    heating_error: Option<String>,
+    /// heat balances done
+    balances: u64,
+    /// whether any film bearing models its own heating
+    heating: bool,
+}
+
+impl OilState {
+    /// The state of `rotor`'s film bearings at the machine file's viscosity.
+    pub(super) fn of(rotor: &crate::rotor::Rotor) -> Self {
+        let n = rotor.film_bearing_count();
+        Self {
+            law_scales: vec![1.0; n],
+            scratch: vec![1.0; n],
+            scales: vec![1.0; n],
+            heated: vec![None; n],
+            heating: rotor.has_oil_heating(),
+            ..Self::default()
+        }
+    }
+}
+
+/// One film bearing's oil as the driver holds it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FilmOil {
+    /// The bearing's name.
+    pub name: String,
+    /// Its viscosity scale in force (µ / µ_reference of the machine file).
+    pub viscosity_scale: f64,
+    /// Its effective temperature at the last heat balance (K), where it is heated.
+    pub effective_temperature_k: Option<f64>,
+}
+
+impl Driver {
+    /// An oil supply temperature (K): each film's scale through its own law (or its effective
+    /// temperature when heated), applied to the running twin and kept for later starts; a
+    /// refused one leaves the last good value in force.
+    pub(super) fn take_oil_temperature(&mut self, t_k: f64) -> Fed {
+        let mut scratch = std::mem::take(&mut self.oil.scratch);
+        let checked = inputs::oil_viscosity_scales(&self.rotor, t_k, &mut scratch).and_then(|()| {
+            // a calibrated viscosity in force is a factor on the law: it follows the temperature
+            let k = self.viscosity_correction.unwrap_or(1.0);
+            match scratch
+                .iter()
+                .find_map(|s| crate::film::check_viscosity_scale(s * k).err())
+            {
+                Some(e) => Err(format!("oil temperature with the calibration: {e}")),
+                None => Ok(()),
+            }
+        });
+        if let Err(why) = checked {
+            self.oil.scratch = scratch;
+            return Fed::Refused(why);
+        }
+        self.oil.law_scales.copy_from_slice(&scratch);
+        self.oil.scratch = scratch;
+        self.oil_scale = self.oil.law_scales.first().copied();
+        self.oil_temperature_k = Some(t_k);
+        self.heat_if_due();
+        match self.push_oil_scales() {
+            Ok(()) => Fed::Taken,
+            Err(why) => Fed::Refused(why),
+        }
+    }
+
+    /// After an accepted speed: the heat balance redone if it is due, and the scales applied.
+    pub(super) fn follow_speed_heating(&mut self) {
+        if self.oil.heating && self.heat_if_due() {
+            if let Err(why) = self.push_oil_scales() {
+                self.oil.heating_error = Some(why);
+            }
+        }
+    }
+
+    /// Redoes the heat balance when the speed or the supply temperature has moved past its step
+    /// since the last one (module documentation); true when it was redone.
+    fn heat_if_due(&mut self) -> bool {
+        if !self.oil.heating {
+            return false;
+        }
+        let Some(speed) = self.speed.as_ref().map(|s| s.speed_rad_s) else {
+            return false;
+        };
+        if speed < self.settings.min_speed_rad_s {
+            return false;
+        }
+        let supply = self.oil_temperature_k;
+        if let Some((w0, t0)) = self.oil.balanced_at {
+            let moved_t = match (supply, t0) {
+                (Some(a), Some(b)) => (a - b).abs() > HEAT_BALANCE_TEMPERATURE_STEP_K,
+                (None, None) => false,
+                _ => true,
+            };
+            if (speed / w0 - 1.0).abs() <= HEAT_BALANCE_SPEED_STEP && !moved_t {
+                return false;
+            }
+        }
+        self.oil.balanced_at = Some((speed, supply));
+        self.oil.balances += 1;
+        let film = self.settings.twin.film;
+        match self.rotor.heat_films_with(supply, speed, 1.0, film) {
+            Ok(temps) => {
+                for t in temps {
+                    let i = self.rotor.bearings[..t.bearing]
+                        .iter()
+                        .filter(|b| matches!(b.model, crate::rotor::BearingModel::Film(_)))
+                        .count();
+                    let e = &t.effective;
+                    self.oil.heated[i] = Some((e.effective_temperature_k, t.viscosity_scale));
+                }
+                self.oil.heating_error = None;
+            }
+            Err(e) => self.oil.heating_error = Some(e),
+        }
+        true
+    }
+
+    /// Sets the scales in force (heated or law, × the calibration's correction) on the machine
+    /// and the running twin.
+    fn push_oil_scales(&mut self) -> Result<(), String> {
+        let k = self.viscosity_correction.unwrap_or(1.0);
+        for ((s, law), heated) in self
+            .oil
+            .scales
+            .iter_mut()
+            .zip(&self.oil.law_scales)
+            .zip(&self.oil.heated)
+        {
+            *s = heated.map_or(*law, |(_, h)| h) * k;
+        }
+        self.rotor
+            .set_film_viscosity_scales(&self.oil.scales)
+            .map_err(|e| format!("oil temperature: {e}"))?;
+        if let Some(s) = self.session.as_mut() {
+            s.twin_mut()
+                .set_viscosity_scales(&self.oil.scales)
+                .map_err(|e| format!("oil temperature: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The last accepted oil supply temperature (K), if any.
+    pub fn oil_temperature_k(&self) -> Option<f64> {
+        self.oil_temperature_k
+    }
+
+    /// The viscosity scale in force of the first film bearing (µ / µ_reference of the machine
+    /// file); each bearing's: [`Self::film_oil`].
+    pub fn viscosity_scale(&self) -> f64 {
+        self.rotor.viscosity_scale()
+    }
+
+    /// Each film bearing's oil: its scale in force and, when heated, its effective temperature.
+    pub fn film_oil(&self) -> Vec<FilmOil> {
+        let films = self.rotor.bearings.iter().filter_map(|b| match &b.model {
+            crate::rotor::BearingModel::Film(f) => Some((b, f)),
+            _ => None,
+        });
+        films
+            .zip(&self.oil.heated)
+            .map(|((b, f), h)| FilmOil {
+                name: b.name.clone(),
+                viscosity_scale: f.viscosity_scale,
+                effective_temperature_k: h.map(|(t, _)| t),
+            })
+            .collect()
+    }
+
+    /// Heat balances done, and why the last one failed if it did.
+    pub fn heat_balances(&self) -> (u64, Option<&str>) {
+        (self.oil.balances, self.oil.heating_error.as_deref())
+    }
+}
