@@ -144,13 +144,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         "--ramp-rpm-s {:?} must lie between 0 and 10,000 rpm/s",
         args.ramp_rpm_s
     );
-    let mut trace = match &args.trace {
-        Some(path) => Some(std::io::BufWriter::new(
-            std::fs::File::create(path)
-                .map_err(|e| anyhow::anyhow!("--trace {}: cannot create: {e}", path.display()))?,
-        )),
-        None => None,
-    };
+    let mut trace = open_trace(args)?;
     if args.whip {
         eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
         for _ in 0..500 * 128 {
@@ -176,9 +170,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         times.push(t.elapsed().as_secs_f64() * 1e6);
         iterations += out.newton_iterations;
         contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
-        for b in &out.bearings {
-            max_eps = max_eps.max(b.eccentricity_ratio);
-        }
+        max_eps = (out.bearings.iter()).fold(max_eps, |m, b| m.max(b.eccentricity_ratio));
         write_trace(&mut trace, out)?;
     }
     if let Some(w) = trace.as_mut() {
@@ -207,8 +199,12 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         contact_step_fraction: contact_steps as f64 / n as f64,
         max_eccentricity_ratio: max_eps,
     };
+    print_twin_figures(args, &fig)
+}
+
+fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()> {
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&fig)?);
+        outln!("{}", serde_json::to_string_pretty(fig)?);
     } else {
         outln!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
         outln!(
@@ -218,6 +214,16 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The `--trace` file, created (None without the option).
+fn open_trace(args: &BenchArgs) -> anyhow::Result<Option<std::io::BufWriter<std::fs::File>>> {
+    let Some(path) = &args.trace else {
+        return Ok(None);
+    };
+    let file = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("--trace {}: cannot create: {e}", path.display()))?;
+    Ok(Some(std::io::BufWriter::new(file)))
 }
 
 /// Appends the step's time and journal positions to the trace, if one is written.
