@@ -50,6 +50,11 @@ pub struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// ORC-9000: write every step's journal positions (time, then x and y of each bearing, m;
+    /// little-endian f64, whip development included) to this file, to compare two builds step
+    /// by step (`scripts/compare_trace.py`).
+    #[arg(long)]
+    trace: Option<std::path::PathBuf>,
 }
 
 /// Timing of one case (µs).
@@ -109,6 +114,11 @@ struct TwinFigures {
     mean_step_us: f64,
     real_time_factor: f64,
     newton_iterations_per_step: f64,
+    /// Share of the measured steps with a journal in contact with the wall (Newton then
+    /// iterates to the full tolerance; away from the wall one correction usually suffices).
+    contact_step_fraction: f64,
+    /// Largest eccentricity ratio of the measured steps.
+    max_eccentricity_ratio: f64,
 }
 
 fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
@@ -134,15 +144,18 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         "--ramp-rpm-s {:?} must lie between 0 and 10,000 rpm/s",
         args.ramp_rpm_s
     );
+    let mut trace = open_trace(args)?;
     if args.whip {
         eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
         for _ in 0..500 * 128 {
-            twin.step(&input)?;
+            let out = twin.step(&input)?;
+            write_trace(&mut trace, out)?;
         }
     }
     let budget = Duration::from_secs_f64(args.seconds);
     let mut times = Vec::with_capacity(1 << 20);
     let mut iterations = 0;
+    let (mut contact_steps, mut max_eps) = (0usize, 0.0_f64);
     let start = Instant::now();
     let t0 = twin.time_s();
     while start.elapsed() < budget && times.len() < (1 << 20) {
@@ -156,6 +169,12 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         let out = twin.step(&input)?;
         times.push(t.elapsed().as_secs_f64() * 1e6);
         iterations += out.newton_iterations;
+        contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
+        max_eps = (out.bearings.iter()).fold(max_eps, |m, b| m.max(b.eccentricity_ratio));
+        write_trace(&mut trace, out)?;
+    }
+    if let Some(w) = trace.as_mut() {
+        std::io::Write::flush(w)?;
     }
     let total_us: f64 = times.iter().sum();
     let n = times.len();
@@ -177,15 +196,49 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         mean_step_us: total_us / n as f64,
         real_time_factor: h_us * n as f64 / total_us,
         newton_iterations_per_step: iterations as f64 / n as f64,
+        contact_step_fraction: contact_steps as f64 / n as f64,
+        max_eccentricity_ratio: max_eps,
     };
+    print_twin_figures(args, &fig)
+}
+
+fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()> {
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&fig)?);
+        outln!("{}", serde_json::to_string_pretty(fig)?);
     } else {
         outln!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
         outln!(
-            "  {} steps: median {:.1} µs, p99 {:.1} µs, max {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step",
-            fig.steps, fig.median_step_us, fig.p99_step_us, fig.max_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step
+            "  {} steps: median {:.1} µs, p99 {:.1} µs, max {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step; largest ε {:.3}, {:.1} % of the steps in wall contact",
+            fig.steps, fig.median_step_us, fig.p99_step_us, fig.max_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step,
+            fig.max_eccentricity_ratio, 100.0 * fig.contact_step_fraction
         );
+    }
+    Ok(())
+}
+
+/// The `--trace` file, created (None without the option).
+fn open_trace(args: &BenchArgs) -> anyhow::Result<Option<std::io::BufWriter<std::fs::File>>> {
+    let Some(path) = &args.trace else {
+        return Ok(None);
+    };
+    let file = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("--trace {}: cannot create: {e}", path.display()))?;
+    Ok(Some(std::io::BufWriter::new(file)))
+}
+
+/// Appends the step's time and journal positions to the trace, if one is written.
+fn write_trace(
+    trace: &mut Option<std::io::BufWriter<std::fs::File>>,
+    out: &crate::dynamics::StepOutput,
+) -> anyhow::Result<()> {
+    if let Some(w) = trace {
+        use std::io::Write;
+        w.write_all(&out.time_s.to_le_bytes())?;
+        for b in &out.bearings {
+            for v in b.position_m {
+                w.write_all(&v.to_le_bytes())?;
+            }
+        }
     }
     Ok(())
 }

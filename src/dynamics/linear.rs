@@ -15,39 +15,56 @@ use super::band_lu::BandLu;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::{Mat, Par};
 
-/// A square sparse matrix in compressed rows, for the per-step products (M, C, G).
+/// M, C and G in compressed rows on their common pattern (an entry where any of the three is
+/// nonzero), for the step's right-hand side: one pass over the rows with four independent sums
+/// (the products' add chains overlap) instead of four passes. A zero entry of one matrix adds an
+/// exact zero to its sum, so each sum is the same, bit for bit, as over that matrix's own
+/// nonzeros in the same column order.
 #[derive(Debug, Clone)]
-pub(crate) struct SparseRows {
+pub(crate) struct SparseMcg {
     start: Vec<usize>,
-    col: Vec<usize>,
-    val: Vec<f64>,
+    /// per entry: column, then the M, C and G values
+    entries: Vec<(usize, [f64; 3])>,
 }
 
-impl SparseRows {
-    /// The nonzero entries of a dense matrix.
-    pub(crate) fn from_dense(m: &Mat<f64>) -> Self {
+impl SparseMcg {
+    /// The entries of three dense matrices of one size where any is nonzero.
+    pub(crate) fn from_dense(m: &Mat<f64>, c: &Mat<f64>, g: &Mat<f64>) -> Self {
         let mut start = vec![0];
-        let (mut col, mut val) = (Vec::new(), Vec::new());
+        let mut entries = Vec::new();
         for i in 0..m.nrows() {
             for j in 0..m.ncols() {
-                if m[(i, j)] != 0.0 {
-                    col.push(j);
-                    val.push(m[(i, j)]);
+                let v = [m[(i, j)], c[(i, j)], g[(i, j)]];
+                if v != [0.0; 3] {
+                    entries.push((j, v));
                 }
             }
-            start.push(col.len());
+            start.push(entries.len());
         }
-        Self { start, col, val }
+        Self { start, entries }
     }
 
-    /// out += scale · A x. Allocates nothing.
-    pub(crate) fn add_product(&self, scale: f64, x: &[f64], out: &mut [f64]) {
+    /// out += M x_m + C x_c + Ω_f G x_c + Ω_d G x_g (summed in that order, row by row).
+    /// Allocates nothing.
+    pub(crate) fn add_products(
+        &self,
+        [x_m, x_c, x_g]: [&[f64]; 3],
+        omega_f: f64,
+        omega_d: f64,
+        out: &mut [f64],
+    ) {
         for (i, o) in out.iter_mut().enumerate() {
-            let mut s = 0.0;
-            for k in self.start[i]..self.start[i + 1] {
-                s += self.val[k] * x[self.col[k]];
+            let (mut sm, mut sc, mut sg, mut sd) = (0.0, 0.0, 0.0, 0.0);
+            for &(j, [m, c, g]) in &self.entries[self.start[i]..self.start[i + 1]] {
+                sm += m * x_m[j];
+                sc += c * x_c[j];
+                sg += g * x_c[j];
+                sd += g * x_g[j];
             }
-            *o += scale * s;
+            *o += sm;
+            *o += sc;
+            *o += omega_f * sg;
+            *o += omega_d * sd;
         }
     }
 }

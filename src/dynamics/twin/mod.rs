@@ -1,7 +1,7 @@
 //! The engine: state, construction at the static equilibrium, and the time step.
 
 use super::bearing_link::{BearingLink, LinearReference, LinkEvaluation};
-use super::linear::{SparseRows, StepFactor};
+use super::linear::{SparseMcg, StepFactor};
 use super::{BearingState, ProbeState, StepOutput, TwinConfig, TwinError};
 use crate::film::{FilmCoefficients, FilmModel, JournalKinematics};
 use crate::rotor::Unbalance;
@@ -44,6 +44,10 @@ pub struct Checkpoint {
     external: Vec<f64>,
 }
 
+/// A probe station in the step: the reduced DOFs of its node (x, y), and the sine and cosine of
+/// each probe's angle (taken once: a reading is x cos a + y sin a).
+type ProbeStation = ([usize; 2], [(f64, f64); 2]);
+
 /// The twin core (see the module documentation of [`crate::dynamics`]).
 pub struct Twin {
     config: TwinConfig,
@@ -51,9 +55,8 @@ pub struct Twin {
     c: Mat<f64>,
     g: Mat<f64>,
     k: Mat<f64>,
-    m_rows: SparseRows,
-    c_rows: SparseRows,
-    g_rows: SparseRows,
+    /// M, C, G in compressed rows for the step's right-hand side
+    mcg_rows: SparseMcg,
     /// full DOF → reduced index (or HELD)
     reduced_of: Vec<usize>,
     gravity: Vec<f64>,
@@ -63,12 +66,13 @@ pub struct Twin {
     b_dofs: Vec<usize>,
     /// factors for h, h/2, h/4
     factors: Vec<StepFactor>,
-    probes: Vec<([usize; 2], [f64; 2])>,
+    probes: Vec<ProbeStation>,
     state: State,
     rated_speed_rad_s: f64,
     // scratch, sized once
     rhs: Vec<f64>,
     tmp: Vec<f64>,
+    tmp_c: Vec<f64>,
     q_lin: Vec<f64>,
     next: State,
     /// the state before a step, for retries
@@ -352,7 +356,7 @@ impl Twin {
             let x = [at(dofs[0]), at(dofs[1])];
             *p = ProbeState {
                 displacement_m: x,
-                readings_m: angles.map(|a| x[0] * a.cos() + x[1] * a.sin()),
+                readings_m: angles.map(|(sin, cos)| x[0] * cos + x[1] * sin),
             };
         }
     }

@@ -2,7 +2,7 @@
 
 use super::{State, Twin, HELD};
 use crate::dynamics::bearing_link::{BearingLink, LinkEvaluation};
-use crate::dynamics::linear::{SparseRows, StepFactor};
+use crate::dynamics::linear::{SparseMcg, StepFactor};
 use crate::dynamics::{
     BearingState, Coupling, FilmEvaluation, ProbeState, StepOutput, TwinConfig, TwinError,
 };
@@ -84,7 +84,11 @@ impl Twin {
             .iter()
             .map(|p| {
                 let r = &sys.reduced_of;
-                ([r[4 * p.node], r[4 * p.node + 1]], p.angles_rad)
+                let [a, b] = p.angles_rad;
+                (
+                    [r[4 * p.node], r[4 * p.node + 1]],
+                    [a.sin_cos(), b.sin_cos()],
+                )
             })
             .collect();
         let output = StepOutput {
@@ -94,9 +98,7 @@ impl Twin {
         };
         Self {
             config,
-            m_rows: SparseRows::from_dense(&sys.m),
-            c_rows: SparseRows::from_dense(&sys.c),
-            g_rows: SparseRows::from_dense(&sys.g),
+            mcg_rows: SparseMcg::from_dense(&sys.m, &sys.c, &sys.g),
             m: sys.m,
             c: sys.c,
             g: sys.g,
@@ -118,6 +120,7 @@ impl Twin {
             rated_speed_rad_s: rotor.rated_speed_rad_s,
             rhs: vec![0.0; n],
             tmp: vec![0.0; n],
+            tmp_c: vec![0.0; n],
             q_lin: vec![0.0; n],
             qb: vec![0.0; nb],
             a_b: vec![0.0; nb],

@@ -141,16 +141,14 @@ impl Twin {
         let s = &self.state;
         for i in 0..n {
             self.tmp[i] = nm.a0 * s.q[i] + nm.a1 * s.qd[i] + s.qdd[i];
+            self.tmp_c[i] = nm.a2 * s.q[i] + s.qd[i];
         }
-        self.m_rows.add_product(1.0, &self.tmp, &mut self.rhs);
-        for i in 0..n {
-            self.tmp[i] = nm.a2 * s.q[i] + s.qd[i];
-        }
-        self.c_rows.add_product(1.0, &self.tmp, &mut self.rhs);
-        self.g_rows
-            .add_product(factored_speed, &self.tmp, &mut self.rhs);
-        self.g_rows
-            .add_product(-(speed - factored_speed), &s.qd, &mut self.rhs);
+        self.mcg_rows.add_products(
+            [&self.tmp, &self.tmp_c, &s.qd],
+            factored_speed,
+            -(speed - factored_speed),
+            &mut self.rhs,
+        );
         self.factors[level].solve(&self.rhs, &mut self.q_lin);
         for (r, &d) in self.b_dofs.iter().enumerate() {
             self.a_b[r] = self.q_lin[d];

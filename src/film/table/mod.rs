@@ -68,6 +68,25 @@ struct Node {
     inflow_couette: f64,
 }
 
+impl Node {
+    /// Adds `w` × `m`, field by field.
+    #[inline]
+    fn add(&mut self, w: f64, m: &Node) {
+        self.force[0] += w * m.force[0];
+        self.force[1] += w * m.force[1];
+        self.p_max += w * m.p_max;
+        for k in 0..3 {
+            self.angles[k][0] += w * m.angles[k][0];
+            self.angles[k][1] += w * m.angles[k][1];
+        }
+        self.torque_pressure += w * m.torque_pressure;
+        self.torque_couette += w * m.torque_couette;
+        self.side_flow += w * m.side_flow;
+        self.inflow_pressure += w * m.inflow_pressure;
+        self.inflow_couette += w * m.inflow_couette;
+    }
+}
+
 /// One row of the table as built: its index, nodes and mid-plane profiles.
 type Row = (usize, Vec<Node>, Vec<f64>);
 
@@ -296,23 +315,31 @@ impl FilmTable {
         let mut n = Node::default();
         for (a, &r) in rows.iter().enumerate() {
             for (b, &c) in cols.iter().enumerate() {
-                let w = wr[a] * wc[b];
-                let m = &self.nodes[r * N_PSI + c];
-                n.force[0] += w * m.force[0];
-                n.force[1] += w * m.force[1];
-                n.p_max += w * m.p_max;
-                for k in 0..3 {
-                    n.angles[k][0] += w * m.angles[k][0];
-                    n.angles[k][1] += w * m.angles[k][1];
-                }
-                n.torque_pressure += w * m.torque_pressure;
-                n.torque_couette += w * m.torque_couette;
-                n.side_flow += w * m.side_flow;
-                n.inflow_pressure += w * m.inflow_pressure;
-                n.inflow_couette += w * m.inflow_couette;
+                n.add(wr[a] * wc[b], &self.nodes[r * N_PSI + c]);
             }
         }
         n
+    }
+
+    /// The interpolated node at (ε, ψ) and its force's derivatives with respect to ε and ψ
+    /// (those of [`force_with_slopes`](Self::force_with_slopes), from the same stencil pass:
+    /// the same sums in the same order).
+    fn node_with_slopes(&self, eps: f64, psi: f64) -> (Node, [f64; 2], [f64; 2]) {
+        let st = self.stencil_with_slopes(eps, psi);
+        let mut n = Node::default();
+        let (mut f_eps, mut f_psi) = ([0.0; 2], [0.0; 2]);
+        for a in 0..4 {
+            for b in 0..4 {
+                let m = &self.nodes[st.rows[a] * N_PSI + st.cols[b]];
+                n.add(st.wr[a] * st.wc[b], m);
+                let (w_eps, w_psi) = (st.dwr[a] * st.wc[b], st.wr[a] * st.dwc[b]);
+                f_eps[0] += w_eps * m.force[0];
+                f_eps[1] += w_eps * m.force[1];
+                f_psi[0] += w_psi * m.force[0];
+                f_psi[1] += w_psi * m.force[1];
+            }
+        }
+        (n, f_eps, f_psi)
     }
 
     /// The film force `[F_x, F_y]` (N) in the fixed frame for `kin` (no checks).
@@ -329,11 +356,26 @@ impl FilmTable {
 impl FilmTable {
     /// −∂F/∂(x, y) and −∂F/∂(ẋ, ẏ) of the interpolant by the chain rule through the line of
     /// centres: F = R(φ) V f(ε, ψ), with U = ω ε − 2 v_t / c, W = 2 v_r / c, V = √(U² + W²),
-    /// ψ = atan2(W, U). Away from the centre (ε > 10⁻³) only.
+    /// ψ = atan2(W, U). Away from the centre (ε > 10⁻³) only. (The film reads
+    /// [`node_with_slopes`](Self::node_with_slopes) and
+    /// [`coefficients_from_slopes`](Self::coefficients_from_slopes); this is the tests' path.)
+    #[cfg(test)]
     fn analytic_coefficients(
         &self,
         kin: &JournalKinematics,
         s: &LineOfCentres,
+    ) -> (Matrix2<f64>, Matrix2<f64>) {
+        let [f, f_eps, f_psi] = self.force_with_slopes(s.eps, s.psi);
+        self.coefficients_from_slopes(kin, s, [f, f_eps, f_psi])
+    }
+
+    /// [`analytic_coefficients`](Self::analytic_coefficients) from the interpolated force per
+    /// unit V and its slopes d/dε, d/dψ at the state.
+    fn coefficients_from_slopes(
+        &self,
+        kin: &JournalKinematics,
+        s: &LineOfCentres,
+        [f, f_eps, f_psi]: [[f64; 2]; 3],
     ) -> (Matrix2<f64>, Matrix2<f64>) {
         let c = self.geometry.radial_clearance_m;
         let (cp, sp) = (s.cos_phi, s.sin_phi);
@@ -343,7 +385,6 @@ impl FilmTable {
         let v_t = -vx * sp + vy * cp;
         let omega = kin.speed_rad_s;
         let (u, w) = (omega * s.eps - 2.0 * v_t / c, 2.0 * v_r / c);
-        let [f, f_eps, f_psi] = self.force_with_slopes(s.eps, s.psi);
         let g = [s.v * f[0], s.v * f[1]];
         // per variable x, y, ẋ, ẏ: derivatives of ε, φ, v_r, v_t
         let eps_q = [cp / c, sp / c, 0.0, 0.0];

@@ -1,7 +1,7 @@
 //! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
 //! interpolated, the eight coefficients by the chain rule.
 
-use super::{FilmTable, LineOfCentres, N_PSI};
+use super::{FilmTable, LineOfCentres, Node, N_PSI};
 use crate::film::{
     wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
     JournalKinematics,
@@ -41,34 +41,28 @@ impl FilmModel for TabulatedFilm {
         self.last = *kin;
         let s = LineOfCentres::of(kin, c);
         let n = self.table.node_at(s.eps, s.psi);
-        let omega = kin.speed_rad_s;
-        let angle = |k: usize| wrap_angle_rad(s.phi() + n.angles[k][1].atan2(n.angles[k][0]));
-        let zone = s.v > 0.0 && n.p_max > 0.0;
-        let torque = omega * n.torque_couette + s.v * n.torque_pressure;
-        Ok(FilmResult {
-            force_n: s.rotate_to_fixed([s.v * n.force[0], s.v * n.force[1]]),
-            max_pressure_pa: (s.v * n.p_max).max(0.0),
-            max_pressure_angle_rad: if zone { angle(0) } else { 0.0 },
-            film_start_rad: if zone { angle(1) } else { 0.0 },
-            film_end_rad: if zone { angle(2) } else { 0.0 },
-            friction_torque_n_m: torque,
-            power_loss_w: torque * omega,
-            side_flow_m3_s: s.v * n.side_flow,
-            inflow_m3_s: omega * n.inflow_couette + s.v * n.inflow_pressure,
-        })
+        Ok(result_of(&s, &n, kin.speed_rad_s))
     }
 
     fn solve_with_coefficients(
         &mut self,
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
-        let result = self.solve(kin)?;
         let c = self.table.geometry.radial_clearance_m;
+        kin.validate(c)?;
+        self.last = *kin;
         let s = LineOfCentres::of(kin, c);
-        let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
-            self.table.analytic_coefficients(kin, &s)
+        // one stencil pass gives the node and its force's slopes (the analytic coefficients)
+        let (result, (k, d)) = if s.eps > 1e-3 && s.v > 0.0 {
+            let (n, f_eps, f_psi) = self.table.node_with_slopes(s.eps, s.psi);
+            let coefficients =
+                self.table
+                    .coefficients_from_slopes(kin, &s, [n.force, f_eps, f_psi]);
+            (result_of(&s, &n, kin.speed_rad_s), coefficients)
         } else {
-            self.table.difference_coefficients(kin)
+            let n = self.table.node_at(s.eps, s.psi);
+            let coefficients = self.table.difference_coefficients(kin);
+            (result_of(&s, &n, kin.speed_rad_s), coefficients)
         };
         Ok((
             result,
@@ -136,21 +130,95 @@ impl FilmModel for TabulatedFilm {
     }
 }
 
+/// The film's result at state `s` (line-of-centres frame) from the interpolated node `n`, at
+/// speed `omega` (rad/s): the force turned back to the fixed frame, the angles of p_max, ζ1 and
+/// ζ2 from the attitude (computed once) and their unit vectors in the node.
+fn result_of(s: &LineOfCentres, n: &Node, omega: f64) -> FilmResult {
+    let zone = s.v > 0.0 && n.p_max > 0.0;
+    let phi = if zone { s.phi() } else { 0.0 };
+    let angle = |k: usize| {
+        if zone {
+            wrap_angle_rad(phi + n.angles[k][1].atan2(n.angles[k][0]))
+        } else {
+            0.0
+        }
+    };
+    let torque = omega * n.torque_couette + s.v * n.torque_pressure;
+    FilmResult {
+        force_n: s.rotate_to_fixed([s.v * n.force[0], s.v * n.force[1]]),
+        max_pressure_pa: (s.v * n.p_max).max(0.0),
+        max_pressure_angle_rad: angle(0),
+        film_start_rad: angle(1),
+        film_end_rad: angle(2),
+        friction_torque_n_m: torque,
+        power_loss_w: torque * omega,
+        side_flow_m3_s: s.v * n.side_flow,
+        inflow_m3_s: omega * n.inflow_couette + s.v * n.inflow_pressure,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::film::{FilmGrid, Lubricant};
 
+    /// The seed bearing's table (D 60 mm, L 30 mm, c 40 µm, 60 × 10).
+    fn seed_table() -> Arc<FilmTable> {
+        let geometry = BearingGeometry::plain(0.06, 0.03, 40e-6).unwrap();
+        let lubricant = Lubricant::new(900.0, 0.0008).unwrap();
+        FilmTable::shared(&geometry, lubricant, FilmGrid::new(60, 10).unwrap()).unwrap()
+    }
+
+    /// The journal at ε, attitude φ, with radial and tangential velocities given as fractions
+    /// of c ω, in the fixed frame.
+    fn kinematics(eps: f64, phi: f64, [vr, vt]: [f64; 2], c: f64, w: f64) -> JournalKinematics {
+        let (vr, vt) = (vr * c * w, vt * c * w);
+        JournalKinematics {
+            position_m: [eps * c * f64::cos(phi), eps * c * f64::sin(phi)],
+            velocity_m_s: [
+                vr * f64::cos(phi) - vt * f64::sin(phi),
+                vr * f64::sin(phi) + vt * f64::cos(phi),
+            ],
+            speed_rad_s: w,
+        }
+    }
+
+    /// The film's one-pass evaluation (node and slopes from one stencil pass, issue 17) gives,
+    /// bit for bit, what the separate passes give: the result of `solve`, and the coefficients
+    /// of the chain rule on `force_with_slopes` (the same sums in the same order), at states
+    /// across the table (whip orbits near the wall, fast squeeze, the centre's fallback).
+    #[test]
+    fn one_pass_evaluation_equals_the_separate_passes_exactly() {
+        let (table, c, w) = (seed_table(), 40e-6, 942.0);
+        let mut film = TabulatedFilm::new(table.clone());
+        for (eps, phi, vr, vt) in [
+            (0.3, 0.4, 0.01, -0.02),
+            (0.6, 2.0, -0.05, 0.1),
+            (0.85, 4.0, 0.2, 0.05),
+            (0.97, 5.5, -0.1, -0.2),
+            (0.5, -2.5, 0.3, 0.6),
+            (0.0005, 1.0, 0.0, 0.0),
+        ] {
+            let kin = kinematics(eps, phi, [vr, vt], c, w);
+            let (r, coef) = film.solve_with_coefficients(&kin).unwrap();
+            let alone = film.solve(&kin).unwrap();
+            assert_eq!(r, alone, "ε {eps}: result");
+            let s = LineOfCentres::of(&kin, c);
+            let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
+                table.analytic_coefficients(&kin, &s)
+            } else {
+                table.difference_coefficients(&kin)
+            };
+            assert_eq!(coef.stiffness_n_per_m, k, "ε {eps}: stiffness");
+            assert_eq!(coef.damping_n_s_per_m, d, "ε {eps}: damping");
+        }
+    }
+
     /// The chain-rule coefficients of the interpolant equal its central differences (steps
     /// 1e-6 c, 1e-6 c ω) to 1e-4 of the matrix scale, at states across the table.
     #[test]
     fn analytic_coefficients_match_differences_of_the_interpolant() {
-        let geometry = BearingGeometry::plain(0.06, 0.03, 40e-6).unwrap();
-        let lubricant = Lubricant::new(900.0, 0.0008).unwrap();
-        let table =
-            FilmTable::shared(&geometry, lubricant, FilmGrid::new(60, 10).unwrap()).unwrap();
-        let c = 40e-6;
-        let w = 942.0;
+        let (table, c, w) = (seed_table(), 40e-6, 942.0);
         for (eps, phi, vr, vt) in [
             (0.3, 0.4, 0.01, -0.02),
             (0.6, 2.0, -0.05, 0.1),
@@ -158,15 +226,7 @@ mod tests {
             (0.95, 5.5, -0.1, -0.2),
             (0.05, 1.0, 0.0, 0.0),
         ] {
-            let (vr, vt) = (vr * c * w, vt * c * w);
-            let kin = JournalKinematics {
-                position_m: [eps * c * f64::cos(phi), eps * c * f64::sin(phi)],
-                velocity_m_s: [
-                    vr * f64::cos(phi) - vt * f64::sin(phi),
-                    vr * f64::sin(phi) + vt * f64::cos(phi),
-                ],
-                speed_rad_s: w,
-            };
+            let kin = kinematics(eps, phi, [vr, vt], c, w);
             let s = LineOfCentres::of(&kin, c);
             let (ka, da) = table.analytic_coefficients(&kin, &s);
             // fine central differences (not the coarse fallback's steps)
