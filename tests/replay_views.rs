@@ -115,14 +115,33 @@ fn block_gaps(report: &Value, n0: f64, n1: f64) -> Vec<(f64, f64, f64)> {
     gaps
 }
 
-/// The worst |amplitude error| and |lag error| of `gaps`, printed with the mean lag error.
-fn worst(gaps: &[(f64, f64, f64)], what: &str) -> (f64, f64) {
+/// The script's run-up (`seconds`, `n0` → `n1` rpm) replayed in a scratch directory `name`,
+/// every block read back ([`assert_blocks_read_back`]): the directory, the report, the output.
+fn run_up_read_back(
+    name: &str,
+    seconds: f64,
+    (n0, n1): (f64, f64),
+    readings: usize,
+    amp_tol: f64,
+) -> (PathBuf, Value, PathBuf) {
+    let dir = scratch(name);
+    let (report, out) = replay_run_up(&dir, seconds, n0, n1);
+    assert_blocks_read_back(&report, (n0, n1), readings, amp_tol);
+    (dir, report, out)
+}
+
+/// Every block of `report` (a run-up `n0` → `n1` rpm) within `amp_tol` (relative) of the
+/// script's amplitude and 1° of its lag, at least `readings` of them; the worst and the mean
+/// lag error printed.
+fn assert_blocks_read_back(report: &Value, (n0, n1): (f64, f64), readings: usize, amp_tol: f64) {
+    let gaps = block_gaps(report, n0, n1);
+    assert!(gaps.len() >= readings, "{} block readings", gaps.len());
     let worst_amp = gaps.iter().map(|g| g.0.abs()).fold(0.0, f64::max);
     let worst_lag = gaps.iter().map(|g| g.1.abs()).fold(0.0, f64::max);
     let mean_lag = gaps.iter().map(|g| g.1).sum::<f64>() / gaps.len() as f64;
     let first = gaps.iter().min_by(|a, b| a.2.total_cmp(&b.2)).unwrap();
     eprintln!(
-        "{what}: {} block readings, worst amplitude {:.2} %, worst lag {:.2}°, mean lag {:+.2}°, \
+        "run-up {n0}–{n1} rpm: {} block readings, worst amplitude {:.2} %, worst lag {:.2}°, mean lag {:+.2}°, \
          lowest-speed block {:.0} rpm lag {:+.2}°",
         gaps.len(),
         100.0 * worst_amp,
@@ -131,7 +150,8 @@ fn worst(gaps: &[(f64, f64, f64)], what: &str) -> (f64, f64) {
         first.2,
         first.1
     );
-    (worst_amp, worst_lag)
+    assert!(worst_amp < amp_tol, "amplitude off by {worst_amp}");
+    assert!(worst_lag < 1.0, "lag off by {worst_lag}°");
 }
 
 /// A run-up from 6,000 to 8,000 rpm in 2 s (1,000 rpm/s), keyphasor and four raw probes (µm,
@@ -139,18 +159,13 @@ fn worst(gaps: &[(f64, f64, f64)], what: &str) -> (f64, f64) {
 /// 30° → 120° (linear in speed), with a 0.5 µm forward 0.5X circle beside it. Each block of 8
 /// revolutions reads the script's amplitude at its mean speed within 1 % and the lag within 1°
 /// on both probe axes of both stations (the lag read against the plant's keyphasor events, as
-/// the node does; measured 0.38 % and 0.43°, mean lag −0.04°). The report has the blocks' full spectra, the static centerline locus inside
-/// the clearance, and says why an AC probe gives no measured centerline; each plot reads back.
+/// the node does; measured 0.38 % and 0.43°, mean lag −0.04°). The report has the blocks' full
+/// spectra, the static centerline locus inside the clearance, and says why an AC probe gives no
+/// measured centerline; each plot reads back.
 #[test]
 fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
-    let (n0, n1) = (6000.0, 8000.0);
-    let dir = scratch("runup");
-    let (report, out) = replay_run_up(&dir, 2.0, n0, n1);
-    let gaps = block_gaps(&report, n0, n1);
-    assert!(gaps.len() >= 4 * 25, "{} block readings", gaps.len());
-    let (worst_amp, worst_lag) = worst(&gaps, "run-up 6,000–8,000 rpm in 2 s");
-    assert!(worst_amp < 0.01, "amplitude off by {worst_amp}");
-    assert!(worst_lag < 1.0, "lag off by {worst_lag}°");
+    // 25 blocks or more at each station, 2 axes each
+    let (dir, report, out) = run_up_read_back("runup", 2.0, (6000.0, 8000.0), 4 * 25, 0.01);
     for st in report["stations"].as_array().unwrap() {
         let blocks = st["blocks"].as_array().unwrap();
         // the report's view numbers
@@ -198,15 +213,8 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
 /// speed, 2 % of amplitude and 2° of lag here, before the block's speed became the plant's).
 #[test]
 fn a_fast_run_up_reads_its_lag_against_the_plants_keyphasor() {
-    let (n0, n1) = (3000.0, 5000.0);
-    let dir = scratch("fast-runup");
-    let (report, _) = replay_run_up(&dir, 0.8, n0, n1);
-    let gaps = block_gaps(&report, n0, n1);
     // 53 revolutions: 6 blocks of 8 at each station, 2 axes each
-    assert!(gaps.len() >= 4 * 6, "{} block readings", gaps.len());
-    let (worst_amp, worst_lag) = worst(&gaps, "run-up 3,000–5,000 rpm in 0.8 s");
-    assert!(worst_lag < 1.0, "lag off by {worst_lag}°");
-    assert!(worst_amp < 0.015, "amplitude off by {worst_amp}");
+    let (dir, ..) = run_up_read_back("fast-runup", 0.8, (3000.0, 5000.0), 4 * 6, 0.015);
     std::fs::remove_dir_all(&dir).ok();
 }
 

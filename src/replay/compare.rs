@@ -783,6 +783,29 @@ mod tests {
         assert!((t_on - steady.blocks[0].end_s).abs() < 1e-9);
     }
 
+    /// Three blocks of the orbits `measured` and `predicted` (functions of the shaft angle), 64
+    /// samples a revolution at 150 rev/s, keyphasor-locked.
+    fn three_blocks(
+        measured: impl Fn(f64) -> [f64; 2],
+        predicted: impl Fn(f64) -> [f64; 2],
+    ) -> StationComparison {
+        let mut c = StationComparison::new("s", 40e-6);
+        for i in 0..=3 * BLOCK_REVS * 64 {
+            let psi = TAU * i as f64 / 64.0;
+            let s = Sample {
+                time_s: psi / (TAU * 150.0),
+                time_ns: 0,
+                angle_rad: psi,
+                speed_rad_s: TAU * 150.0,
+                measured_m: measured(psi),
+                predicted_m: predicted(psi),
+                phase_reference: PhaseReference::Locked,
+            };
+            c.push(s, None);
+        }
+        c
+    }
+
     /// The full spectrum of x + iy (issue 16), known signals through the blocks: a forward
     /// circle of 2 µm puts all of it in +1X; a backward one in −1X; a line (a degenerate
     /// ellipse) x = 2 µm cos ψ splits equally, 1 µm each way; a forward 0.5X whirl shows at
@@ -815,22 +838,7 @@ mod tests {
             ),
         ];
         for (name, orbit, bin, [fwd, bwd]) in cases {
-            let mut c = StationComparison::new("s", 40e-6);
-            for i in 0..=3 * BLOCK_REVS * 64 {
-                let psi = TAU * i as f64 / 64.0;
-                c.push(
-                    Sample {
-                        time_s: psi / (TAU * 150.0),
-                        time_ns: 0,
-                        angle_rad: psi,
-                        speed_rad_s: TAU * 150.0,
-                        measured_m: orbit(psi),
-                        predicted_m: orbit(psi),
-                        phase_reference: PhaseReference::Locked,
-                    },
-                    None,
-                );
-            }
+            let c = three_blocks(orbit, orbit);
             assert_eq!(c.block_spectra.len(), 3, "{name}");
             for b in &c.block_spectra {
                 let full = b.measured_full_m;
@@ -875,22 +883,7 @@ mod tests {
             );
             [one[0] + sub[0], one[1] + sub[1]]
         };
-        let mut c = StationComparison::new("s", 40e-6);
-        for i in 0..=3 * BLOCK_REVS * 64 {
-            let psi = TAU * i as f64 / 64.0;
-            c.push(
-                Sample {
-                    time_s: psi / (TAU * 150.0),
-                    time_ns: 0,
-                    angle_rad: psi,
-                    speed_rad_s: TAU * 150.0,
-                    measured_m: orbit(psi),
-                    predicted_m: orbit(psi + TAU / 4.0),
-                    phase_reference: PhaseReference::Locked,
-                },
-                None,
-            );
-        }
+        let c = three_blocks(orbit, |psi| orbit(psi + TAU / 4.0));
         assert_eq!(c.blocks.len(), 3);
         for b in &c.blocks {
             for f in [&b.measured, &b.predicted] {
