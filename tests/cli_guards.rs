@@ -602,6 +602,38 @@ fn bearing_names_a_speed_out_of_its_range() {
     );
 }
 
+/// `bearing --speeds` ends at the journal's surface speed limit as `--speed-rpm` does (500 m/s:
+/// 159,155 rpm for the flags' Ø 60 mm; the machine file's journal, also Ø 60 mm, the same),
+/// refused before any equilibrium is sought, the error naming the field, the value and the
+/// bound (before session 10 a sweep to 1e9 rpm ran, "static equilibrium ... not found" or a
+/// table of nonsense). A range ending at the bound still runs.
+#[test]
+fn bearing_speeds_end_at_the_surface_speed_limit() {
+    let machine = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/config/orc_microturbine_100kw.yaml"
+    );
+    for extra in [&[][..], &["--config", machine][..]] {
+        for (range, shown) in [
+            ("1000:200000:50000", "200000"),
+            ("1000:1e12:5e11", "1.000e12"),
+        ] {
+            let mut args = vec!["bearing", "--speeds", range];
+            args.extend_from_slice(extra);
+            let err = refused(
+                &args,
+                &format!("invalid --speeds: {shown} rpm is above 159155 rpm"),
+            );
+            assert!(err.contains("500 m/s") && err.contains("0.06 m"), "{err}");
+            assert!(!err.contains("equilibrium"), "{err}");
+        }
+    }
+    let (ok, out, err) = run_cli(&["bearing", "--speeds", "100000:150000:50000", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["speeds"].as_array().map(Vec::len), Some(2), "{v}");
+}
+
 /// Numbers in errors are shown in a bounded format, never 300 digits (issue 15, item 21).
 #[test]
 fn huge_numbers_are_not_echoed_whole() {

@@ -50,25 +50,16 @@ fn truth(n: f64, n0: f64, n1: f64) -> (f64, f64) {
     (2.0 + 2.0 * s, 30.0 + 90.0 * s)
 }
 
-/// A run-up from 6,000 to 8,000 rpm in 2 s (1,000 rpm/s), keyphasor and four raw probes (µm,
-/// AC) in standard types, no speed topic; the 1X is a forward circle of 2 → 4 µm lagging by
-/// 30° → 120° (linear in speed), with a 0.5 µm forward 0.5X circle beside it. Each block of 8
-/// revolutions reads the script's amplitude at its mean speed within 1 % and the lag within 1°
-/// on both probe axes of both stations (measured: 0.61 % and 0.72°; the lag reads early by
-/// about a·T², the keyphasor lock trailing an accelerating shaft: 0.6° at 6,040 rpm). The
-/// report has the blocks' full spectra, the static centerline locus inside the clearance, and
-/// says why an AC probe gives no measured centerline; each plot reads back.
-#[test]
-fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
-    let (n0, n1) = (6000.0, 8000.0);
-    let dir = scratch("runup");
+/// The script's run-up bag (`seconds`, `n0` → `n1` rpm) replayed on the raw-probe machine into
+/// `dir`/out: the JSON report and the output directory.
+fn replay_run_up(dir: &Path, seconds: f64, n0: f64, n1: f64) -> (Value, PathBuf) {
     let bag = dir.join("bag");
-    let (n0s, n1s) = (n0.to_string(), n1.to_string());
+    let (secs, n0s, n1s) = (seconds.to_string(), n0.to_string(), n1.to_string());
     common::interop_script(
         "write_runup_signal_bag.py",
-        [bag.as_os_str(), "2.0".as_ref(), n0s.as_ref(), n1s.as_ref()],
+        [bag.as_os_str(), secs.as_ref(), n0s.as_ref(), n1s.as_ref()],
     );
-    let config = raw_probe_machine(&dir);
+    let config = raw_probe_machine(dir);
     let out = dir.join("out");
     let mut args: Vec<String> = [
         "replay",
@@ -93,14 +84,17 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let (ok, stdout, stderr) = run_cli(&args);
     assert!(ok, "{stdout}\n{stderr}");
-    let report: Value = serde_json::from_str(&stdout).unwrap();
+    (serde_json::from_str(&stdout).unwrap(), out)
+}
+
+/// Every block's measured 1X on both probe axes of both stations against the script's truth at
+/// the block's mean speed: (relative amplitude error, lag read − truth in degrees, speed rpm).
+fn block_gaps(report: &Value, n0: f64, n1: f64) -> Vec<(f64, f64, f64)> {
+    let mut gaps = Vec::new();
     let stations = report["stations"].as_array().unwrap();
     assert_eq!(stations.len(), 2);
-    let (mut worst_amp, mut worst_lag) = (0.0f64, 0.0f64);
     for st in stations {
-        let blocks = st["blocks"].as_array().unwrap();
-        assert!(blocks.len() >= 25, "{} blocks", blocks.len());
-        for b in blocks {
+        for b in st["blocks"].as_array().unwrap() {
             let n = b["speed_rpm"].as_f64().unwrap();
             let (a, beta) = truth(n, n0, n1);
             let axes = b["measured"]["one_x_probe_axes"]
@@ -109,8 +103,7 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
             for (j, alpha) in [45.0, 135.0].iter().enumerate() {
                 let amp = axes[j]["amplitude_m"].as_f64().unwrap() * 1e6;
                 let lag = axes[j]["phase_lag_deg"].as_f64().unwrap();
-                worst_amp = worst_amp.max((amp / a - 1.0).abs());
-                worst_lag = worst_lag.max(lag_gap(lag, beta + alpha).abs());
+                gaps.push((amp / a - 1.0, lag_gap(lag, beta + alpha), n));
                 // the amplitude needs no keyphasor: given beside the vector
                 let plain = b["measured"]["one_x_probe_amplitudes_m"][j]
                     .as_f64()
@@ -118,6 +111,63 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
                 assert!((plain * 1e6 - amp).abs() < 1e-9);
             }
         }
+    }
+    gaps
+}
+
+/// The script's run-up (`seconds`, `n0` → `n1` rpm) replayed in a scratch directory `name`,
+/// every block read back ([`assert_blocks_read_back`]): the directory, the report, the output.
+fn run_up_read_back(
+    name: &str,
+    seconds: f64,
+    (n0, n1): (f64, f64),
+    readings: usize,
+    amp_tol: f64,
+) -> (PathBuf, Value, PathBuf) {
+    let dir = scratch(name);
+    let (report, out) = replay_run_up(&dir, seconds, n0, n1);
+    assert_blocks_read_back(&report, (n0, n1), readings, amp_tol);
+    (dir, report, out)
+}
+
+/// Every block of `report` (a run-up `n0` → `n1` rpm) within `amp_tol` (relative) of the
+/// script's amplitude and 1° of its lag, at least `readings` of them; the worst and the mean
+/// lag error printed.
+fn assert_blocks_read_back(report: &Value, (n0, n1): (f64, f64), readings: usize, amp_tol: f64) {
+    let gaps = block_gaps(report, n0, n1);
+    assert!(gaps.len() >= readings, "{} block readings", gaps.len());
+    let worst_amp = gaps.iter().map(|g| g.0.abs()).fold(0.0, f64::max);
+    let worst_lag = gaps.iter().map(|g| g.1.abs()).fold(0.0, f64::max);
+    let mean_lag = gaps.iter().map(|g| g.1).sum::<f64>() / gaps.len() as f64;
+    let first = gaps.iter().min_by(|a, b| a.2.total_cmp(&b.2)).unwrap();
+    eprintln!(
+        "run-up {n0}–{n1} rpm: {} block readings, worst amplitude {:.2} %, worst lag {:.2}°, mean lag {:+.2}°, \
+         lowest-speed block {:.0} rpm lag {:+.2}°",
+        gaps.len(),
+        100.0 * worst_amp,
+        worst_lag,
+        mean_lag,
+        first.2,
+        first.1
+    );
+    assert!(worst_amp < amp_tol, "amplitude off by {worst_amp}");
+    assert!(worst_lag < 1.0, "lag off by {worst_lag}°");
+}
+
+/// A run-up from 6,000 to 8,000 rpm in 2 s (1,000 rpm/s), keyphasor and four raw probes (µm,
+/// AC) in standard types, no speed topic; the 1X is a forward circle of 2 → 4 µm lagging by
+/// 30° → 120° (linear in speed), with a 0.5 µm forward 0.5X circle beside it. Each block of 8
+/// revolutions reads the script's amplitude at its mean speed within 1 % and the lag within 1°
+/// on both probe axes of both stations (the lag read against the plant's keyphasor events, as
+/// the node does; measured 0.38 % and 0.43°, mean lag −0.04°). The report has the blocks' full
+/// spectra, the static centerline locus inside the clearance, and says why an AC probe gives no
+/// measured centerline; each plot reads back.
+#[test]
+fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
+    // 25 blocks or more at each station, 2 axes each
+    let (dir, report, out) = run_up_read_back("runup", 2.0, (6000.0, 8000.0), 4 * 25, 0.01);
+    for st in report["stations"].as_array().unwrap() {
+        let blocks = st["blocks"].as_array().unwrap();
         // the report's view numbers
         let spectra = st["block_spectra"].as_array().unwrap();
         assert_eq!(spectra.len(), blocks.len());
@@ -137,15 +187,34 @@ fn a_run_up_with_a_known_1x_reads_back_its_bode_and_every_view() {
             .as_str()
             .unwrap()
             .starts_with("AC-coupled"));
+        // the 1X ellipse of a forward circle: forward, semi-minor = semi-major within 2 %
+        for b in blocks {
+            let e = &b["measured"]["one_x_ellipse"];
+            assert_eq!(e["precession"], "forward", "{e}");
+            let (major, minor) = (
+                e["semi_major_m"].as_f64().unwrap(),
+                e["semi_minor_m"].as_f64().unwrap(),
+            );
+            assert!(minor / major > 0.98, "{e}");
+        }
     }
-    eprintln!(
-        "run-up {n0}–{n1} rpm: worst block amplitude {:.2} %, lag {:.2}°",
-        100.0 * worst_amp,
-        worst_lag
-    );
-    assert!(worst_amp < 0.01, "amplitude off by {worst_amp}");
-    assert!(worst_lag < 1.0, "lag off by {worst_lag}°");
     check_views(&out, "probe_outboard", true);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A fast run-up, 3,000 → 5,000 rpm in 0.8 s (2,500 rpm/s: a·T² = 5.3° at 3,189 rpm): the
+/// measured lag of every block within 1° of the script's truth on both axes of both stations,
+/// because the samples are read against the plant's own keyphasor events (the parabola through
+/// three, `signals::keyphasor_one_x`), not the twin's keyphasor-locked angle, which trails the
+/// accelerating shaft (read against it, as before session 10, the lag was −4.9° off at
+/// 3,189 rpm, mean −3.5°: this test failed on main). Measured: worst 0.34°, mean −0.04°. The
+/// amplitude within 1.5 % (measured 0.96 %: it grows 10 % within a block here; the lag was also
+/// read at the twin's block speed, which trailed the plant's by about one revolution's gain of
+/// speed, 2 % of amplitude and 2° of lag here, before the block's speed became the plant's).
+#[test]
+fn a_fast_run_up_reads_its_lag_against_the_plants_keyphasor() {
+    // 53 revolutions: 6 blocks of 8 at each station, 2 axes each
+    let (dir, ..) = run_up_read_back("fast-runup", 0.8, (3000.0, 5000.0), 4 * 6, 0.015);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -235,7 +235,7 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
 /// [`MAX_SURFACE_SPEED_M_S`] of the journal.
 fn check_speed(args: &BearingArgs) -> anyhow::Result<()> {
     let n = args.speed_rpm;
-    let max_rpm = MAX_SURFACE_SPEED_M_S / (std::f64::consts::PI * args.diameter_m) * 60.0;
+    let max_rpm = crate::rotor::max_speed_rpm(args.diameter_m);
     anyhow::ensure!(
         n.is_finite() && n > 0.0 && n <= max_rpm,
         "invalid --speed-rpm {}: must lie in (0, {max_rpm:.0}] rpm, above zero and at most a \

@@ -226,6 +226,25 @@ pub(crate) struct SweepReport {
     pub speeds: Vec<SpeedRow>,
 }
 
+/// The speeds of a sweep end at the journal's surface speed limit
+/// ([`crate::rotor::MAX_SURFACE_SPEED_M_S`], as `--speed-rpm` and the machine file's
+/// `rated_speed_rpm`): a faster one is refused before any equilibrium is sought.
+fn check_top_speed(b: &SweptBearing, speeds: &[f64]) -> anyhow::Result<()> {
+    let d = b.film.geometry().diameter_m;
+    let max_rpm = crate::rotor::max_speed_rpm(d);
+    let top = speeds.iter().copied().fold(0.0, f64::max);
+    anyhow::ensure!(
+        top <= max_rpm,
+        "invalid --speeds: {} rpm is above {max_rpm:.0} rpm, a journal surface speed of {} m/s \
+         (Ø {} m of {}); end the range there",
+        crate::units::shown_value(top),
+        crate::rotor::MAX_SURFACE_SPEED_M_S,
+        crate::units::shown_value(d),
+        b.name
+    );
+    Ok(())
+}
+
 /// The equilibrium at each speed of `speeds` (rpm), the solver warm-started from the speed
 /// before; the coefficients turned from the machine frame into the load frame (K' = Rᵀ K R,
 /// R the rotation by the load's direction).
@@ -234,6 +253,7 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
     let load_angle = b.load_n[1].atan2(b.load_n[0]);
     let r = Rotation2::new(load_angle);
     let c = b.film.geometry().radial_clearance_m;
+    check_top_speed(b, speeds)?;
     let mut rows = Vec::with_capacity(speeds.len());
     for &rpm in speeds {
         let omega = rpm_to_rad_s(rpm);

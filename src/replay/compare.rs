@@ -2,13 +2,25 @@
 //! in blocks of [`BLOCK_REVS`] revolutions of the shaft (amplitude against speed, onset of
 //! instability) and the last [`SUMMARY_REVS`] revolutions are kept for the summary. Both orbits
 //! are sampled at the same instants, so they are aligned by shaft angle by construction; the
-//! shaft angle is the twin's, integrated from the bag's speed.
+//! shaft angle is the twin's, integrated from the bag's speed (and locked to the keyphasor).
+//!
+//! The measured 1X vectors of a block are read against the plant's own angle, interpolated
+//! between the bag's keyphasor events that bracket each sample's stamp, by the node's rule
+//! ([`crate::signals::keyphasor_one_x`]): a finished block waits for the event after its last
+//! sample. The twin's keyphasor-locked angle trails an accelerating shaft (by about a·T²), the
+//! plant's does not. The predicted vectors stay on the twin's angle: the twin's unbalance turns
+//! with that angle, so its response's lag against it is the model's prediction; read against
+//! the plant's angle it would carry the lock's tracking error as well.
 
+use super::orbit_shape::{OrbitEllipse, ShapeDifference};
+use crate::driver::one_x::{NO_CLOSING_EVENT, NO_OPENING_EVENT};
 use crate::monitor::spectrum::{
     one_x_component, order_spectrum, subsynchronous_peak, OrderComponent,
 };
 use crate::monitor::ClassifierSettings;
-use crate::signals::{one_x_vector, OneXVector, PhaseReference};
+use crate::signals::{
+    keyphasor_one_x, one_x_vector, KeyphasorEvents, OneXVector, PhaseReference, Unbracketed,
+};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
@@ -45,6 +57,9 @@ struct CountingRun {
 pub struct Sample {
     /// Bag time since the bag's first message (s).
     pub time_s: f64,
+    /// The sample's time on the driver's clock (ns; its stamp where it is on the bag's clock):
+    /// the keyphasor events' time base.
+    pub time_ns: i64,
     /// Shaft angle (rad).
     pub angle_rad: f64,
     /// Speed (rad/s).
@@ -80,6 +95,11 @@ pub struct OrbitFeatures {
     pub subsync_ratio: Option<f64>,
     /// Mean position `[x, y]` (m).
     pub mean_m: [f64; 2],
+    /// The ellipse of the 1X orbit (axes, inclination, precession; phase-free).
+    pub one_x_ellipse: OrbitEllipse,
+    /// The ellipse of the largest sub-synchronous component, at its order; null unless it
+    /// counts (as `subsync_ratio`).
+    pub subsync_ellipse: Option<OrbitEllipse>,
 }
 
 /// Predicted and measured over one window.
@@ -104,6 +124,11 @@ pub struct WindowComparison {
     pub orbit_rms_distance_m: f64,
     /// Distance between the two mean positions (m).
     pub mean_position_distance_m: f64,
+    /// The 1X ellipses compared, predicted minus measured: axes, inclination, precession and
+    /// their RMS distance minimised over a phase shift (shape alone).
+    pub one_x_shape: ShapeDifference,
+    /// The same of the sub-synchronous ellipses (null unless both count).
+    pub subsync_shape: Option<ShapeDifference>,
     /// Why the window's phases are null (None: keyphasor-referenced).
     pub phase_null_reason: Option<&'static str>,
 }
@@ -136,6 +161,10 @@ pub struct StationComparison {
     axes_rad: [f64; 2],
     settings: ClassifierSettings,
     block: Vec<Sample>,
+    /// a finished block waiting for the keyphasor event after its last sample
+    waiting: Vec<Sample>,
+    /// the keyphasor events at the end of the bag (for the summary window)
+    final_events: Option<Box<KeyphasorEvents>>,
     recent: VecDeque<Sample>,
     /// Completed blocks.
     pub blocks: Vec<WindowComparison>,
@@ -158,6 +187,8 @@ impl StationComparison {
             axes_rad: [0.0, std::f64::consts::FRAC_PI_2],
             settings: ClassifierSettings::default(),
             block: Vec::new(),
+            waiting: Vec::new(),
+            final_events: None,
             recent: VecDeque::new(),
             blocks: Vec::new(),
             block_spectra: Vec::new(),
@@ -183,18 +214,19 @@ impl StationComparison {
         self.clearance_m
     }
 
-    /// Adds a sample (in time order).
-    pub fn push(&mut self, s: Sample) {
+    /// Adds a sample (in time order). With the plant's keyphasor `events` (the driver's), a
+    /// finished block's measured 1X vectors are read against them: the block waits for the
+    /// event after its last sample, at most until the next block is finished (or
+    /// [`Self::finish`]). Without (`None`), against the sample's angle.
+    pub fn push(&mut self, s: Sample, events: Option<&KeyphasorEvents>) {
         self.samples += 1;
         if let Some(first) = self.block.first() {
             if s.angle_rad - first.angle_rad >= BLOCK_REVS as f64 * TAU || s.time_s < first.time_s {
-                let block = std::mem::take(&mut self.block);
-                if let Some(w) = self.compare(&block, BLOCK_REVS) {
-                    self.block_spectra.push(block_spectra(&block, &w));
-                    self.blocks.push(w);
-                }
+                self.take_waiting(events, true);
+                self.waiting = std::mem::take(&mut self.block);
             }
         }
+        self.take_waiting(events, false);
         self.block.push(s);
         self.recent.push_back(s);
         while self
@@ -204,6 +236,31 @@ impl StationComparison {
         {
             self.recent.pop_front();
         }
+    }
+
+    /// The end of the bag: the block waiting for its closing event is finished with the
+    /// events there are (its last revolution extrapolated at the last interval's speed), and
+    /// the summary window is read against `events`.
+    pub fn finish(&mut self, events: Option<&KeyphasorEvents>) {
+        self.take_waiting(events, true);
+        self.final_events = events.map(|e| Box::new(e.clone()));
+    }
+
+    /// The waiting block into the blocks, once its closing keyphasor event has come (or
+    /// `give_up`: then with its measured phases null if it is not bracketed).
+    fn take_waiting(&mut self, events: Option<&KeyphasorEvents>, give_up: bool) {
+        if self.waiting.is_empty() {
+            return;
+        }
+        match self.compare(&self.waiting, BLOCK_REVS, events, give_up) {
+            Err(()) => return,
+            Ok(Some(w)) => {
+                self.block_spectra.push(block_spectra(&self.waiting, &w));
+                self.blocks.push(w);
+            }
+            Ok(None) => {}
+        }
+        self.waiting.clear();
     }
 
     /// The comparison over the last [`SUMMARY_REVS`] revolutions (or as many whole ones as
@@ -219,7 +276,10 @@ impl StationComparison {
             .iter()
             .position(|s| last.angle_rad - s.angle_rad < revs as f64 * TAU)
             .unwrap_or(0);
-        self.compare(&recent[start..], revs)
+        let events = self.final_events.as_deref();
+        self.compare(&recent[start..], revs, events, true)
+            .ok()
+            .flatten()
     }
 
     /// The onset (measured, or predicted with `predicted`): the first block of a run of
@@ -338,40 +398,76 @@ impl StationComparison {
             .collect()
     }
 
-    fn compare(&self, samples: &[Sample], revs: usize) -> Option<WindowComparison> {
+    /// Predicted against measured over `samples` (`revs` whole revolutions of the twin's angle).
+    /// With `events` and a locked twin, the measured 1X vectors are read against the plant's
+    /// angle ([`keyphasor_one_x`], the node's rule); Err while the event after the last sample
+    /// has not come (unless `no_more_events`).
+    fn compare(
+        &self,
+        samples: &[Sample],
+        revs: usize,
+        events: Option<&KeyphasorEvents>,
+        no_more_events: bool,
+    ) -> Result<Option<WindowComparison>, ()> {
         if samples.len() < 8 * revs.max(1) {
-            return None;
+            return Ok(None);
         }
-        let reason = samples.iter().find_map(|s| s.phase_reference.null_reason());
+        let mut reason = samples.iter().find_map(|s| s.phase_reference.null_reason());
         let mut measured = self.features(samples, revs, |s| s.measured_m);
-        let mut predicted = self.features(samples, revs, |s| s.predicted_m);
-        if reason.is_some() {
-            measured.one_x_probe_axes = None;
-            predicted.one_x_probe_axes = None;
+        let predicted = self.features(samples, revs, |s| s.predicted_m);
+        let mut plant_speed = None;
+        if let (None, Some(ev)) = (reason, events) {
+            match self.plant_axes(samples, ev, no_more_events) {
+                Ok(Some((axes, speed))) => {
+                    measured.one_x_probe_axes = Some(axes);
+                    measured.one_x_probe_amplitudes_m = axes.map(|v| v.amplitude_m);
+                    plant_speed = speed;
+                }
+                Ok(None) => {}
+                Err(Unbracketed::Pending) if !no_more_events => return Err(()),
+                Err(Unbracketed::Pending) => reason = Some(NO_CLOSING_EVENT),
+                Err(Unbracketed::Missing) => reason = Some(NO_OPENING_EVENT),
+            }
         }
-        let (mm, pm) = (measured.mean_m, predicted.mean_m);
-        let n = samples.len() as f64;
-        let shape = samples
-            .iter()
-            .map(|s| {
-                let dx = (s.predicted_m[0] - pm[0]) - (s.measured_m[0] - mm[0]);
-                let dy = (s.predicted_m[1] - pm[1]) - (s.measured_m[1] - mm[1]);
-                dx * dx + dy * dy
-            })
-            .sum::<f64>()
-            / n;
-        Some(WindowComparison {
-            start_s: samples[0].time_s,
-            end_s: samples[samples.len() - 1].time_s,
-            speed_rpm: samples.iter().map(|s| s.speed_rad_s).sum::<f64>() / n * 30.0
-                / std::f64::consts::PI,
-            revolutions: revs,
-            measured,
-            predicted,
-            orbit_rms_distance_m: shape.sqrt(),
-            mean_position_distance_m: (pm[0] - mm[0]).hypot(pm[1] - mm[1]),
-            phase_null_reason: reason,
-        })
+        let mut w = window(samples, revs, measured, predicted, reason);
+        if let Some(speed) = plant_speed {
+            w.speed_rpm = crate::units::rad_s_to_rpm(speed);
+        }
+        Ok(Some(w))
+    }
+
+    /// The measured 1X vectors along the station's probe axes against the plant's angle from
+    /// `events`, and the plant's mean speed over the samples (rad/s: its angle travelled over
+    /// the time taken). The twin's speed, from the last keyphasor interval, trails an
+    /// accelerating shaft (by about one revolution's gain of speed), so a block's speed is the
+    /// plant's where the events give it: the Bode plot's abscissa.
+    #[allow(clippy::type_complexity)]
+    fn plant_axes(
+        &self,
+        samples: &[Sample],
+        events: &KeyphasorEvents,
+        no_more_events: bool,
+    ) -> Result<Option<([OneXVector; 2], Option<f64>)>, Unbracketed> {
+        let axis = |a: f64| {
+            let (sn, cs) = a.sin_cos();
+            let along = samples
+                .iter()
+                .map(move |s| (s.time_ns, s.measured_m[0] * cs + s.measured_m[1] * sn));
+            keyphasor_one_x(along, samples.len(), events, no_more_events)
+        };
+        let angle = |t: i64| match no_more_events {
+            true => events.angle_at_or_after(t).ok(),
+            false => events.angle_at(t).ok(),
+        };
+        let (first, last) = (samples[0].time_ns, samples[samples.len() - 1].time_ns);
+        let speed = match (angle(first), angle(last)) {
+            (Some(a), Some(b)) if last > first => Some((b - a) / ((last - first) as f64 * 1e-9)),
+            _ => None,
+        };
+        match (axis(self.axes_rad[0])?, axis(self.axes_rad[1])?) {
+            (Some(a), Some(b)) => Ok(Some(([a, b], speed))),
+            _ => Ok(None),
+        }
     }
 
     fn features(
@@ -404,6 +500,8 @@ impl StationComparison {
         };
         let axes = [axis(self.axes_rad[0]), axis(self.axes_rad[1])];
         OrbitFeatures {
+            one_x_ellipse: ellipse(samples, 1.0, &pick).unwrap_or_default(),
+            subsync_ellipse: ratio.and_then(|r| ellipse(samples, r, &pick)),
             one_x_amplitude_m: one_x.semi_major_m(),
             one_x_forward_phase_deg: one_x.forward_phase_rad.to_degrees(),
             one_x_probe_axes: Some(axes),
@@ -413,6 +511,64 @@ impl StationComparison {
             mean_m: mean,
         }
     }
+}
+
+/// The comparison of `samples` (`revs` revolutions) from the two orbits' features; `reason`:
+/// why the phases are null (then the probe-axis vectors are).
+fn window(
+    samples: &[Sample],
+    revs: usize,
+    mut measured: OrbitFeatures,
+    mut predicted: OrbitFeatures,
+    reason: Option<&'static str>,
+) -> WindowComparison {
+    if reason.is_some() {
+        measured.one_x_probe_axes = None;
+        predicted.one_x_probe_axes = None;
+    }
+    let (mm, pm) = (measured.mean_m, predicted.mean_m);
+    let n = samples.len() as f64;
+    let equal_times = samples
+        .iter()
+        .map(|s| {
+            let dx = (s.predicted_m[0] - pm[0]) - (s.measured_m[0] - mm[0]);
+            let dy = (s.predicted_m[1] - pm[1]) - (s.measured_m[1] - mm[1]);
+            dx * dx + dy * dy
+        })
+        .sum::<f64>()
+        / n;
+    WindowComparison {
+        start_s: samples[0].time_s,
+        end_s: samples[samples.len() - 1].time_s,
+        speed_rpm: samples.iter().map(|s| s.speed_rad_s).sum::<f64>() / n * 30.0
+            / std::f64::consts::PI,
+        revolutions: revs,
+        measured,
+        predicted,
+        orbit_rms_distance_m: equal_times.sqrt(),
+        mean_position_distance_m: (pm[0] - mm[0]).hypot(pm[1] - mm[1]),
+        one_x_shape: ShapeDifference::of(&predicted.one_x_ellipse, &measured.one_x_ellipse),
+        subsync_shape: match (predicted.subsync_ellipse, measured.subsync_ellipse) {
+            (Some(p), Some(m)) => Some(ShapeDifference::of(&p, &m)),
+            _ => None,
+        },
+        phase_null_reason: reason,
+    }
+}
+
+/// The ellipse of the orbit `pick` at `order` over `samples`: the x and y components fitted at
+/// that order of the samples' angle ([`one_x_vector`] at order·ψ: Hann-weighted, exact for a
+/// mean and a whole number of cycles of the order); None with less than one cycle.
+fn ellipse(
+    samples: &[Sample],
+    order: f64,
+    pick: &impl Fn(&Sample) -> [f64; 2],
+) -> Option<OrbitEllipse> {
+    let part = |j: usize| {
+        let values = samples.iter().map(|s| (order * s.angle_rad, pick(s)[j]));
+        one_x_vector(values, samples.len())
+    };
+    Some(OrbitEllipse::from_vectors(order, &part(0)?, &part(1)?))
 }
 
 /// The order spectra of one block: semi-major axes and the full (forward and backward) spectra,
@@ -470,6 +626,7 @@ pub fn phase_difference_deg(a: f64, b: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::orbit_shape::Precession;
     use super::*;
 
     /// Known orbits: measured = forward 1X circle of 3 µm at phase 0 plus a forward 0.45X circle
@@ -498,14 +655,18 @@ mod tests {
                 sum2 += (p[0] - m[0]).powi(2) + (p[1] - m[1]).powi(2);
                 n += 1;
             }
-            c.push(Sample {
-                time_s: psi / (TAU * f),
-                angle_rad: psi,
-                speed_rad_s: TAU * f,
-                measured_m: m,
-                predicted_m: p,
-                phase_reference: PhaseReference::Locked,
-            });
+            c.push(
+                Sample {
+                    time_s: psi / (TAU * f),
+                    time_ns: 0,
+                    angle_rad: psi,
+                    speed_rad_s: TAU * f,
+                    measured_m: m,
+                    predicted_m: p,
+                    phase_reference: PhaseReference::Locked,
+                },
+                None,
+            );
         }
         let w = c.summary().unwrap();
         assert_eq!(w.revolutions, SUMMARY_REVS);
@@ -560,14 +721,18 @@ mod tests {
                 1e-6 * psi.cos() + a * (0.45 * psi).cos(),
                 1e-6 * psi.sin() + a * (0.45 * psi).sin(),
             ];
-            c.push(Sample {
-                time_s: psi / (TAU * 150.0),
-                angle_rad: psi,
-                speed_rad_s: TAU * 150.0,
-                measured_m: m,
-                predicted_m: [1e-6 * psi.cos(), 1e-6 * psi.sin()],
-                phase_reference: PhaseReference::Locked,
-            });
+            c.push(
+                Sample {
+                    time_s: psi / (TAU * 150.0),
+                    time_ns: 0,
+                    angle_rad: psi,
+                    speed_rad_s: TAU * 150.0,
+                    measured_m: m,
+                    predicted_m: [1e-6 * psi.cos(), 1e-6 * psi.sin()],
+                    phase_reference: PhaseReference::Locked,
+                },
+                None,
+            );
         }
         c
     }
@@ -618,6 +783,29 @@ mod tests {
         assert!((t_on - steady.blocks[0].end_s).abs() < 1e-9);
     }
 
+    /// Three blocks of the orbits `measured` and `predicted` (functions of the shaft angle), 64
+    /// samples a revolution at 150 rev/s, keyphasor-locked.
+    fn three_blocks(
+        measured: impl Fn(f64) -> [f64; 2],
+        predicted: impl Fn(f64) -> [f64; 2],
+    ) -> StationComparison {
+        let mut c = StationComparison::new("s", 40e-6);
+        for i in 0..=3 * BLOCK_REVS * 64 {
+            let psi = TAU * i as f64 / 64.0;
+            let s = Sample {
+                time_s: psi / (TAU * 150.0),
+                time_ns: 0,
+                angle_rad: psi,
+                speed_rad_s: TAU * 150.0,
+                measured_m: measured(psi),
+                predicted_m: predicted(psi),
+                phase_reference: PhaseReference::Locked,
+            };
+            c.push(s, None);
+        }
+        c
+    }
+
     /// The full spectrum of x + iy (issue 16), known signals through the blocks: a forward
     /// circle of 2 µm puts all of it in +1X; a backward one in −1X; a line (a degenerate
     /// ellipse) x = 2 µm cos ψ splits equally, 1 µm each way; a forward 0.5X whirl shows at
@@ -650,18 +838,7 @@ mod tests {
             ),
         ];
         for (name, orbit, bin, [fwd, bwd]) in cases {
-            let mut c = StationComparison::new("s", 40e-6);
-            for i in 0..=3 * BLOCK_REVS * 64 {
-                let psi = TAU * i as f64 / 64.0;
-                c.push(Sample {
-                    time_s: psi / (TAU * 150.0),
-                    angle_rad: psi,
-                    speed_rad_s: TAU * 150.0,
-                    measured_m: orbit(psi),
-                    predicted_m: orbit(psi),
-                    phase_reference: PhaseReference::Locked,
-                });
-            }
+            let c = three_blocks(orbit, orbit);
             assert_eq!(c.block_spectra.len(), 3, "{name}");
             for b in &c.block_spectra {
                 let full = b.measured_full_m;
@@ -683,6 +860,49 @@ mod tests {
                 // the semi-major axis is forward + backward
                 assert!((b.measured_m[bin] - fwd - bwd).abs() < 1e-3 * r);
             }
+        }
+    }
+
+    /// The shape comparison is phase-free: predicted = the measured orbit a quarter revolution
+    /// later (a 1X ellipse 3 µm × 1 µm inclined 25°, forward, plus a 4 µm × 2 µm backward 0.5X
+    /// ellipse inclined 110°, a whirl that counts). Each block's ellipses read back their axes
+    /// and inclination within 1e-3 (relative; degrees), the 0.5X one backward; the shape
+    /// distances are 0 (below 1e-3 of the size) while the distance at equal times is large
+    /// (above 2 µm: two points a quarter turn apart on each ellipse).
+    #[test]
+    fn a_time_shifted_orbit_has_the_same_shape() {
+        let orbit = |psi: f64| {
+            let ell = |a: f64, b: f64, tilt: f64, p: f64| {
+                let (u, v) = (a * p.cos(), b * p.sin());
+                let (s, c) = tilt.to_radians().sin_cos();
+                [u * c - v * s, u * s + v * c]
+            };
+            let (one, sub) = (
+                ell(3e-6, 1e-6, 25.0, psi),
+                ell(4e-6, -2e-6, 110.0, 0.5 * psi),
+            );
+            [one[0] + sub[0], one[1] + sub[1]]
+        };
+        let c = three_blocks(orbit, |psi| orbit(psi + TAU / 4.0));
+        assert_eq!(c.blocks.len(), 3);
+        for b in &c.blocks {
+            for f in [&b.measured, &b.predicted] {
+                let e = f.one_x_ellipse;
+                assert!((e.semi_major_m / 3e-6 - 1.0).abs() < 1e-3, "{e:?}");
+                assert!((e.semi_minor_m / 1e-6 - 1.0).abs() < 1e-3, "{e:?}");
+                assert!((e.inclination_deg - 25.0).abs() < 1e-3, "{e:?}");
+                assert_eq!(e.precession, Precession::Forward);
+                let s = f.subsync_ellipse.expect("the 0.5X whirl counts");
+                assert!((s.order - 0.5).abs() < 1e-3, "{s:?}");
+                assert!((s.semi_major_m / 4e-6 - 1.0).abs() < 1e-3, "{s:?}");
+                assert!((s.semi_minor_m / 2e-6 - 1.0).abs() < 1e-3, "{s:?}");
+                assert!((s.inclination_deg - 110.0).abs() < 1e-3, "{s:?}");
+                assert_eq!(s.precession, Precession::Backward);
+            }
+            assert!(b.one_x_shape.shape_distance_m < 1e-3 * 3e-6, "{b:?}");
+            let sub = b.subsync_shape.expect("both count");
+            assert!(sub.shape_distance_m < 1e-3 * 4e-6, "{sub:?}");
+            assert!(b.orbit_rms_distance_m > 2e-6, "{}", b.orbit_rms_distance_m);
         }
     }
 

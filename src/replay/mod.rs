@@ -8,6 +8,7 @@
 pub mod calibration;
 pub mod compare;
 mod forecast;
+pub mod orbit_shape;
 mod report;
 
 pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
@@ -328,10 +329,14 @@ impl Replaying {
     ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
         let Replaying {
             mut report,
-            comparisons,
+            mut comparisons,
             forecasting,
+            driver,
             ..
         } = self;
+        for c in &mut comparisons {
+            c.finish(Some(driver.keyphasor_events()));
+        }
         report.finish(&comparisons, wall.elapsed().as_secs_f64());
         report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
         if let Some(out) = out {
@@ -373,14 +378,18 @@ impl Replaying {
             Fed::Started { speed_rad_s } => self
                 .report
                 .note_start(since_t0(t_ns), crate::units::rad_s_to_rpm(speed_rad_s)),
-            Fed::Compared(c) => self.comparisons[c.station].push(Sample {
-                time_s: since_t0(c.time_ns),
-                angle_rad: c.angle_rad,
-                speed_rad_s: c.speed_rad_s,
-                measured_m: c.measured_m,
-                predicted_m: c.predicted_m,
-                phase_reference: c.phase_reference,
-            }),
+            Fed::Compared(c) => self.comparisons[c.station].push(
+                Sample {
+                    time_s: since_t0(c.time_ns),
+                    time_ns: c.time_ns,
+                    angle_rad: c.angle_rad,
+                    speed_rad_s: c.speed_rad_s,
+                    measured_m: c.measured_m,
+                    predicted_m: c.predicted_m,
+                    phase_reference: c.phase_reference,
+                },
+                Some(self.driver.keyphasor_events()),
+            ),
             Fed::Refused(why) => self.report.note_rejection(topic, &why),
             Fed::Taken | Fed::Unused => {}
         }

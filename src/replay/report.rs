@@ -5,6 +5,7 @@ use super::compare::{
     phase_difference_deg, BlockSpectra, StationComparison, TransientSpan, WindowComparison,
     ONSET_BLOCKS,
 };
+use super::orbit_shape::{OrbitEllipse, ShapeDifference};
 use crate::bag::Bag;
 use crate::session::{Outgoing, Session};
 use crate::signals::OneXVector;
@@ -58,6 +59,21 @@ pub struct StationReport {
     pub orbit_rms_distance_m: Option<f64>,
     /// Distance between the mean positions (m).
     pub mean_position_distance_m: Option<f64>,
+    // --- orbit shape, phase-free (issue 16) ---
+    /// The measured 1X orbit's ellipse: semi-major and semi-minor axes (m), inclination of the
+    /// major axis (deg from +x towards +y), precession (forward/backward).
+    pub one_x_ellipse_measured: Option<OrbitEllipse>,
+    /// The predicted 1X orbit's ellipse.
+    pub one_x_ellipse_predicted: Option<OrbitEllipse>,
+    /// Predicted minus measured 1X ellipse, and their RMS distance minimised over a phase
+    /// shift (`shape_distance_m`: the shape difference alone).
+    pub one_x_shape: Option<ShapeDifference>,
+    /// The measured largest sub-synchronous component's ellipse (null unless it counts).
+    pub subsync_ellipse_measured: Option<OrbitEllipse>,
+    /// The predicted one (null unless it counts).
+    pub subsync_ellipse_predicted: Option<OrbitEllipse>,
+    /// Predicted against measured sub-synchronous ellipse (null unless both count).
+    pub subsync_shape: Option<ShapeDifference>,
     /// Blocks of 8 revolutions over the whole bag (amplitude against speed).
     pub blocks: Vec<WindowComparison>,
     // --- views (issue 16) ---
@@ -295,30 +311,8 @@ impl ReplayReport {
                 r.count, r.topic, r.last_reason
             );
         }
-        let um = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} µm", v * 1e6));
-        let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
         for st in &self.stations {
-            s += &format!(
-                "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit RMS distance at equal times {}\n",
-                st.station,
-                um(st.one_x_amplitude_predicted_m),
-                um(st.one_x_amplitude_measured_m),
-                match (&st.one_x_probe_axes_measured, &st.one_x_probe_axes_predicted) {
-                    (Some(m), Some(p)) => format!(
-                        "phase lag {:.1}°/{:.1}° predicted vs {:.1}°/{:.1}° measured",
-                        p[0].phase_lag_deg, p[1].phase_lag_deg, m[0].phase_lag_deg, m[1].phase_lag_deg
-                    ),
-                    _ => format!(
-                        "phase null: {}",
-                        st.phase_null_reason.as_deref().unwrap_or("—")
-                    ),
-                },
-                um(st.subsync_amplitude_predicted_m),
-                ratio(st.subsync_ratio_predicted),
-                um(st.subsync_amplitude_measured_m),
-                ratio(st.subsync_ratio_measured),
-                um(st.orbit_rms_distance_m),
-            );
+            s += &station_lines(st);
         }
         let at = |t: Option<f64>, w: Option<f64>| match (t, w) {
             (Some(t), Some(w)) => format!("{t:.2} s ({w:.0} rpm)"),
@@ -357,6 +351,76 @@ impl ReplayReport {
         }
         s
     }
+}
+
+/// The terminal lines of one station: amplitudes, phases, sub-synchronous, distances, shape.
+fn station_lines(st: &StationReport) -> String {
+    let um = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} µm", v * 1e6));
+    let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
+    let s = format!(
+        "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit RMS distance at equal times {}\n",
+        st.station,
+        um(st.one_x_amplitude_predicted_m),
+        um(st.one_x_amplitude_measured_m),
+        match (&st.one_x_probe_axes_measured, &st.one_x_probe_axes_predicted) {
+            (Some(m), Some(p)) => format!(
+                "phase lag {:.1}°/{:.1}° predicted vs {:.1}°/{:.1}° measured",
+                p[0].phase_lag_deg, p[1].phase_lag_deg, m[0].phase_lag_deg, m[1].phase_lag_deg
+            ),
+            _ => format!(
+                "phase null: {}",
+                st.phase_null_reason.as_deref().unwrap_or("—")
+            ),
+        },
+        um(st.subsync_amplitude_predicted_m),
+        ratio(st.subsync_ratio_predicted),
+        um(st.subsync_amplitude_measured_m),
+        ratio(st.subsync_ratio_measured),
+        um(st.orbit_rms_distance_m),
+    );
+    s + &shape_line(st)
+}
+
+/// The phase-free shape line of a station: the 1X (and sub-synchronous) ellipses, predicted
+/// against measured, and their shape distance.
+fn shape_line(st: &StationReport) -> String {
+    let ell = |e: &OrbitEllipse| {
+        format!(
+            "{:.2} × {:.2} µm at {:.0}°, {:?}",
+            e.semi_major_m * 1e6,
+            e.semi_minor_m * 1e6,
+            e.inclination_deg,
+            e.precession
+        )
+        .to_lowercase()
+    };
+    let one = |label: &str,
+               p: &Option<OrbitEllipse>,
+               m: &Option<OrbitEllipse>,
+               d: &Option<ShapeDifference>| match (p, m, d) {
+        (Some(p), Some(m), Some(d)) => format!(
+            "{label} ellipse {} predicted vs {} measured, shape distance {:.2} µm",
+            ell(p),
+            ell(m),
+            d.shape_distance_m * 1e6
+        ),
+        _ => format!("{label}: no ellipse to compare (none counts)"),
+    };
+    format!(
+        "  orbit shape (phase-free): {}; {}\n",
+        one(
+            "1X",
+            &st.one_x_ellipse_predicted,
+            &st.one_x_ellipse_measured,
+            &st.one_x_shape
+        ),
+        one(
+            "sub-synchronous",
+            &st.subsync_ellipse_predicted,
+            &st.subsync_ellipse_measured,
+            &st.subsync_shape
+        ),
+    )
 }
 
 /// The report of one station's comparison, over its summary window.
@@ -399,6 +463,12 @@ fn station_report(c: &StationComparison) -> StationReport {
         subsync_ratio_measured: w.as_ref().and_then(|w| w.measured.subsync_ratio),
         orbit_rms_distance_m: get(|w| w.orbit_rms_distance_m),
         mean_position_distance_m: get(|w| w.mean_position_distance_m),
+        one_x_ellipse_measured: w.as_ref().map(|w| w.measured.one_x_ellipse),
+        one_x_ellipse_predicted: w.as_ref().map(|w| w.predicted.one_x_ellipse),
+        one_x_shape: w.as_ref().map(|w| w.one_x_shape),
+        subsync_ellipse_measured: w.as_ref().and_then(|w| w.measured.subsync_ellipse),
+        subsync_ellipse_predicted: w.as_ref().and_then(|w| w.predicted.subsync_ellipse),
+        subsync_shape: w.as_ref().and_then(|w| w.subsync_shape),
         blocks: c.blocks.clone(),
         block_spectra: c.block_spectra.clone(),
         mean_position_null_reason: c.mean_not_measured.clone(),

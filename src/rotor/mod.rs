@@ -20,6 +20,7 @@ pub use critical_speeds::{critical_speeds, CriticalSpeed, API_684_MIN_AMPLIFICAT
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
+pub use machine::max_speed_rpm;
 pub(crate) use machine::{mapping_name, shown};
 pub use machine::{
     AlarmLevelsSpec, BearingModelSpec, BearingSpec, DiscSpec, FilmSpec, GroovesSpec, LubricantSpec,

@@ -22,6 +22,12 @@ const MAX_SHAFT_DAMPING_BETA_S: f64 = 1e-2;
 /// 0.8–0.9 GPa): no shaft runs faster, so a rated speed beyond it is a unit slip, not a machine.
 /// The `bearing` command bounds the journal speed by the same figure.
 pub const MAX_SURFACE_SPEED_M_S: f64 = 500.0;
+
+/// The speed (rpm) at which a shaft or journal of `diameter_m` reaches
+/// [`MAX_SURFACE_SPEED_M_S`]: the upper bound of every speed given for it.
+pub fn max_speed_rpm(diameter_m: f64) -> f64 {
+    MAX_SURFACE_SPEED_M_S / (std::f64::consts::PI * diameter_m) * 60.0
+}
 /// Largest gravity component (m/s²).
 const MAX_GRAVITY_M_S2: f64 = 100.0;
 
@@ -47,7 +53,7 @@ impl MachineDescription {
             .iter()
             .map(|s| s.outer_diameter_m)
             .fold(0.0, f64::max);
-        let max_rpm = MAX_SURFACE_SPEED_M_S / (std::f64::consts::PI * diameter_m) * 60.0;
+        let max_rpm = max_speed_rpm(diameter_m);
         if self.rated_speed_rpm > max_rpm {
             return Err(rules.error(
                 "rated_speed_rpm",

@@ -26,7 +26,7 @@ pub use probes::{ProbeSpec, ProximityProbeSpec, RunoutSpec};
 
 use super::error::ConfigError;
 use checks::MAX_MACHINE_FILE_BYTES;
-pub use checks::MAX_SURFACE_SPEED_M_S;
+pub use checks::{max_speed_rpm, MAX_SURFACE_SPEED_M_S};
 use rules::Rules;
 pub(crate) use rules::{mapping_name, shown};
 use serde::{Deserialize, Serialize};
