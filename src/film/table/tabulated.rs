@@ -1,7 +1,7 @@
 //! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
 //! interpolated, the eight coefficients by the chain rule.
 
-use super::{FilmTable, LineOfCentres, N_PSI};
+use super::{FilmTable, LineOfCentres};
 use crate::film::{
     wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
     JournalKinematics,
@@ -104,7 +104,7 @@ impl FilmModel for TabulatedFilm {
         // the four nodes: weight and the start of the profile
         let nodes: [(f64, usize); 4] = std::array::from_fn(|n| {
             let (a, b) = (n / 2, n % 2);
-            (wr[a] * wc[b], (rows[a] * N_PSI + cols[b]) * t.n_theta)
+            (wr[a] * wc[b], (rows[a] * t.res.n_psi + cols[b]) * t.n_theta)
         });
         let profile = |start: usize| &t.profiles[start..start + t.n_theta];
         if t.n_theta <= blend.len() {
