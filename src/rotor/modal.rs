@@ -653,18 +653,21 @@ pub fn stability_threshold(
     threshold_with(rotor, statics, [from_rpm, to_rpm, step_rpm], solvers)
 }
 
-/// [`stability_threshold`] with every film bearing's tabulated film (equilibria and
-/// coefficients from the table's interpolant, [`crate::film::TabulatedFilm`]): the threshold
-/// the twin's table implies (README "The film table's resolution").
+/// [`stability_threshold`] over `[from, to, step]` (rpm) with every film bearing's tabulated
+/// film (equilibria and coefficients from the table's interpolant,
+/// [`crate::film::TabulatedFilm`]): the threshold the twin's table implies (README "The film
+/// table's resolution").
 pub fn stability_threshold_tabulated(
     rotor: &Rotor,
     statics: &StaticSolution,
-    from_rpm: f64,
-    to_rpm: f64,
-    step_rpm: f64,
+    speeds_rpm: [f64; 3],
 ) -> Result<Option<Threshold>, RotorError> {
-    let solvers = BearingSolvers::tabulated(rotor)?;
-    threshold_with(rotor, statics, [from_rpm, to_rpm, step_rpm], solvers)
+    threshold_with(
+        rotor,
+        statics,
+        speeds_rpm,
+        BearingSolvers::tabulated(rotor)?,
+    )
 }
 
 /// The threshold search over `[from, to, step]` (rpm) with these film solvers.

@@ -167,6 +167,7 @@ impl TableCache {
                 n_theta: grid.n_theta,
                 res,
                 u_max,
+                couette_factor: super::couette_factor(grid),
             }),
             Err(why) => Lookup::Rejected(CacheWarning {
                 path,

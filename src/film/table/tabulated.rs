@@ -1,7 +1,7 @@
 //! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
 //! interpolated, the eight coefficients by the chain rule.
 
-use super::{FilmTable, LineOfCentres};
+use super::FilmTable;
 use crate::film::{
     wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
     JournalKinematics,
@@ -39,7 +39,7 @@ impl FilmModel for TabulatedFilm {
         let c = self.table.geometry.radial_clearance_m;
         kin.validate(c)?;
         self.last = *kin;
-        let s = LineOfCentres::of(kin, c);
+        let s = self.table.line_of_centres(kin);
         let n = self.table.node_at(s.eps, s.psi);
         let omega = kin.speed_rad_s;
         let angle = |k: usize| wrap_angle_rad(s.phi() + n.angles[k][1].atan2(n.angles[k][0]));
@@ -63,8 +63,7 @@ impl FilmModel for TabulatedFilm {
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
         let result = self.solve(kin)?;
-        let c = self.table.geometry.radial_clearance_m;
-        let s = LineOfCentres::of(kin, c);
+        let s = self.table.line_of_centres(kin);
         let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
             self.table.analytic_coefficients(kin, &s)
         } else {
@@ -82,7 +81,7 @@ impl FilmModel for TabulatedFilm {
 
     fn midplane_pressure(&self, out: &mut [f64]) {
         let t = &self.table;
-        let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
+        let s = t.line_of_centres(&self.last);
         // bilinear between the four nodes around the state: the profile is for display and the
         // monitor's revolution-to-revolution pressure difference, not for the force
         let (rows, cols, wr, wc) = t.bilinear(s.eps, s.psi);
@@ -167,7 +166,7 @@ mod tests {
                 ],
                 speed_rad_s: w,
             };
-            let s = LineOfCentres::of(&kin, c);
+            let s = table.line_of_centres(&kin);
             let (ka, da) = table.analytic_coefficients(&kin, &s);
             // fine central differences (not the coarse fallback's steps)
             let (dq, dv) = (1e-6 * c, 1e-6 * c * w);
