@@ -206,14 +206,19 @@ impl Rig {
             let Fed::Compared(c) = fed else {
                 continue;
             };
-            self.comparisons[i][c.station].push(Sample {
-                time_s: (c.time_ns - EPOCH_NS) as f64 * 1e-9,
-                angle_rad: c.angle_rad,
-                speed_rad_s: c.speed_rad_s,
-                measured_m: c.measured_m,
-                predicted_m: c.predicted_m,
-                phase_reference: c.phase_reference,
-            });
+            // the measured 1X against the plant's keyphasor events, as the replay reads it
+            self.comparisons[i][c.station].push(
+                Sample {
+                    time_s: (c.time_ns - EPOCH_NS) as f64 * 1e-9,
+                    time_ns: c.time_ns,
+                    angle_rad: c.angle_rad,
+                    speed_rad_s: c.speed_rad_s,
+                    measured_m: c.measured_m,
+                    predicted_m: c.predicted_m,
+                    phase_reference: c.phase_reference,
+                },
+                Some(d.keyphasor_events()),
+            );
             if i == 0 {
                 self.blocks.add(&c, d.keyphasor_events());
             }
@@ -525,6 +530,11 @@ fn nonlinear_onset_after_live_calibration() {
     rig.drivers[2].apply_calibration(applied).unwrap();
     check_and_apply(&mut rig, &before, &e, 120.0);
     rig.ramp(8000.0, 9400.0, 3.5, true);
+    for (comparisons, d) in rig.comparisons.iter_mut().zip(&rig.drivers) {
+        for c in comparisons.iter_mut() {
+            c.finish(Some(d.keyphasor_events()));
+        }
+    }
     let onset = |i: usize, predicted: bool| {
         rig.comparisons[i]
             .iter()
