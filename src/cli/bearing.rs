@@ -236,9 +236,11 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
 fn check_speed(args: &BearingArgs) -> anyhow::Result<()> {
     let n = args.speed_rpm;
     let max_rpm = crate::rotor::max_speed_rpm(args.diameter_m);
+    // shown rounded down, so that the bound printed is itself allowed
+    let max_rpm_shown = max_rpm.floor();
     anyhow::ensure!(
         n.is_finite() && n > 0.0 && n <= max_rpm,
-        "invalid --speed-rpm {}: must lie in (0, {max_rpm:.0}] rpm, above zero and at most a \
+        "invalid --speed-rpm {}: must lie in (0, {max_rpm_shown:.0}] rpm, above zero and at most a \
          journal surface speed of {MAX_SURFACE_SPEED_M_S} m/s (Ø {} m)",
         shown_value(n),
         shown_value(args.diameter_m)

@@ -232,10 +232,12 @@ pub(crate) struct SweepReport {
 fn check_top_speed(b: &SweptBearing, speeds: &[f64]) -> anyhow::Result<()> {
     let d = b.film.geometry().diameter_m;
     let max_rpm = crate::rotor::max_speed_rpm(d);
+    // shown rounded down, so that the bound printed is itself allowed
+    let max_rpm_shown = max_rpm.floor();
     let top = speeds.iter().copied().fold(0.0, f64::max);
     anyhow::ensure!(
         top <= max_rpm,
-        "invalid --speeds: {} rpm is above {max_rpm:.0} rpm, a journal surface speed of {} m/s \
+        "invalid --speeds: {} rpm is above {max_rpm_shown:.0} rpm, a journal surface speed of {} m/s \
          (Ø {} m of {}); end the range there",
         crate::units::shown_value(top),
         crate::rotor::MAX_SURFACE_SPEED_M_S,

@@ -381,15 +381,24 @@ fn station_lines(st: &StationReport) -> String {
     s + &shape_line(st)
 }
 
+/// Minor over major semi-axis above which an ellipse is read as a circle: its inclination is
+/// then printed as "—" (a rounding of the axes turns it anywhere).
+const NEAR_CIRCLE: f64 = 0.98;
+
 /// The phase-free shape line of a station: the 1X (and sub-synchronous) ellipses, predicted
 /// against measured, and their shape distance.
 fn shape_line(st: &StationReport) -> String {
     let ell = |e: &OrbitEllipse| {
+        // a near-circle (minor/major above NEAR_CIRCLE) has no meaningful inclination
+        let inclination = if e.semi_minor_m > NEAR_CIRCLE * e.semi_major_m {
+            "—".to_string()
+        } else {
+            format!("{:.0}°", e.inclination_deg)
+        };
         format!(
-            "{:.2} × {:.2} µm at {:.0}°, {:?}",
+            "{:.2} × {:.2} µm at {inclination}, {:?}",
             e.semi_major_m * 1e6,
             e.semi_minor_m * 1e6,
-            e.inclination_deg,
             e.precession
         )
         .to_lowercase()

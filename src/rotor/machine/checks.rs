@@ -54,12 +54,14 @@ impl MachineDescription {
             .map(|s| s.outer_diameter_m)
             .fold(0.0, f64::max);
         let max_rpm = max_speed_rpm(diameter_m);
+        // shown rounded down, so that the bound printed is itself allowed
+        let max_rpm_shown = max_rpm.floor();
         if self.rated_speed_rpm > max_rpm {
             return Err(rules.error(
                 "rated_speed_rpm",
                 crate::units::shown_value(self.rated_speed_rpm),
                 format!(
-                    "must be at most {max_rpm:.0} rpm: the shaft's surface speed (Ø {diameter_m} m) \
+                    "must be at most {max_rpm_shown:.0} rpm: the shaft's surface speed (Ø {diameter_m} m) \
                      would exceed {MAX_SURFACE_SPEED_M_S} m/s, where the centrifugal stress reaches \
                      the yield strength of steel"
                 ),
