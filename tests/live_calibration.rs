@@ -208,15 +208,7 @@ impl Rig {
             };
             // the measured 1X against the plant's keyphasor events, as the replay reads it
             self.comparisons[i][c.station].push(
-                Sample {
-                    time_s: (c.time_ns - EPOCH_NS) as f64 * 1e-9,
-                    time_ns: c.time_ns,
-                    angle_rad: c.angle_rad,
-                    speed_rad_s: c.speed_rad_s,
-                    measured_m: c.measured_m,
-                    predicted_m: c.predicted_m,
-                    phase_reference: c.phase_reference,
-                },
+                Sample::of(&c, (c.time_ns - EPOCH_NS) as f64 * 1e-9),
                 Some(d.keyphasor_events()),
             );
             if i == 0 {

@@ -72,6 +72,21 @@ pub struct Sample {
     pub phase_reference: PhaseReference,
 }
 
+impl Sample {
+    /// The driver's comparison of one probe sample, at `time_s` since the bag's first message.
+    pub fn of(c: &crate::driver::ProbeComparison, time_s: f64) -> Sample {
+        Sample {
+            time_s,
+            time_ns: c.time_ns,
+            angle_rad: c.angle_rad,
+            speed_rad_s: c.speed_rad_s,
+            measured_m: c.measured_m,
+            predicted_m: c.predicted_m,
+            phase_reference: c.phase_reference,
+        }
+    }
+}
+
 /// The features of one orbit over a window.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct OrbitFeatures {

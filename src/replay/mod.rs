@@ -379,15 +379,7 @@ impl Replaying {
                 .report
                 .note_start(since_t0(t_ns), crate::units::rad_s_to_rpm(speed_rad_s)),
             Fed::Compared(c) => self.comparisons[c.station].push(
-                Sample {
-                    time_s: since_t0(c.time_ns),
-                    time_ns: c.time_ns,
-                    angle_rad: c.angle_rad,
-                    speed_rad_s: c.speed_rad_s,
-                    measured_m: c.measured_m,
-                    predicted_m: c.predicted_m,
-                    phase_reference: c.phase_reference,
-                },
+                Sample::of(&c, since_t0(c.time_ns)),
                 Some(self.driver.keyphasor_events()),
             ),
             Fed::Refused(why) => self.report.note_rejection(topic, &why),

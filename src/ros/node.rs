@@ -245,10 +245,7 @@ async fn run_async(
     );
     model.set_node_name(&ros.fully_qualified_name());
     model.set_counters(counters.clone());
-    let model_stop = stop.clone();
-    let model_thread = std::thread::Builder::new()
-        .name("rotor_twin model".into())
-        .spawn(move || model.run(out_tx, model_stop))?;
+    let model_thread = spawn_model(model, out_tx, &stop)?;
     let publish_thread = publishers.spawn(out_rx, rec.clone(), counters.clone())?;
 
     let route = InputRoute {
@@ -283,6 +280,18 @@ async fn run_async(
         Some(t) => finish_recording(t, &ros),
         None => Ok(()),
     }
+}
+
+/// The model thread: steps the twin and sends what it publishes to `out` until `stop`.
+fn spawn_model(
+    model: model::ModelLoop,
+    out: mpsc::SyncSender<model::Published>,
+    stop: &Arc<AtomicBool>,
+) -> std::io::Result<std::thread::JoinHandle<()>> {
+    let stop = stop.clone();
+    std::thread::Builder::new()
+        .name("rotor_twin model".into())
+        .spawn(move || model.run(out, stop))
 }
 
 /// The start-up line (at log level info) and the ROS arguments that have no effect.
