@@ -356,9 +356,14 @@ impl ReplayReport {
 /// The terminal lines of one station: amplitudes, phases, sub-synchronous, distances, shape.
 fn station_lines(st: &StationReport) -> String {
     let um = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} µm", v * 1e6));
-    let ratio = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.3}X"));
+    // A sub-synchronous component is "amplitude at order", or "none" when the block has none.
+    let subsync = |a: Option<f64>, r: Option<f64>| match (a, r) {
+        (Some(a), Some(r)) => format!("{:.2} µm at {r:.3}X", a * 1e6),
+        (Some(a), None) => format!("{:.2} µm", a * 1e6),
+        _ => "none".to_string(),
+    };
     let s = format!(
-        "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} at {} vs {} at {}, orbit RMS distance at equal times {}\n",
+        "{}: 1X {} predicted vs {} measured ({}), sub-synchronous {} predicted vs {} measured, orbit RMS distance at equal times {}\n",
         st.station,
         um(st.one_x_amplitude_predicted_m),
         um(st.one_x_amplitude_measured_m),
@@ -372,10 +377,8 @@ fn station_lines(st: &StationReport) -> String {
                 st.phase_null_reason.as_deref().unwrap_or("—")
             ),
         },
-        um(st.subsync_amplitude_predicted_m),
-        ratio(st.subsync_ratio_predicted),
-        um(st.subsync_amplitude_measured_m),
-        ratio(st.subsync_ratio_measured),
+        subsync(st.subsync_amplitude_predicted_m, st.subsync_ratio_predicted),
+        subsync(st.subsync_amplitude_measured_m, st.subsync_ratio_measured),
         um(st.orbit_rms_distance_m),
     );
     s + &shape_line(st)
