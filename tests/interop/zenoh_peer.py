@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 from peer import Header, JournalState, RotorSpeed, Time  # noqa: E402
+from latency import speed_latencies, summary  # noqa: E402
 from cyclonedds.core import Policy, Qos  # noqa: E402
 from cyclonedds.domain import DomainParticipant  # noqa: E402
 from cyclonedds.idl import IdlStruct  # noqa: E402
@@ -100,26 +101,6 @@ def first_reply(p, timeout_s):
     return None
 
 
-def latencies(p, samples):
-    lat = []
-    for k in range(1, samples + 1):
-        v = BASE + 0.001 * k
-        t0 = time.perf_counter()
-        p.send(v)
-        got = None
-        while time.perf_counter() - t0 < 1.0 and got is None:
-            for s in p.r.take(N=1000):
-                if abs(s.speed - v) < 1e-9:
-                    got = time.perf_counter() - t0
-                    break
-            if got is None:
-                time.sleep(0.0002)
-        if got is not None:
-            lat.append(got * 1e3)
-        time.sleep(0.05)
-    return sorted(lat)
-
-
 def throughput(p, seconds):
     """Counts JournalStates for `seconds` s, and per bearing the states missing in their sequence."""
     while p.all.take(N=5000):
@@ -168,11 +149,7 @@ def main():
     if first is not None:
         time.sleep(1.0)
         p.r.take(N=20000)
-        lat = latencies(p, samples)
-        out.update({"sent": samples, "samples": len(lat),
-                    "median_ms": statistics.median(lat) if lat else None,
-                    "p99_ms": lat[min(len(lat) - 1, int(0.99 * len(lat)))] if lat else None,
-                    "max_ms": lat[-1] if lat else None,
+        out.update({"sent": samples, **summary(speed_latencies(p.send, p.r, BASE, samples)),
                     "throughput": throughput(p, tput_s)})
     print(json.dumps(out))
 

@@ -95,8 +95,8 @@ bridge_conf() { # $1: listen endpoints, $2: connect endpoints (JSON lists)
     ros2dds: {
       domain: 0,
       allow: {
-        publishers: ["/rotor_twin/.*", "/diagnostics"],
-        subscribers: ["/rotor_twin/.*"],
+        publishers: [".*/rotor_twin/.*", "/diagnostics"],
+        subscribers: [".*/rotor_twin/.*"],
         service_servers: [], service_clients: [], action_servers: [], action_clients: [],
       },
     },
