@@ -2,7 +2,7 @@
 
 Usage: zenoh_peer.py latency SAMPLES THROUGHPUT_S [--announce] [--first-reply-timeout S]
        zenoh_peer.py silence SECONDS [--announce]
-  latency: waits for the first JournalState (sending speeds every 50 ms until one arrives), then
+  latency: waits for the first JournalState (sending speeds every 50 ms until one arrives) and 3 s, then
     sends SAMPLES new speeds (BASE + k*0.001 rad/s, one every 50 ms) and times the first
     JournalState carrying each (as latency.py does); then counts the JournalStates that arrive in
     THROUGHPUT_S seconds, and per bearing the states missing from their sequence of stamps.
@@ -33,6 +33,7 @@ from cyclonedds.topic import Topic  # noqa: E402
 from cyclonedds.util import duration  # noqa: E402
 
 BASE = 837.76  # rad/s, 8,000 rpm: below the microturbine's whip threshold
+WARMUP_S = 3.0  # after the first reply: the twin's start (it falls behind at first under load)
 
 
 # rmw_dds_common (Jazzy: 16-byte GIDs), the graph topic every rmw writes
@@ -119,13 +120,16 @@ def throughput(p, seconds):
     # per bearing, the states missing between consecutive stamps (the node publishes one every
     # whole number of model steps, so the interval is the median gap, not exactly 1/state_rate_hz)
     missing = {}
+    span_s = max(((max(ts) - min(ts)) * 1e-9 for ts in stamps.values()), default=0.0)
     for b, ts in stamps.items():
         ts = sorted(ts)
         gaps = [t1 - t0 for t0, t1 in zip(ts, ts[1:])]
         dt = statistics.median(gaps) if gaps else 0
         missing[b] = sum(round(g / dt) - 1 for g in gaps) if dt > 0 else None
     return {"received": n, "seconds": round(elapsed, 3), "per_s": round(n / elapsed, 1),
-            "bearings": len(stamps), "missing": missing}
+            "bearings": len(stamps), "missing": missing,
+            # model time covered by the stamps over the wall time: the node's pace as seen from here
+            "model_s": round(span_s, 3), "model_over_wall": round(span_s / elapsed, 3)}
 
 
 def main():
@@ -147,7 +151,7 @@ def main():
     first = first_reply(p, timeout)
     out = {"mode": "latency", "first_reply_s": first}
     if first is not None:
-        time.sleep(1.0)
+        time.sleep(WARMUP_S)
         p.r.take(N=20000)
         out.update({"sent": samples, **summary(speed_latencies(p.send, p.r, BASE, samples)),
                     "throughput": throughput(p, tput_s)})

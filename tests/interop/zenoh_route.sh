@@ -11,8 +11,8 @@
 # pair, inside `unshare -n`: nothing reaches the real network. The bridges talk Zenoh over TCP
 # (B connects to A's tcp/10.99.0.1:7447), multicast scouting off; on each host every DDS participant
 # is confined to loopback (the node: ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST; Cyclone, i.e. the
-# bridge and the peer: CYCLONEDDS_URI naming only `lo`); the bridges route only /rotor_twin/* and
-# /diagnostics (allow lists). Phases, each printed as one JSON line (and kept in OUT_DIR):
+# bridge and the peer: CYCLONEDDS_URI naming only `lo`); the bridges route only the twins' topics
+# (.*/rotor_twin/.*) and /diagnostics (allow lists). Phases, each printed as one JSON line (in OUT_DIR):
 #   closed  no bridge: a peer on B NOT confined (it searches the veth by multicast) sends speeds for
 #           8 s; it must receive 0 journal states, and no UDP packet from A may be on the veth
 #   zenoh   both bridges: latency of SAMPLES speed commands (speed -> first JournalState carrying
