@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A fleet route over Zenoh between two "hosts" (issue 17), and the direct DDS route for comparison.
 # A benchmark script, not part of `cargo test`. As root:
-#   ZENOH_BRIDGE=/path/to/zenoh-bridge-ros2dds bash tests/interop/zenoh_route.sh [SAMPLES] [THROUGHPUT_S] [OUT_DIR]
+#   ZENOH_BRIDGE=PATH bash tests/interop/zenoh_route.sh [SAMPLES] [THROUGHPUT_S] [OUT_DIR]
+# (PATH: a zenoh-bridge-ros2dds binary; none: only the phases without bridges)
 # (SAMPLES speed commands, default 200; THROUGHPUT_S seconds of counting journal states, default 10;
 # ROTOR_TWIN_BIN overrides target/release/rotor-twin.)
 #
@@ -31,7 +32,10 @@ root="$(cd "$here/../.." && pwd)"
 if [ "${ZENOH_ROUTE_INNER:-}" != 1 ]; then
   bridge="${ZENOH_BRIDGE:-$(command -v zenoh-bridge-ros2dds || true)}"
   # ZENOH_BRIDGE=none: only the closed and direct phases (a check of the DDS side of this script)
-  [ -x "$bridge" ] || [ "$bridge" = none ] || { echo "zenoh_route.sh: no zenoh-bridge-ros2dds (set ZENOH_BRIDGE; see tests/interop/setup-zenoh-bridge.sh)" >&2; exit 2; }
+  [ -x "$bridge" ] || [ "$bridge" = none ] || {
+    echo "zenoh_route.sh: no zenoh-bridge-ros2dds (ZENOH_BRIDGE; tests/interop/setup-zenoh-bridge.sh)" >&2
+    exit 2
+  }
   bin="${ROTOR_TWIN_BIN:-$root/target/release/rotor-twin}"
   [ -x "$bin" ] || { echo "zenoh_route.sh: no $bin (cargo build --release)" >&2; exit 2; }
   py="$(bash "$here/setup-venv.sh")/bin/python"
@@ -63,11 +67,15 @@ inb ip link set vb up multicast on
 pids=()
 node=
 # SIGTERM: a background job of a script ignores SIGINT unless it installs its own handler
-cleanup() { for p in "${pids[@]}" $node "$hostb"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+cleanup() {
+  for p in "${pids[@]}" $node "$hostb"; do kill -TERM "$p" 2> /dev/null || true; done
+  wait 2> /dev/null || true
+}
 trap cleanup EXIT
 inb ip -o addr show vb > b_addr.txt
 
-lo_only='<CycloneDDS><Domain><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces></General></Domain></CycloneDDS>'
+lo_only='<CycloneDDS><Domain><General><Interfaces><NetworkInterface name="lo" multicast="true"/>'
+lo_only+='</Interfaces></General></Domain></CycloneDDS>'
 peer="$here/zenoh_peer.py"
 
 start_node() { # $1: label; the remaining args: environment for the node
@@ -75,7 +83,9 @@ start_node() { # $1: label; the remaining args: environment for the node
   env "$@" "$bin" node --ros-args -p model:=nonlinear -p state_rate_hz:=1000.0 \
     > "node_$label.out" 2> "node_$label.err" &
   node=$!
-  for _ in $(seq 600); do grep -q "waiting for /rotor_twin/speed" "node_$label.err" && break; sleep 0.1; done
+  for _ in $(seq 600); do
+    grep -q "waiting for /rotor_twin/speed" "node_$label.err" && break; sleep 0.1
+  done
 }
 stop() { kill -TERM "$1"; wait "$1" || true; }
 capture() { # $1: pcap file; capture on A's end of the veth
@@ -105,39 +115,57 @@ bridge_conf() { # $1: listen endpoints, $2: connect endpoints (JSON lists)
 EOF
 }
 
-# ---- closed: no bridge; the node confined to lo; an unconfined peer on B searches the veth ----
-start_node closed ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-capture closed.pcap
-inb timeout 60 "$py" "$peer" silence 8 > closed.json 2> closed.err
-kill "$tcpd"; wait "$tcpd" || true
-echo "{\"phase\": \"closed\", \"peer\": $(cat closed.json), \"udp_from_a\": $(count closed.pcap 'udp and src host 10.99.0.1'), \"udp_from_b\": $(count closed.pcap 'udp and src host 10.99.0.2')}" | tee -a summary.jsonl
+report() { # $1: phase, $2: the peer's JSON file, then pairs of key and (JSON) value
+  local line="{\"phase\": \"$1\", \"peer\": $(cat "$2")"; shift 2
+  while [ $# -gt 1 ]; do line+=", \"$1\": $2"; shift 2; done
+  echo "$line}" | tee -a summary.jsonl
+}
+peer_b() { # $1: label; the rest: the peer's arguments. Confined to lo unless $UNCONFINED
+  local label="$1"; shift
+  if [ -n "${UNCONFINED:-}" ]; then inb timeout 600 "$py" "$peer" "$@" > "$label.json" 2> "$label.err"
+  else inb env CYCLONEDDS_URI="$lo_only" timeout 600 "$py" "$peer" "$@" > "$label.json" 2> "$label.err"; fi
+}
 
-if [ "$bridge" = none ]; then stop "$node"; node=; fi
-# ---- zenoh: a bridge on each host, everything DDS confined to lo ----
-if [ "$bridge" != none ]; then
-bridge_conf '["tcp/10.99.0.1:7447"]' '[]' > bridge_a.json5
-bridge_conf '[]' '["tcp/10.99.0.1:7447"]' > bridge_b.json5
-t0=$(date +%s.%N)
-env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_a.json5 > bridge_a.log 2>&1 &
-ba=$!; pids+=("$ba")
-inb env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_b.json5 > bridge_b.log 2>&1 &
-bb=$!; pids+=("$bb")
-capture zenoh.pcap
-inb env CYCLONEDDS_URI="$lo_only" timeout 600 "$py" "$peer" latency "$samples" "$tput_s" --announce \
-  > zenoh.json 2> zenoh.err
-kill "$tcpd"; wait "$tcpd" || true
-echo "{\"phase\": \"zenoh\", \"peer\": $(cat zenoh.json), \"veth_udp\": $(count zenoh.pcap udp), \"veth_tcp_7447\": $(count zenoh.pcap 'tcp port 7447'), \"veth_other\": $(count zenoh.pcap 'not udp and not tcp port 7447'), \"bridges_up_to_end_s\": $(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')}" | tee -a summary.jsonl
+closed_phase() { # no bridge; the node confined to lo; an unconfined peer on B searches the veth
+  start_node closed ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+  capture closed.pcap
+  UNCONFINED=1 peer_b closed silence 8
+  kill "$tcpd"; wait "$tcpd" || true
+  report closed closed.json udp_from_a "$(count closed.pcap 'udp and src host 10.99.0.1')" \
+    udp_from_b "$(count closed.pcap 'udp and src host 10.99.0.2')"
+}
 
-# ---- stopped: the same peer with the bridges stopped ----
-stop "$bb"; stop "$ba"; pids=()
-inb env CYCLONEDDS_URI="$lo_only" timeout 60 "$py" "$peer" silence 5 --announce > stopped.json 2> stopped.err
-echo "{\"phase\": \"stopped\", \"peer\": $(cat stopped.json)}" | tee -a summary.jsonl
+zenoh_phase() { # a bridge on each host, every DDS participant confined to lo; then bridges stopped
+  bridge_conf '["tcp/10.99.0.1:7447"]' '[]' > bridge_a.json5
+  bridge_conf '[]' '["tcp/10.99.0.1:7447"]' > bridge_b.json5
+  local t0; t0=$(date +%s.%N)
+  env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_a.json5 \
+    > bridge_a.log 2>&1 &
+  ba=$!; pids+=("$ba")
+  inb env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_b.json5 \
+    > bridge_b.log 2>&1 &
+  bb=$!; pids+=("$bb")
+  capture zenoh.pcap
+  peer_b zenoh latency "$samples" "$tput_s" --announce
+  kill "$tcpd"; wait "$tcpd" || true
+  report zenoh zenoh.json veth_udp "$(count zenoh.pcap udp)" \
+    veth_tcp_7447 "$(count zenoh.pcap 'tcp port 7447')" \
+    veth_other "$(count zenoh.pcap 'not udp and not tcp port 7447')" \
+    bridges_start_to_end_s "$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')"
+  stop "$bb"; stop "$ba"; pids=()
+  peer_b stopped silence 5 --announce
+  report stopped stopped.json
+}
+
+direct_phase() { # plain DDS across the veth (discovery by multicast), nothing confined
+  start_node direct
+  UNCONFINED=1 peer_b direct latency "$samples" "$tput_s"
+  report direct direct.json
+}
+
+closed_phase
+if [ "$bridge" != none ]; then zenoh_phase; fi
 stop "$node"; node=
-fi
-
-# ---- direct: plain DDS across the veth (discovery by multicast), nothing confined ----
-start_node direct
-inb timeout 600 "$py" "$peer" latency "$samples" "$tput_s" > direct.json 2> direct.err
-echo "{\"phase\": \"direct\", \"peer\": $(cat direct.json)}" | tee -a summary.jsonl
+direct_phase
 stop "$node"; node=
 echo "load average at the end: $(cut -d' ' -f1-3 /proc/loadavg); results in $out" | tee -a summary.jsonl
