@@ -77,15 +77,13 @@ class Peer:
         self.dp = DomainParticipant(0)
         qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(100),
                   Policy.DataRepresentation(use_cdrv0_representation=True))
-        deep = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepLast(20000),
-                   Policy.DataRepresentation(use_cdrv0_representation=True))
         self.w = DataWriter(self.dp, Topic(self.dp, "rt/rotor_twin/speed", RotorSpeed), qos=qos)
-        states = Topic(self.dp, "rt/rotor_twin/journal_state", JournalState)
-        # the latency reader keeps only the newest 100 (as latency.py: no backlog in the timing);
-        # the throughput reader keeps everything (what the route delivers, not what Python takes)
-        self.r = DataReader(self.dp, states, qos=qos)
-        self.all = DataReader(self.dp, states, qos=deep)
-        self.graph = announce(self.dp, [self.w], [self.r, self.all]) if announce_node else None
+        # one reader, keeping the newest 100 (as latency.py: no backlog in the timing). A second,
+        # deeper reader of the topic in this participant received nothing through the bridge
+        # (zenoh-plugin-ros2dds 1.9.0; not investigated), so the throughput is read by this one
+        # too: "missing" counts what the route and this reader's depth lost together.
+        self.r = DataReader(self.dp, Topic(self.dp, "rt/rotor_twin/journal_state", JournalState), qos=qos)
+        self.graph = announce(self.dp, [self.w], [self.r]) if announce_node else None
 
     def send(self, v):
         now = time.time_ns()
@@ -104,13 +102,13 @@ def first_reply(p, timeout_s):
 
 def throughput(p, seconds):
     """Counts JournalStates for `seconds` s, and per bearing the states missing in their sequence."""
-    while p.all.take(N=5000):
+    while p.r.take(N=5000):
         pass
     stamps = {}
     n = 0
     t0 = time.perf_counter()
     while time.perf_counter() - t0 < seconds:
-        batch = p.all.take(N=5000)
+        batch = p.r.take(N=5000)
         for s in batch:
             stamps.setdefault(s.bearing, set()).add(s.header.stamp.sec * 10**9 + s.header.stamp.nanosec)
         n += len(batch)
