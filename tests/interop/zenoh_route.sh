@@ -142,8 +142,9 @@ zenoh_phase() { # a bridge on each host, every DDS participant confined to lo; t
   env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_a.json5 \
     > bridge_a.log 2>&1 &
   ba=$!; pids+=("$ba")
-  inb env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" -c bridge_b.json5 \
-    > bridge_b.log 2>&1 &
+  # nsenter itself, not the inb function: $! must be the bridge (a function would run in a subshell)
+  nsenter -t "$hostb" -n env CYCLONEDDS_URI="$lo_only" ROS_DISTRO=jazzy RUST_LOG=info "$bridge" \
+    -c bridge_b.json5 > bridge_b.log 2>&1 &
   bb=$!; pids+=("$bb")
   capture zenoh.pcap
   peer_b zenoh latency "$samples" "$tput_s" --announce
