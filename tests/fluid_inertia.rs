@@ -478,23 +478,12 @@ fn kicked_table_growth(rotor: &Rotor, rpm: f64, (from, revs): (usize, usize)) ->
         kicks: vec![kick],
     };
     let run = run_driven(&quiet, &spec, None, &drive).unwrap();
-    let pts: Vec<(f64, f64)> = run.history[from..]
-        .iter()
-        .map(|r| (r.revolution as f64, r.rev_to_rev_orbit_diff.ln()))
-        .collect();
     let largest = run.history.iter().map(|r| r.rev_to_rev_orbit_diff);
     assert!(
         largest.fold(0.0, f64::max) < 0.05,
         "the orbit left the linear range"
     );
-    let m = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / m,
-        pts.iter().map(|p| p.1).sum::<f64>() / m,
-    );
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    sxy / sxx
+    run.growth_from(from)
 }
 
 /// Check (d): the time integration with `full` (eq. I1's force and Jacobian at every Newton
