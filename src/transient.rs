@@ -74,7 +74,13 @@ impl TransientResult {
     pub fn growth_per_rev(&self) -> f64 {
         let n = self.history.len();
         let take = (n / 2).max(10).min(n);
-        let pts: Vec<(f64, f64)> = self.history[n - take..]
+        self.growth_from(n - take)
+    }
+
+    /// [`Self::growth_per_rev`] fitted over the revolutions from index `from` of the history to
+    /// the end (a window chosen by the caller, e.g. where a kicked orbit is still linear).
+    pub fn growth_from(&self, from: usize) -> f64 {
+        let pts: Vec<(f64, f64)> = self.history[from.min(self.history.len())..]
             .iter()
             .filter(|r| r.rev_to_rev_orbit_diff > 0.0)
             .map(|r| (r.revolution as f64, r.rev_to_rev_orbit_diff.ln()))
