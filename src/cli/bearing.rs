@@ -83,6 +83,20 @@ pub struct BearingArgs {
     /// (laminar below Taylor's onset 41.3·√(R/c)).
     #[arg(long, default_value = "laminar", value_parser = parse_flow)]
     flow: crate::film::FlowRegime,
+    /// Adiabatic thermal film (finite model, plain bearing): the viscosity follows the film's
+    /// own temperature around the bearing (eq. E1–E3 of src/film/thermal.rs).
+    #[arg(long)]
+    thermal: bool,
+    /// Oil supply temperature (°C), with --thermal.
+    #[arg(long, default_value_t = 40.0)]
+    supply_temperature_c: f64,
+    /// Specific heat c_p of the oil (J/(kg·K)), with --thermal (default: the ASSUMED 1,900 of MDM).
+    #[arg(long, default_value_t = 1900.0)]
+    specific_heat_j_per_kg_k: f64,
+    /// Walther's law through two points °C:mm²/s, with --thermal (default: the machine file's MDM
+    /// points).
+    #[arg(long, default_value = "40:0.889,80:0.60")]
+    viscosity_points: String,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -94,7 +108,7 @@ pub struct BearingArgs {
     /// are taken from it (with --speeds).
     #[arg(long, requires = "speeds", conflicts_with_all = [
         "diameter_m", "length_m", "clearance_m", "viscosity_pa_s", "density_kg_m3", "load_n",
-        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model", "flow",
+        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model", "flow", "thermal",
     ])]
     config: Option<PathBuf>,
     /// The machine file's bearing, by name; default its first film bearing.
@@ -140,6 +154,8 @@ struct BearingReport {
     #[serde(with = "crate::film::rows")]
     damping_dimensionless: Matrix2<f64>,
     frame: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    thermal: Option<super::bearing_thermal::ThermalReport>,
 }
 
 pub(crate) fn run(args: &BearingArgs) -> anyhow::Result<()> {
@@ -221,6 +237,18 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
             args.flow
         );
     }
+    if args.thermal {
+        anyhow::ensure!(
+            args.model == ModelKind::Finite
+                && args.grooves == Grooves::None
+                && args.flow == crate::film::FlowRegime::Laminar,
+            "--thermal is built for the finite laminar film of a plain bearing (--model finite \
+             --grooves none --flow laminar)"
+        );
+        let film = FiniteFilm::new(geometry, lubricant, args.grid)?;
+        let thermal = crate::film::ThermalFilm::new(film, thermal_oil(args)?)?;
+        return Ok((Box::new(thermal), lubricant));
+    }
     let model: Box<dyn FilmModel> = match args.model {
         ModelKind::Finite => {
             Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?.with_flow(args.flow))
@@ -228,6 +256,32 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
         ModelKind::Short => Box::new(ShortFilm::new(geometry, lubricant)?),
     };
     Ok((model, lubricant))
+}
+
+/// The oil of `--thermal` from the flags.
+fn thermal_oil(args: &BearingArgs) -> anyhow::Result<crate::film::ThermalOil> {
+    super::bearing_thermal::thermal_oil(
+        &args.viscosity_points,
+        args.density_kg_m3,
+        args.specific_heat_j_per_kg_k,
+        args.supply_temperature_c,
+    )
+}
+
+/// The thermal figures at the equilibrium `eq`, with `--thermal`.
+fn thermal_report(
+    args: &BearingArgs,
+    lubricant: Lubricant,
+    eq: &Equilibrium,
+    omega: f64,
+) -> anyhow::Result<Option<super::bearing_thermal::ThermalReport>> {
+    if !args.thermal {
+        return Ok(None);
+    }
+    let geometry = BearingGeometry::plain(args.diameter_m, args.length_m, args.clearance_m)?;
+    let film = FiniteFilm::new(geometry, lubricant, args.grid)?;
+    let kin = crate::film::JournalKinematics::at_position(eq.position_m, omega);
+    super::bearing_thermal::report(film, thermal_oil(args)?, &kin).map(Some)
 }
 
 /// `--speed-rpm`, checked before any equilibrium is sought (issue 15, item 21: -5, 1 and 1e30
@@ -288,7 +342,14 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
                 "invalid --load-n {}: the static load (N) must be a finite number greater than zero",
                 shown_value(w)
             );
-            check_capacity(model.as_mut(), args, w)?;
+            if args.thermal {
+                // the capacity of the film at the supply temperature (a hotter film carries
+                // less: the equilibrium search then names the failure)
+                let g = BearingGeometry::plain(args.diameter_m, args.length_m, args.clearance_m)?;
+                check_capacity(&mut FiniteFilm::new(g, lubricant, args.grid)?, args, w)?;
+            } else {
+                check_capacity(model.as_mut(), args, w)?;
+            }
             equilibrium_under_load(model.as_mut(), args.viscosity_pa_s, [w, 0.0], omega)
         }
     }
@@ -324,6 +385,7 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
         stiffness_dimensionless: eq.coefficients.dimensionless_stiffness(w, c),
         damping_dimensionless: eq.coefficients.dimensionless_damping(w, c, omega),
         frame: FRAME,
+        thermal: thermal_report(args, lubricant, &eq, omega)?,
     };
     anyhow::ensure!(
         report_is_finite(&report),
@@ -428,6 +490,9 @@ fn print_table(r: &BearingReport) -> anyhow::Result<()> {
         "  B = c ω c_r/W              {}",
         d(r.damping_dimensionless)
     );
+    if let Some(t) = &r.thermal {
+        super::bearing_thermal::print(t)?;
+    }
     outln!("  frame: {}", r.frame);
     Ok(())
 }

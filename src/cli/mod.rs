@@ -32,6 +32,7 @@ macro_rules! outln {
 mod bag;
 mod bearing;
 mod bearing_speeds;
+mod bearing_thermal;
 mod bench;
 mod mode_shapes;
 mod modes;

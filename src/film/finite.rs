@@ -72,6 +72,9 @@ pub struct FiniteFilm {
     /// Their slopes dG/dH (3H² laminar), for the perturbation equations.
     dg_node: Vec<f64>,
     dg_face: Vec<f64>,
+    /// Per column: the viscosity over the lubricant's, µ(ζ)/µ₀, of a thermal film
+    /// (`src/film/thermal.rs`, eq. E1); empty for the isoviscous film (seed eq. 2).
+    viscosity_ratio: Vec<f64>,
     /// Laminar, turbulent or auto (`src/film/turbulence.rs`).
     flow: FlowRegime,
     /// The flow factors of the last film shape.
@@ -156,6 +159,7 @@ impl FiniteFilm {
             h3_face: vec![0.0; nt],
             dg_node: vec![0.0; nt],
             dg_face: vec![0.0; nt],
+            viscosity_ratio: Vec::new(),
             flow: FlowRegime::Laminar,
             factors: FlowFactors::new(FlowRegime::Laminar, 0.0, 1.0),
             source: vec![0.0; nt],
@@ -186,6 +190,25 @@ impl FiniteFilm {
         self.flow = flow;
         self.warm = false;
         self
+    }
+
+    /// Sets the viscosity around the film, µ(ζ_i)/µ₀ per grid column (a thermal film, eq. E1
+    /// of `src/film/thermal.rs`); an empty slice restores the isoviscous film. Each conductance
+    /// H³ is divided by the ratio at its node (axial) or the mean of its two nodes (a θ-face).
+    pub fn set_viscosity_ratio(&mut self, ratio: &[f64]) -> Result<(), FilmError> {
+        if !ratio.is_empty() && ratio.len() != self.grid.n_theta {
+            return Err(FilmError::InvalidParameter {
+                name: "viscosity ratio columns",
+                value: ratio.len() as f64,
+                rule: "must equal the grid's n_theta",
+            });
+        }
+        for &r in ratio {
+            super::error::positive("viscosity ratio µ/µ₀", r)?;
+        }
+        self.viscosity_ratio.clear();
+        self.viscosity_ratio.extend_from_slice(ratio);
+        Ok(())
     }
 
     /// The flow regime.
@@ -276,6 +299,16 @@ impl FiniteFilm {
             let [gx, dgx, _, _] = self.factors.conductances(hf);
             (self.h3_node[i], self.dg_node[i]) = (gz, dgz);
             (self.h3_face[i], self.dg_face[i]) = (gx, dgx);
+        }
+        if !self.viscosity_ratio.is_empty() {
+            for i in 0..nt {
+                let at_node = self.viscosity_ratio[i];
+                let at_face = 0.5 * (at_node + self.viscosity_ratio[(i + 1) % nt]);
+                self.h3_node[i] /= at_node;
+                self.dg_node[i] /= at_node;
+                self.h3_face[i] /= at_face;
+                self.dg_face[i] /= at_face;
+            }
         }
         for i in 0..nt {
             let west = if i == 0 { nt - 1 } else { i - 1 };

@@ -23,6 +23,7 @@ mod heating;
 mod inertia;
 mod short;
 mod table;
+mod thermal;
 mod turbulence;
 mod viscosity;
 
@@ -42,6 +43,7 @@ pub use table::{
     FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,
 };
 pub use table::{EccentricityMap, FilmTable, TableResolution, TabulatedFilm};
+pub use thermal::{ThermalFilm, ThermalOil, ThermalState};
 pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};
 pub use viscosity::{
     check_viscosity_scale, ViscosityLaw, ViscosityScaledFilm, ViscosityTable, WaltherLaw,

@@ -118,10 +118,13 @@ impl FiniteFilm {
         let c = self.geometry.radial_clearance_m;
         let mu = self.lubricant.viscosity_pa_s;
         // with the turbulent Couette shear factor (eq. T3; 1 laminar)
+        // and the viscosity of each column of a thermal film (µ(ζ)/µ₀, eq. E1)
+        let ratio = |i: usize| self.viscosity_ratio.get(i).copied().unwrap_or(1.0);
         let inverse_h: f64 = self
             .h_node
             .iter()
-            .map(|&h| self.factors.couette_shear(h) / h)
+            .enumerate()
+            .map(|(i, &h)| ratio(i) * self.factors.couette_shear(h) / h)
             .sum();
         let couette =
             mu * speed_rad_s * r.powi(3) * self.geometry.length_m / c * inverse_h * self.dtheta;
@@ -163,5 +166,74 @@ impl FiniteFilm {
             q += self.row_width(j) * (speed_rad_s * h - self.h3_face[west] * dpi / self.dtheta);
         }
         r * r * c * q
+    }
+
+    /// The mid-plane pressure zone of the last solve, (first, last) column, as ζ1 and ζ2 report it.
+    pub(crate) fn pressure_zone(&self) -> Option<(usize, usize)> {
+        self.midplane_zone()
+    }
+
+    /// Film thickness at column i's node of the last solve, h/c.
+    pub(crate) fn film_thickness(&self, i: usize) -> f64 {
+        self.h_node[i]
+    }
+
+    /// The heat budget of the last converged solve at `speed_rad_s`, per grid column i (both
+    /// halves of the bearing; the thermal film's inputs, `src/film/thermal.rs` eq. E2–E3):
+    /// `flow[i]` the circumferential flow through the θ-face after column i (m³/s, the solver's
+    /// own flux, as [`Self::inflow`]); `couette_w[i]` the Couette dissipation µω²R²/h of a full
+    /// film over the column's cells (W); `pressure_w[i]` the pressure-flow dissipation
+    /// h³|∇p|²/(12µ) (W), each face's share split between the cells it joins (an edge face's to
+    /// its one cell). With p = 6µ₀(R/c)²Π and G the conductance H³/(µ/µ₀), the latter is
+    /// 3µ₀R²G/c·|∇Π|² per unit area.
+    pub(crate) fn column_budget(
+        &self,
+        speed_rad_s: f64,
+        flow: &mut [f64],
+        couette_w: &mut [f64],
+        pressure_w: &mut [f64],
+    ) {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let r = self.geometry.radius_m();
+        let c = self.geometry.radial_clearance_m;
+        let mu0 = self.lubricant.viscosity_pa_s;
+        let ratio = |i: usize| self.viscosity_ratio.get(i).copied().unwrap_or(1.0);
+        // both halves: the cells of a column cover R²Δθ · L/R
+        let column_area = r * self.geometry.length_m * self.dtheta;
+        let per_gradient = 3.0 * mu0 * r * r / c;
+        pressure_w[..nt].fill(0.0);
+        for i in 0..nt {
+            let h = self.h_node[i];
+            couette_w[i] = mu0 * ratio(i) * (speed_rad_s * r).powi(2) / (c * h)
+                * self.factors.couette_shear(h)
+                * column_area;
+            let east = (i + 1) % nt;
+            let mut q = 0.0;
+            for j in 0..nz {
+                let w = self.row_width(j);
+                let dpi = (self.pi[east * nz + j] - self.pi[i * nz + j]) / self.dtheta;
+                q += w * (speed_rad_s * self.h_face[i] - self.h3_face[i] * dpi);
+                let face =
+                    per_gradient * self.h3_face[i] * dpi * dpi * 2.0 * r * r * self.dtheta * w;
+                pressure_w[i] += 0.5 * face;
+                pressure_w[east] += 0.5 * face;
+                let above = if j + 1 < nz {
+                    self.pi[i * nz + j + 1]
+                } else {
+                    0.0
+                };
+                let dz_pi = (above - self.pi[i * nz + j]) / self.dz;
+                pressure_w[i] += per_gradient
+                    * self.h3_node[i]
+                    * dz_pi
+                    * dz_pi
+                    * 2.0
+                    * r
+                    * r
+                    * self.dtheta
+                    * self.dz;
+            }
+            flow[i] = r * r * c * q;
+        }
     }
 }

@@ -1,0 +1,114 @@
+//! `rotor-twin bearing --thermal`: the adiabatic thermal film (`src/film/thermal.rs`, eq. E1–E3).
+
+use crate::film::{
+    FilmModel, FiniteFilm, JournalKinematics, ThermalFilm, ThermalOil, ViscosityLaw, WaltherLaw,
+    ZERO_CELSIUS_K,
+};
+use anyhow::Context;
+use serde::Serialize;
+
+/// The oil of `--thermal`: Walther's law through two `°C:mm²/s` points (`40:0.889,80:0.60`, the
+/// machine file's MDM points), density ρ, c_p and supply temperature; used from 0 to 250 °C.
+pub(crate) fn thermal_oil(
+    points: &str,
+    density_kg_m3: f64,
+    specific_heat_j_per_kg_k: f64,
+    supply_temperature_c: f64,
+) -> anyhow::Result<ThermalOil> {
+    let parsed: Vec<(f64, f64)> = points
+        .split(',')
+        .map(|p| {
+            let (t, nu) = p.split_once(':').with_context(|| {
+                format!("invalid --viscosity-points '{p}': each point is °C:mm²/s")
+            })?;
+            let num = |s: &str| {
+                s.trim().parse::<f64>().with_context(|| {
+                    format!("invalid --viscosity-points '{p}': '{s}' is not a number")
+                })
+            };
+            Ok((num(t)? + ZERO_CELSIUS_K, num(nu)?))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let [a, b] = parsed[..] else {
+        anyhow::bail!(
+            "invalid --viscosity-points '{points}': Walther's law takes exactly two °C:mm²/s points"
+        );
+    };
+    let range = [ZERO_CELSIUS_K, 250.0 + ZERO_CELSIUS_K];
+    let law = WaltherLaw::through([a, b], density_kg_m3, range)
+        .map_err(|e| anyhow::anyhow!("invalid --viscosity-points '{points}': {e}"))?;
+    let supply_k = supply_temperature_c + ZERO_CELSIUS_K;
+    anyhow::ensure!(
+        supply_k.is_finite() && (range[0]..=range[1]).contains(&supply_k),
+        "invalid --supply-temperature-c {supply_temperature_c}: must lie within 0–250 °C"
+    );
+    Ok(ThermalOil {
+        law: ViscosityLaw::Walther(law),
+        specific_heat_j_per_kg_k,
+        supply_temperature_k: supply_k,
+    })
+}
+
+/// The thermal figures of the `--json` report (°C where named so).
+#[derive(Debug, Serialize)]
+pub(crate) struct ThermalReport {
+    supply_temperature_c: f64,
+    /// After mixing where the film re-forms (E3).
+    inlet_temperature_c: f64,
+    rupture_temperature_c: f64,
+    max_temperature_c: f64,
+    mean_temperature_c: f64,
+    fresh_flow_m3_s: f64,
+    dissipation_w: f64,
+    heat_carried_w: f64,
+    iterations: usize,
+    /// Per grid column, from +x in the direction of rotation.
+    temperature_c: Vec<f64>,
+}
+
+/// The thermal film's state at `kin` (the equilibrium found), solved anew from the supply
+/// temperature (the fixed point of E1–E3 does not depend on where it starts).
+pub(crate) fn report(
+    film: FiniteFilm,
+    oil: ThermalOil,
+    kin: &JournalKinematics,
+) -> anyhow::Result<ThermalReport> {
+    let supply = oil.supply_temperature_k;
+    let mut thermal = ThermalFilm::new(film, oil)?;
+    thermal
+        .solve(kin)
+        .context("thermal film at the equilibrium")?;
+    let s = thermal.state();
+    let c = |k: f64| k - ZERO_CELSIUS_K;
+    Ok(ThermalReport {
+        supply_temperature_c: c(supply),
+        inlet_temperature_c: c(s.inlet_temperature_k),
+        rupture_temperature_c: c(s.rupture_temperature_k),
+        max_temperature_c: c(s.max_temperature_k),
+        mean_temperature_c: c(s.mean_temperature_k),
+        fresh_flow_m3_s: s.fresh_flow_m3_s,
+        dissipation_w: s.dissipation_w,
+        heat_carried_w: s.heat_carried_w,
+        iterations: s.iterations,
+        temperature_c: thermal.temperature_k().iter().map(|&t| c(t)).collect(),
+    })
+}
+
+/// The terminal lines of `--thermal`.
+pub(crate) fn print(t: &ThermalReport) -> anyhow::Result<()> {
+    outln!(
+        "  thermal film (adiabatic)   supply {:.2} °C, inlet after mixing {:.2} °C, at rupture {:.2} °C",
+        t.supply_temperature_c,
+        t.inlet_temperature_c,
+        t.rupture_temperature_c
+    );
+    outln!(
+        "                             max {:.2} °C, flow-weighted mean {:.2} °C; fresh oil {:.3e} m³/s; dissipation {:.2} W ({} iterations)",
+        t.max_temperature_c,
+        t.mean_temperature_c,
+        t.fresh_flow_m3_s,
+        t.dissipation_w,
+        t.iterations
+    );
+    Ok(())
+}
