@@ -129,7 +129,10 @@ fn the_film_balance_closes_with_mass_conservation_and_not_with_the_reynolds_cond
         // taken full (φ = 1), so the Couette flow that reaches the feed is the full ωRh/2 and
         // the feed delivers nothing net: the side flow is fluid the condition creates
         assert!(r.feed_m3_s.abs() < 0.1 * r.side_m3_s, "{r:?}");
-        assert!((r.side_m3_s / b.side_m3_s - 1.0).abs() < 1e-9, "same pressure field");
+        assert!(
+            (r.side_m3_s / b.side_m3_s - 1.0).abs() < 1e-9,
+            "same pressure field"
+        );
     }
 }
 
@@ -175,7 +178,10 @@ fn a_whirling_journal_conserves_the_fluid_step_by_step() {
     );
     // round-off of a converged solve (the band LU's residual on ~600 unknowns)
     assert!(worst < 1e-9, "flow balance off by {worst:e}");
-    assert!((dv - net).abs() < 1e-9 * v0, "volume {dv:e} vs net inflow {net:e}");
+    assert!(
+        (dv - net).abs() < 1e-9 * v0,
+        "volume {dv:e} vs net inflow {net:e}"
+    );
     // the film does rupture and re-form on this orbit (else the test checks nothing of φ)
     assert!(ruptured > 0.2, "deepest rupture {ruptured}");
 }
@@ -219,15 +225,34 @@ fn the_transient_film_relaxes_to_the_steady_solution() {
 /// of the forward film (F_x the same, F_y and ζ mirrored).
 #[test]
 fn reversed_rotation_gives_the_mirror_image() {
-    let mut fwd = film(seed_bearing(0.5), FilmGrid::DEFAULT, Cavitation::MassConserving);
+    let mut fwd = film(
+        seed_bearing(0.5),
+        FilmGrid::DEFAULT,
+        Cavitation::MassConserving,
+    );
     let mut rev = fwd.clone();
     let a = fwd.solve(&at(0.6)).unwrap();
     let mut k = at(0.6);
     k.speed_rad_s = -k.speed_rad_s;
     let b = rev.solve(&k).unwrap();
-    assert!((a.force_n[0] - b.force_n[0]).abs() < 1e-9 * load(&a), "{a:?} {b:?}");
-    assert!((a.force_n[1] + b.force_n[1]).abs() < 1e-9 * load(&a), "{a:?} {b:?}");
-    assert!(rev.flow_balance().feed_m3_s < 0.0, "the feed delivers into −θ");
+    assert!(
+        (a.force_n[0] - b.force_n[0]).abs() < 1e-9 * load(&a),
+        "{a:?} {b:?}"
+    );
+    assert!(
+        (a.force_n[1] + b.force_n[1]).abs() < 1e-9 * load(&a),
+        "{a:?} {b:?}"
+    );
+    // the feed delivers the same flow, now carried towards −θ, and it leaves at the ends
+    let (f, r) = (fwd.flow_balance(), rev.flow_balance());
+    assert!(
+        (f.feed_m3_s - r.feed_m3_s).abs() < 1e-9 * f.feed_m3_s,
+        "{f:?} {r:?}"
+    );
+    assert!(
+        (r.feed_m3_s - r.side_m3_s).abs() < 1e-10 * r.feed_m3_s,
+        "{r:?}"
+    );
 }
 
 /// Grid convergence of the steady JFO film (L/D 0.5, ε 0.6): load and rupture angle on
@@ -252,6 +277,14 @@ fn grid_convergence_of_the_steady_film() {
         );
         loads.push(load(&r));
     }
+    // measured: 60×10 → 120×20 +0.26 %, 120×20 → 240×40 +0.042 %: the default grid is within
+    // the project's 0.5 % on refinement
+    let first = (loads[1] / loads[0] - 1.0).abs();
     let last = (loads[2] / loads[1] - 1.0).abs();
-    println!("120×20 → 240×40: {:.3} %", 100.0 * last);
+    println!(
+        "60×10 → 120×20: {:.3} %, 120×20 → 240×40: {:.3} %",
+        100.0 * first,
+        100.0 * last
+    );
+    assert!(first < 0.005 && last < 0.005 && last < first, "{loads:?}");
 }

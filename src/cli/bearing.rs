@@ -240,7 +240,9 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
     if args.model == ModelKind::Short && args.cavitation != CavitationKind::Reynolds {
-        anyhow::bail!("--cavitation mass-conserving is built in the finite model only; use --model finite");
+        anyhow::bail!(
+            "--cavitation mass-conserving is built in the finite model only; use --model finite"
+        );
     }
     if args.model == ModelKind::Short && args.flow != crate::film::FlowRegime::Laminar {
         anyhow::bail!(

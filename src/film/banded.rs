@@ -485,7 +485,11 @@ mod tests {
         let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         for i in 0..n {
             let ax: f64 = (0..n).map(|j| dense[i][j] * x[j]).sum();
-            assert!((ax - rhs[i]).abs() < 1e-12 * xmax, "row {i}: {ax} vs {}", rhs[i]);
+            assert!(
+                (ax - rhs[i]).abs() < 1e-12 * xmax,
+                "row {i}: {ax} vs {}",
+                rhs[i]
+            );
         }
         // and a singular matrix is refused
         lu.reset(3, 1, 1);

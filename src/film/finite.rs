@@ -26,7 +26,7 @@
 //! with the same factor. The moving zone boundary adds nothing to first order because p and
 //! ∂p/∂n vanish there (Lund 1987).
 
-use super::banded::{PivotedBandLu, BandMatrix};
+use super::banded::{BandMatrix, PivotedBandLu};
 use super::coefficients::FilmCoefficients;
 use super::error::FilmError;
 use super::geometry::{BearingGeometry, FilmGrid, Lubricant};

@@ -138,8 +138,8 @@ impl FiniteFilm {
         // was at the start of a transient (a fixed feed hole)
         let steady = self.inverse_step == 0.0;
         if self.geometry.grooves.is_empty() && (steady || self.feed_column.is_none()) {
-            self.feed_column = (0..self.grid.n_theta)
-                .max_by(|&a, &b| self.h_node[a].total_cmp(&self.h_node[b]));
+            self.feed_column =
+                (0..self.grid.n_theta).max_by(|&a, &b| self.h_node[a].total_cmp(&self.h_node[b]));
         }
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         for i in 0..nt {
@@ -189,7 +189,12 @@ impl FiniteFilm {
 
     /// The coefficients of node (i, j) in (M3): `(node, coefficient)` of Π (own, west, east,
     /// south, north) and of φ (own, the two upwind faces), and the constant term.
-    fn mixed_row(&self, i: usize, j: usize, speed: f64) -> ([(usize, f64); 5], [(usize, f64); 3], f64) {
+    fn mixed_row(
+        &self,
+        i: usize,
+        j: usize,
+        speed: f64,
+    ) -> ([(usize, f64); 5], [(usize, f64); 3], f64) {
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         let k = i * nz + j;
         let west = if i == 0 { nt - 1 } else { i - 1 };
