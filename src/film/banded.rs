@@ -222,34 +222,39 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// Stored by columns in LAPACK's `dgbtrf` layout: `kl` sub-diagonals, `ku` super-diagonals and
 /// `kl` more rows for the fill-in that row interchanges bring; `A[i][j]` lives at
 /// `j·ld + (kl + ku + i − j)` with `ld = 2·kl + ku + 1`. Factor cost n·kl·(kl + ku).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct PivotedBandLu {
+    /// The band and its fill-in by columns, overwritten by L and U.
     data: Vec<f64>,
+    /// Row interchanged with row k at step k.
     pivot: Vec<usize>,
+    /// Rows.
     n: usize,
+    /// Sub-diagonals.
     kl: usize,
+    /// Super-diagonals (before fill-in).
     ku: usize,
 }
 
 impl PivotedBandLu {
+    /// Leading dimension: stored rows a column.
+    fn ld(&self) -> usize {
+        2 * self.kl + self.ku + 1
+    }
+
+    /// Position of A[i][j] in `data`.
+    #[inline]
+    fn at(&self, i: usize, j: usize) -> usize {
+        j * self.ld() + (self.kl + self.ku + i - j)
+    }
+
     /// Reserves room for matrices up to `max_n` rows with up to `max_k` sub- and super-diagonals.
     pub(crate) fn with_capacity(max_n: usize, max_k: usize) -> Self {
         Self {
             data: vec![0.0; max_n * (3 * max_k + 1)],
             pivot: vec![0; max_n],
-            n: 0,
-            kl: 0,
-            ku: 0,
+            ..Self::default()
         }
-    }
-
-    fn ld(&self) -> usize {
-        2 * self.kl + self.ku + 1
-    }
-
-    #[inline]
-    fn at(&self, i: usize, j: usize) -> usize {
-        j * self.ld() + (self.kl + self.ku + i - j)
     }
 
     /// Starts a new zero matrix of `n` rows with `kl` sub- and `ku` super-diagonals.
@@ -334,18 +339,22 @@ impl PivotedBandLu {
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [−½, ½) from a linear congruential generator seeded with `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
+
     /// A random diagonally dominant band matrix: the factor reproduces A x = r to round-off.
     #[test]
     fn solves_a_diagonally_dominant_band_system() {
         let (n, b) = (37, 5);
         let mut dense = vec![vec![0.0; n]; n];
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(12345);
         let mut m = BandMatrix::with_capacity(n, b);
         m.reset(n, b);
         for i in 0..n {
@@ -458,13 +467,7 @@ mod tests {
     #[test]
     fn band_lu_solves_a_system_that_needs_pivoting() {
         let (n, kl, ku) = (41, 4, 3);
-        let mut seed = 987u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(987);
         let mut dense = vec![vec![0.0; n]; n];
         let mut lu = PivotedBandLu::with_capacity(n, kl.max(ku));
         lu.reset(n, kl, ku);

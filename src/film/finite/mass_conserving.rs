@@ -67,6 +67,14 @@ pub struct FlowBalance {
     pub storage_m3_s: f64,
 }
 
+/// The terms of (M3) at one node: `(node, coefficient)` of Π (own, west, east, south, north) and
+/// of φ (own, the two upwind faces), and the constant term.
+struct MixedRow {
+    pi: [(usize, f64); 5],
+    phi: [(usize, f64); 3],
+    constant: f64,
+}
+
 /// Most set-update passes allowed for one mass-conserving solve.
 const MAX_PASSES: usize = 200;
 
@@ -74,6 +82,9 @@ impl FiniteFilm {
     /// This solver with the cavitation model `cavitation` (Reynolds by default).
     pub fn with_cavitation(mut self, cavitation: Cavitation) -> Self {
         self.cavitation = cavitation;
+        // the Reynolds condition's flows read φ = 1 everywhere
+        self.phi.fill(1.0);
+        self.feed_column = None;
         if cavitation == Cavitation::MassConserving {
             let nodes = self.grid.n_theta * self.grid.n_z;
             self.lu = PivotedBandLu::with_capacity(nodes, self.grid.n_z + 1);
@@ -187,14 +198,8 @@ impl FiniteFilm {
         n
     }
 
-    /// The coefficients of node (i, j) in (M3): `(node, coefficient)` of Π (own, west, east,
-    /// south, north) and of φ (own, the two upwind faces), and the constant term.
-    fn mixed_row(
-        &self,
-        i: usize,
-        j: usize,
-        speed: f64,
-    ) -> ([(usize, f64); 5], [(usize, f64); 3], f64) {
+    /// The terms of (M3) at node (i, j) at speed `speed` (rad/s).
+    fn mixed_row(&self, i: usize, j: usize, speed: f64) -> MixedRow {
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         let k = i * nz + j;
         let west = if i == 0 { nt - 1 } else { i - 1 };
@@ -227,7 +232,11 @@ impl FiniteFilm {
             (up_east * nz + j, rw * speed * self.h_face[i]),
             (up_west * nz + j, -rw * speed * self.h_face[west]),
         ];
-        (pi_terms, phi_terms, constant)
+        MixedRow {
+            pi: pi_terms,
+            phi: phi_terms,
+            constant,
+        }
     }
 
     /// Assembles and solves (M3) for the current full / ruptured sets, and stores Π and φ.
@@ -239,9 +248,9 @@ impl FiniteFilm {
         let speed = self.speed_now;
         for r in 0..n {
             let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
-            let (pi_terms, phi_terms, constant) = self.mixed_row(i, j, speed);
-            let mut rhs = -constant;
-            for (m, a) in pi_terms {
+            let row = self.mixed_row(i, j, speed);
+            let mut rhs = -row.constant;
+            for (m, a) in row.pi {
                 if a == 0.0 {
                     continue;
                 }
@@ -252,7 +261,7 @@ impl FiniteFilm {
                     lu.add(r, s as usize, a);
                 }
             }
-            for (m, a) in phi_terms {
+            for (m, a) in row.phi {
                 let s = self.slot[m];
                 if s == NOT_FREE || self.free[m] {
                     rhs -= a;
@@ -375,7 +384,7 @@ impl FiniteFilm {
             let east = if i + 1 == nt { 0 } else { i + 1 };
             for j in 0..nz {
                 let k = i * nz + j;
-                let (_, phi_terms, constant) = self.mixed_row(i, j, speed);
+                let row = self.mixed_row(i, j, speed);
                 // flow into node k across the faces it shares with a fed column
                 for (nb, face) in [(west, west), (east, i)] {
                     if self.fixed_pi(nb).is_none() {
@@ -392,7 +401,7 @@ impl FiniteFilm {
                     // the face to the bearing edge, Π = 0 there
                     side += self.dtheta * self.h3_node[i] / self.dz * self.pi[k];
                 }
-                storage += phi_terms[0].1 * self.phi[k] + constant;
+                storage += row.phi[0].1 * self.phi[k] + row.constant;
             }
         }
         let r = self.geometry.radius_m();
