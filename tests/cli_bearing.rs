@@ -118,3 +118,25 @@ fn bad_flags_are_named() {
         assert!(!out.contains("NaN"), "{args:?} printed NaN");
     }
 }
+
+#[test]
+fn mass_conserving_cavitation_is_a_flag_and_the_default_is_unchanged() {
+    // issue 18: the JFO film of the default bearing (fed at its widest gap) against the
+    // Reynolds condition, the default; measured ε 0.5323 vs 0.5328, p_max −0.3 %
+    let re = json(&["bearing", "--json"]);
+    let jfo = json(&["bearing", "--json", "--cavitation", "mass-conserving"]);
+    assert_eq!(re["cavitation"], "reynolds");
+    assert_eq!(jfo["cavitation"], "mass-conserving");
+    for key in ["eccentricity_ratio", "max_pressure_pa", "power_loss_w"] {
+        let (a, b) = (re[key].as_f64().unwrap(), jfo[key].as_f64().unwrap());
+        assert!((b / a - 1.0).abs() < 0.01, "{key}: {b} vs {a}");
+    }
+    let (ok, _, err) = run_cli(&[
+        "bearing",
+        "--model",
+        "short",
+        "--cavitation",
+        "mass-conserving",
+    ]);
+    assert!(!ok && err.contains("--cavitation"), "{err}");
+}

@@ -37,6 +37,26 @@ pub(crate) enum ModelKind {
     Short,
 }
 
+/// How the film cavitates (finite model).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub(crate) enum CavitationKind {
+    /// Reynolds condition: p ≥ 0, p = ∂p/∂n = 0 at rupture (seed eq. 6).
+    Reynolds,
+    /// Jakobsson–Floberg–Olsson / Elrod–Adams: pressure and fluid fraction (issue 18); a plain
+    /// bearing is fed at ambient pressure at its widest gap.
+    MassConserving,
+}
+
+impl From<CavitationKind> for crate::film::Cavitation {
+    fn from(kind: CavitationKind) -> Self {
+        match kind {
+            CavitationKind::Reynolds => Self::Reynolds,
+            CavitationKind::MassConserving => Self::MassConserving,
+        }
+    }
+}
+
 /// Static analysis of one journal bearing (defaults: the seed's microturbine bearing).
 #[derive(Debug, Clone, Args)]
 pub struct BearingArgs {
@@ -97,6 +117,9 @@ pub struct BearingArgs {
     /// points).
     #[arg(long, default_value = "40:0.889,80:0.60")]
     viscosity_points: String,
+    /// Cavitation condition of the finite film: reynolds or mass-conserving (JFO, issue 18).
+    #[arg(long, value_enum, default_value_t = CavitationKind::Reynolds)]
+    cavitation: CavitationKind,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -108,7 +131,7 @@ pub struct BearingArgs {
     /// are taken from it (with --speeds).
     #[arg(long, requires = "speeds", conflicts_with_all = [
         "diameter_m", "length_m", "clearance_m", "viscosity_pa_s", "density_kg_m3", "load_n",
-        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model", "flow", "thermal",
+        "grooves", "groove_width_deg", "supply_pressure_pa", "grid", "model", "flow", "thermal", "cavitation",
     ])]
     config: Option<PathBuf>,
     /// The machine file's bearing, by name; default its first film bearing.
@@ -127,6 +150,7 @@ pub struct BearingArgs {
 #[derive(Debug, Serialize)]
 struct BearingReport {
     model: ModelKind,
+    cavitation: CavitationKind,
     grid: String,
     grooves: Grooves,
     speed_rpm: f64,
@@ -231,6 +255,11 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
     if args.model == ModelKind::Short && args.grooves != Grooves::None {
         anyhow::bail!("--model short represents a plain bearing only; use --grooves none");
     }
+    if args.model == ModelKind::Short && args.cavitation != CavitationKind::Reynolds {
+        anyhow::bail!(
+            "--cavitation mass-conserving is built in the finite model only; use --model finite"
+        );
+    }
     if args.model == ModelKind::Short && args.flow != crate::film::FlowRegime::Laminar {
         anyhow::bail!(
             "--flow {:?} is built in the finite model only; use --model finite",
@@ -241,9 +270,10 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
         anyhow::ensure!(
             args.model == ModelKind::Finite
                 && args.grooves == Grooves::None
-                && args.flow == crate::film::FlowRegime::Laminar,
-            "--thermal is built for the finite laminar film of a plain bearing (--model finite \
-             --grooves none --flow laminar)"
+                && args.flow == crate::film::FlowRegime::Laminar
+                && args.cavitation == CavitationKind::Reynolds,
+            "--thermal is built for the finite laminar film of a plain bearing with the Reynolds \
+             condition (--model finite --grooves none --flow laminar --cavitation reynolds)"
         );
         let film = FiniteFilm::new(geometry, lubricant, args.grid)?;
         let thermal = crate::film::ThermalFilm::new(film, thermal_oil(args)?)?;
@@ -251,7 +281,8 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
     }
     let model: Box<dyn FilmModel> = match args.model {
         ModelKind::Finite => {
-            Box::new(FiniteFilm::new(geometry, lubricant, args.grid)?.with_flow(args.flow))
+            let film = FiniteFilm::new(geometry, lubricant, args.grid)?.with_flow(args.flow);
+            Box::new(film.with_cavitation(args.cavitation.into()))
         }
         ModelKind::Short => Box::new(ShortFilm::new(geometry, lubricant)?),
     };
@@ -359,6 +390,7 @@ fn analyse(args: &BearingArgs) -> anyhow::Result<BearingReport> {
     let f = &eq.film;
     let report = BearingReport {
         model: args.model,
+        cavitation: args.cavitation,
         grid: match args.model {
             ModelKind::Finite => format!("{}x{}", args.grid.n_theta, args.grid.n_z),
             ModelKind::Short => "closed form".into(),
@@ -428,10 +460,11 @@ fn print_table(r: &BearingReport) -> anyhow::Result<()> {
         format!("[{a00:>8.3} {a01:>8.3}; {a10:>8.3} {a11:>8.3}]")
     };
     outln!(
-        "rotor-twin bearing: {:?} film, grid {}, grooves {:?}",
+        "rotor-twin bearing: {:?} film, grid {}, grooves {:?}, cavitation {:?}",
         r.model,
         r.grid,
-        r.grooves
+        r.grooves,
+        r.cavitation
     );
     outln!("  speed                      {:>12.1} rpm", r.speed_rpm);
     outln!("  static load                {:>12.2} N", r.load_n);

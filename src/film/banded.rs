@@ -214,22 +214,147 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
+/// LU factorisation with partial pivoting of a general (non-symmetric) band matrix, in place,
+/// (`src/dynamics/band_lu.rs` does not pivot: fine for its near-SPD Newmark matrix, not here),
+/// allocation-free after [`PivotedBandLu::with_capacity`] (the mass-conserving film's mixed system of
+/// pressures and fluid fractions is not symmetric).
+///
+/// Stored by columns in LAPACK's `dgbtrf` layout: `kl` sub-diagonals, `ku` super-diagonals and
+/// `kl` more rows for the fill-in that row interchanges bring; `A[i][j]` lives at
+/// `j·ld + (kl + ku + i − j)` with `ld = 2·kl + ku + 1`. Factor cost n·kl·(kl + ku).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PivotedBandLu {
+    /// The band and its fill-in by columns, overwritten by L and U.
+    data: Vec<f64>,
+    /// Row interchanged with row k at step k.
+    pivot: Vec<usize>,
+    /// Rows.
+    n: usize,
+    /// Sub-diagonals.
+    kl: usize,
+    /// Super-diagonals (before fill-in).
+    ku: usize,
+}
+
+impl PivotedBandLu {
+    /// Leading dimension: stored rows a column.
+    fn ld(&self) -> usize {
+        2 * self.kl + self.ku + 1
+    }
+
+    /// Position of A[i][j] in `data`.
+    #[inline]
+    fn at(&self, i: usize, j: usize) -> usize {
+        j * self.ld() + (self.kl + self.ku + i - j)
+    }
+
+    /// Reserves room for matrices up to `max_n` rows with up to `max_k` sub- and super-diagonals.
+    pub(crate) fn with_capacity(max_n: usize, max_k: usize) -> Self {
+        Self {
+            data: vec![0.0; max_n * (3 * max_k + 1)],
+            pivot: vec![0; max_n],
+            ..Self::default()
+        }
+    }
+
+    /// Starts a new zero matrix of `n` rows with `kl` sub- and `ku` super-diagonals.
+    pub(crate) fn reset(&mut self, n: usize, kl: usize, ku: usize) {
+        let len = n * (2 * kl + ku + 1);
+        assert!(
+            len <= self.data.len() && n <= self.pivot.len(),
+            "band LU capacity exceeded"
+        );
+        (self.n, self.kl, self.ku) = (n, kl, ku);
+        self.data[..len].fill(0.0);
+    }
+
+    /// Adds `value` to `A[i][j]` for `j − ku ≤ i ≤ j + kl`.
+    #[inline]
+    pub(crate) fn add(&mut self, i: usize, j: usize, value: f64) {
+        debug_assert!(i <= j + self.kl && j <= i + self.ku);
+        let k = self.at(i, j);
+        self.data[k] += value;
+    }
+
+    /// Factors P A = L U in place (partial pivoting). Returns false if A is singular.
+    pub(crate) fn factor(&mut self) -> bool {
+        let (n, kl) = (self.n, self.kl);
+        let reach = self.ku + self.kl;
+        for k in 0..n {
+            let last = (k + kl).min(n - 1);
+            let mut p = k;
+            for i in k + 1..=last {
+                if self.data[self.at(i, k)].abs() > self.data[self.at(p, k)].abs() {
+                    p = i;
+                }
+            }
+            self.pivot[k] = p;
+            let pivot = self.data[self.at(p, k)];
+            if pivot == 0.0 || !pivot.is_finite() {
+                return false;
+            }
+            let right = (k + reach).min(n - 1);
+            if p != k {
+                for j in k..=right {
+                    let (a, b) = (self.at(k, j), self.at(p, j));
+                    self.data.swap(a, b);
+                }
+            }
+            for i in k + 1..=last {
+                let ik = self.at(i, k);
+                let l = self.data[ik] / pivot;
+                self.data[ik] = l;
+                if l != 0.0 {
+                    for j in k + 1..=right {
+                        let (ij, kj) = (self.at(i, j), self.at(k, j));
+                        self.data[ij] -= l * self.data[kj];
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Solves A x = r in place (after [`factor`](Self::factor)); `x` holds r on entry.
+    pub(crate) fn solve(&self, x: &mut [f64]) {
+        let (n, kl) = (self.n, self.kl);
+        let reach = self.ku + self.kl;
+        for k in 0..n {
+            x.swap(k, self.pivot[k]);
+            for i in k + 1..=(k + kl).min(n - 1) {
+                x[i] -= self.data[self.at(i, k)] * x[k];
+            }
+        }
+        for k in (0..n).rev() {
+            let mut s = x[k];
+            for j in k + 1..=(k + reach).min(n - 1) {
+                s -= self.data[self.at(k, j)] * x[j];
+            }
+            x[k] = s / self.data[self.at(k, k)];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Uniform numbers in [−½, ½) from a linear congruential generator seeded with `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        }
+    }
 
     /// A random diagonally dominant band matrix: the factor reproduces A x = r to round-off.
     #[test]
     fn solves_a_diagonally_dominant_band_system() {
         let (n, b) = (37, 5);
         let mut dense = vec![vec![0.0; n]; n];
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rnd = uniform(12345);
         let mut m = BandMatrix::with_capacity(n, b);
         m.reset(n, b);
         for i in 0..n {
@@ -335,5 +460,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A random non-symmetric band matrix with small diagonal entries (row interchanges are
+    /// needed): the LU factor reproduces A x = r to round-off (residual of the dense product).
+    #[test]
+    fn band_lu_solves_a_system_that_needs_pivoting() {
+        let (n, kl, ku) = (41, 4, 3);
+        let mut rnd = uniform(987);
+        let mut dense = vec![vec![0.0; n]; n];
+        let mut lu = PivotedBandLu::with_capacity(n, kl.max(ku));
+        lu.reset(n, kl, ku);
+        for (i, row) in dense.iter_mut().enumerate() {
+            for (j, a) in row.iter_mut().enumerate() {
+                if i <= j + kl && j <= i + ku {
+                    // the diagonal is the smallest entry of its row
+                    let v = if i == j { 1e-3 * rnd() } else { rnd() };
+                    *a = v;
+                    lu.add(i, j, v);
+                }
+            }
+        }
+        let rhs: Vec<f64> = (0..n).map(|p| ((p as f64) * 0.37).cos()).collect();
+        let mut x = rhs.clone();
+        assert!(lu.factor());
+        lu.solve(&mut x);
+        let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for i in 0..n {
+            let ax: f64 = (0..n).map(|j| dense[i][j] * x[j]).sum();
+            assert!(
+                (ax - rhs[i]).abs() < 1e-12 * xmax,
+                "row {i}: {ax} vs {}",
+                rhs[i]
+            );
+        }
+        // and a singular matrix is refused
+        lu.reset(3, 1, 1);
+        lu.add(0, 0, 1.0);
+        lu.add(1, 0, 1.0);
+        assert!(!lu.factor());
     }
 }

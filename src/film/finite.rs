@@ -26,7 +26,7 @@
 //! with the same factor. The moving zone boundary adds nothing to first order because p and
 //! ∂p/∂n vanish there (Lund 1987).
 
-use super::banded::BandMatrix;
+use super::banded::{BandMatrix, PivotedBandLu};
 use super::coefficients::FilmCoefficients;
 use super::error::FilmError;
 use super::geometry::{BearingGeometry, FilmGrid, Lubricant};
@@ -107,6 +107,22 @@ pub struct FiniteFilm {
     max_passes: usize,
     /// Unknowns in the last factored system (free nodes).
     n_free: usize,
+    /// Reynolds condition or mass-conserving (`finite/mass_conserving.rs`).
+    cavitation: Cavitation,
+    /// Per node: fluid fraction φ of the last solve (1 with the Reynolds condition).
+    phi: Vec<f64>,
+    /// Per node: φ⁰H⁰ of the last committed step (mass-conserving transient).
+    content_old: Vec<f64>,
+    /// 1/Δt of the mass-conserving transient (1/s), 0 when steady.
+    inverse_step: f64,
+    /// The mass-conserving film's mixed system (empty with the Reynolds condition).
+    lu: PivotedBandLu,
+    /// The fed column of a plain bearing in the mass-conserving mode (its widest gap).
+    feed_column: Option<usize>,
+    /// (Ẋ, Ẏ) of the last film shape (1/s).
+    journal_velocity: [f64; 2],
+    /// ω of the last film shape (rad/s).
+    speed_now: f64,
 }
 
 impl FiniteFilm {
@@ -176,6 +192,14 @@ impl FiniteFilm {
             last_passes: 0,
             max_passes: MAX_ACTIVE_SET_PASSES,
             n_free: 0,
+            cavitation: Cavitation::Reynolds,
+            phi: vec![1.0; nodes],
+            content_old: vec![0.0; nodes],
+            inverse_step: 0.0,
+            lu: PivotedBandLu::with_capacity(0, 0),
+            feed_column: None,
+            journal_velocity: [0.0; 2],
+            speed_now: 0.0,
             geometry,
             lubricant,
             grid,
@@ -284,6 +308,7 @@ impl FiniteFilm {
         let c = self.geometry.radial_clearance_m;
         let (x, y) = (kin.position_m[0] / c, kin.position_m[1] / c);
         let (vx, vy) = (kin.velocity_m_s[0] / c, kin.velocity_m_s[1] / c);
+        (self.journal_velocity, self.speed_now) = ([vx, vy], kin.speed_rad_s);
         let nt = self.grid.n_theta;
         let r = self.geometry.radius_m();
         let reynolds =
@@ -448,9 +473,14 @@ impl FiniteFilm {
             }
         }
         self.warm = false;
+        Err(self.not_converged(kin, self.max_passes))
+    }
+
+    /// The error of a cavitation iteration that did not settle in `iterations` passes at `kin`.
+    fn not_converged(&self, kin: &JournalKinematics, iterations: usize) -> FilmError {
         let c = self.geometry.radial_clearance_m;
-        Err(FilmError::CavitationNotConverged {
-            iterations: self.max_passes,
+        FilmError::CavitationNotConverged {
+            iterations,
             eccentricity_ratio: kin.eccentricity_ratio(c),
             attitude_deg: kin.position_m[1]
                 .atan2(kin.position_m[0])
@@ -458,7 +488,7 @@ impl FiniteFilm {
                 .rem_euclid(360.0),
             velocity_m_s: kin.velocity_m_s,
             speed_rad_s: kin.speed_rad_s,
-        })
+        }
     }
 
     /// One primal–dual update of the active set; true if anything changed.
@@ -615,6 +645,9 @@ impl FilmModel for FiniteFilm {
     }
 
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
+        if self.cavitation == Cavitation::MassConserving {
+            return self.solve_mass_conserving_at(kin);
+        }
         kin.validate(self.geometry.radial_clearance_m)?;
         self.update_film_shape(kin);
         let c = self.geometry.radial_clearance_m;
@@ -640,6 +673,9 @@ impl FilmModel for FiniteFilm {
         &mut self,
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        if self.cavitation == Cavitation::MassConserving {
+            return self.mass_conserving_coefficients(kin);
+        }
         let result = self.solve(kin)?;
         let coefficients = self.perturbation_coefficients(kin.speed_rad_s);
         let c = self.geometry.radial_clearance_m;
@@ -700,7 +736,10 @@ impl FilmModel for FiniteFilm {
     }
 }
 
+mod mass_conserving;
 mod outputs;
+
+pub use mass_conserving::{Cavitation, FlowBalance};
 
 #[cfg(test)]
 mod tests {

@@ -33,7 +33,7 @@ pub use equilibrium::{
     sommerfeld_number, Equilibrium, MAX_EQUILIBRIUM_ECCENTRICITY,
 };
 pub use error::FilmError;
-pub use finite::FiniteFilm;
+pub use finite::{Cavitation, FiniteFilm, FlowBalance};
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
 pub use heating::{effective_temperature, EffectiveTemperature, OilHeating};
 pub use inertia::{equilibrium_with_inertia, FilmInertia, FluidInertia, InertiaForce};

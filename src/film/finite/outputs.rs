@@ -163,7 +163,10 @@ impl FiniteFilm {
         let mut q = 0.0;
         for j in 0..nz {
             let dpi = self.pi[s * nz + j] - self.pi[west * nz + j];
-            q += self.row_width(j) * (speed_rad_s * h - self.h3_face[west] * dpi / self.dtheta);
+            // the Couette flow carries the fluid fraction of the upwind node (1 with the
+            // Reynolds condition)
+            let couette = speed_rad_s * h * self.phi[west * nz + j];
+            q += self.row_width(j) * (couette - self.h3_face[west] * dpi / self.dtheta);
         }
         r * r * c * q
     }

@@ -1,0 +1,415 @@
+//! Mass-conserving (Jakobsson–Floberg–Olsson / Elrod–Adams) cavitation: the film's fluid
+//! fraction φ is an unknown beside the pressure, and the fluid is carried through the ruptured
+//! zone to where the film re-forms.
+//!
+//! The p–θ form of Ausas, Jai & Buscaglia (2009) and the complementarity form of Giacopini,
+//! Fowell, Dini & Strozzi (2010), written in the units of [`FiniteFilm`] (Π = p/6µ(R/c)²,
+//! H = h/c, x = Rθ, z̄ = z/R):
+//!
+//! ```text
+//!   (M1)  ∂/∂θ(H³ ∂Π/∂θ) + ∂/∂z̄(H³ ∂Π/∂z̄) = ω ∂(φH)/∂θ + 2 ∂(φH)/∂t ,
+//!   (M2)  Π ≥ 0,   0 ≤ φ ≤ 1,   Π·(1 − φ) = 0 ,
+//! ```
+//!
+//! i.e. where the film is whole (φ = 1) (M1) is the Reynolds equation of `finite.rs`; where it
+//! is ruptured (Π = 0) the Couette flow ωRh/2·φ is carried unchanged and φ follows the gap.
+//!
+//! Finite volumes on the grid of the Reynolds solver (node k = column i, axial row j, volume
+//! V = Δθ·w_j), the Couette flux upwinded (face i+½ carries ω H_{i+½} φ_i for ω > 0):
+//!
+//! ```text
+//!   (M3)  (A Π)_k + w_j ω (H_{i+½} φ_i − H_{i−½} φ_{i−1}) + 2 V D_k = 0 ,
+//!         D_k = φ_k Ḣ_i                          (steady: ∂φ/∂t = 0, Ḣ from the journal velocity)
+//!         D_k = (φ_k H_k − φ⁰_k H⁰_k) / Δt       (transient, backward Euler; ⁰ = last committed step)
+//! ```
+//!
+//! A as in `finite.rs`. The complementarity (M2) is solved by an active-set iteration on the
+//! mixed unknowns: each node is either full (unknown Π, φ = 1) or ruptured (unknown φ, Π = 0);
+//! one pass solves the linear system (M3) of the current sets (not symmetric: band LU), then a
+//! full node with Π < 0 ruptures and a ruptured node with φ > 1 fills. The sets of the previous
+//! solve are the next one's first guess.
+//!
+//! Feeding: the grooves of the geometry hold Π at their supply pressure and φ = 1. A plain
+//! bearing (no groove) is fed at ambient pressure (Π = 0, φ = 1) at the column of the widest gap
+//! of the current journal position — the film flooded at the start of its convergent part, the
+//! idealisation under which the Reynolds condition is the steady limit of (M1–M2).
+
+use super::{FiniteFilm, NOT_FREE};
+use crate::film::banded::PivotedBandLu;
+use crate::film::coefficients::FilmCoefficients;
+use crate::film::error::FilmError;
+use crate::film::{FilmResult, JournalKinematics};
+use serde::{Deserialize, Serialize};
+
+/// How the film cavitates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Cavitation {
+    /// Reynolds (Swift–Stieber) condition: p ≥ 0 and p = ∂p/∂n = 0 where the film ruptures
+    /// (seed eq. 6); mass is not conserved where the film re-forms.
+    #[default]
+    Reynolds,
+    /// Jakobsson–Floberg–Olsson / Elrod–Adams: pressure and fluid fraction, eq. (M1–M3).
+    MassConserving,
+}
+
+/// The flow balance of the whole film (both halves) after a solve (m³/s): what the feed
+/// (grooves or feed line) delivers, what leaves at the bearing ends from the film outside the
+/// feed, and the rate of change of the fluid volume ∫φh dA. Mass is conserved when
+/// `feed = side + storage`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FlowBalance {
+    /// Net flow out of the fed nodes into the rest of the film (m³/s).
+    pub feed_m3_s: f64,
+    /// Flow out of both bearing ends from the nodes that are not fed (m³/s).
+    pub side_m3_s: f64,
+    /// d/dt ∫φh dA over the nodes that are not fed (m³/s).
+    pub storage_m3_s: f64,
+}
+
+/// The terms of (M3) at one node: `(node, coefficient)` of Π (own, west, east, south, north) and
+/// of φ (own, the two upwind faces), and the constant term.
+struct MixedRow {
+    pi: [(usize, f64); 5],
+    phi: [(usize, f64); 3],
+    constant: f64,
+}
+
+/// Most set-update passes allowed for one mass-conserving solve.
+const MAX_PASSES: usize = 200;
+
+impl FiniteFilm {
+    /// This solver with the cavitation model `cavitation` (Reynolds by default).
+    pub fn with_cavitation(mut self, cavitation: Cavitation) -> Self {
+        self.cavitation = cavitation;
+        // the Reynolds condition's flows read φ = 1 everywhere
+        self.phi.fill(1.0);
+        self.feed_column = None;
+        if cavitation == Cavitation::MassConserving {
+            let nodes = self.grid.n_theta * self.grid.n_z;
+            self.lu = PivotedBandLu::with_capacity(nodes, self.grid.n_z + 1);
+        }
+        self.warm = false;
+        self
+    }
+
+    /// The cavitation model.
+    pub fn cavitation(&self) -> Cavitation {
+        self.cavitation
+    }
+
+    /// Fluid fraction φ at node (`i` around, `j` from mid-plane to edge) of the last solve
+    /// (1 where the film is whole; always 1 with the Reynolds condition).
+    pub fn fluid_fraction(&self, i: usize, j: usize) -> f64 {
+        self.phi[i * self.grid.n_z + j.min(self.grid.n_z - 1)]
+    }
+
+    /// Transient mode with step `step_s` (s): the next solves use D_k of (M3) with the fluid
+    /// content of the last committed step, which this call sets to that of the last solve.
+    /// `None`: steady mode (∂φ/∂t = 0).
+    pub fn set_time_step(&mut self, step_s: Option<f64>) -> Result<(), FilmError> {
+        match step_s {
+            Some(dt) => {
+                crate::film::error::positive("film time step (s)", dt)?;
+                self.inverse_step = 1.0 / dt;
+                self.commit_step();
+            }
+            None => self.inverse_step = 0.0,
+        }
+        Ok(())
+    }
+
+    /// Accepts the last solve as the start of the next step: φ⁰H⁰ ← φH.
+    pub fn commit_step(&mut self) {
+        let nz = self.grid.n_z;
+        for (k, c) in self.content_old.iter_mut().enumerate() {
+            *c = self.phi[k] * self.h_node[k / nz];
+        }
+    }
+
+    /// Π of a node whose pressure is imposed (a groove, or the feed line of a plain bearing in
+    /// the mass-conserving mode), else `None`.
+    #[inline]
+    pub(super) fn fixed_pi(&self, i: usize) -> Option<f64> {
+        if self.groove_pi[i].is_finite() {
+            Some(self.groove_pi[i])
+        } else if self.feed_column == Some(i) {
+            Some(0.0)
+        } else {
+            None
+        }
+    }
+
+    /// The mass-conserving solve of (M1–M3) for the film shape of `kin`.
+    pub(super) fn solve_mass_conserving(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<FilmResult, FilmError> {
+        // a plain bearing's feed line follows the widest gap when steady, and stays where it
+        // was at the start of a transient (a fixed feed hole)
+        let steady = self.inverse_step == 0.0;
+        if self.geometry.grooves.is_empty() && (steady || self.feed_column.is_none()) {
+            self.feed_column =
+                (0..self.grid.n_theta).max_by(|&a, &b| self.h_node[a].total_cmp(&self.h_node[b]));
+        }
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        for i in 0..nt {
+            let fixed = self.fixed_pi(i);
+            if let Some(p) = fixed {
+                self.pi[i * nz..(i + 1) * nz].fill(p);
+                self.phi[i * nz..(i + 1) * nz].fill(1.0);
+            }
+            if !self.warm || fixed.is_some() {
+                let full = fixed.is_none() && self.source[i] < 0.0;
+                self.free[i * nz..(i + 1) * nz].fill(full);
+            }
+        }
+        for pass in 1..=MAX_PASSES {
+            self.solve_mixed_system()?;
+            if !self.update_mixed_sets() {
+                self.last_passes = pass;
+                self.warm = true;
+                return Ok(self.outputs(kin.speed_rad_s));
+            }
+        }
+        self.warm = false;
+        Err(self.not_converged(kin, MAX_PASSES))
+    }
+
+    /// Orders the unknown nodes column by column from just after a fed column (every mixed
+    /// system has one, so the ring is cut there and the bandwidth is n_z). Returns the count.
+    fn order_unknowns(&mut self) -> usize {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let cut = (0..nt).find(|&i| self.fixed_pi(i).is_some()).unwrap_or(0);
+        let mut n = 0;
+        for m in 1..=nt {
+            let i = (cut + m) % nt;
+            for j in 0..nz {
+                let k = i * nz + j;
+                if self.fixed_pi(i).is_none() {
+                    self.slot[k] = n as u32;
+                    self.order[n] = (i as u32, j as u32);
+                    n += 1;
+                } else {
+                    self.slot[k] = NOT_FREE;
+                }
+            }
+        }
+        n
+    }
+
+    /// The terms of (M3) at node (i, j) at speed `speed` (rad/s).
+    fn mixed_row(&self, i: usize, j: usize, speed: f64) -> MixedRow {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let k = i * nz + j;
+        let west = if i == 0 { nt - 1 } else { i - 1 };
+        let east = if i + 1 == nt { 0 } else { i + 1 };
+        let rw = self.row_width(j);
+        let w = rw / self.dtheta;
+        let (cw, ce) = (w * self.h3_face[west], w * self.h3_face[i]);
+        let ca = self.dtheta * self.h3_node[i] / self.dz;
+        let south = if j > 0 { ca } else { 0.0 };
+        let north = if j + 1 < nz { ca } else { 0.0 };
+        let pi_terms = [
+            (k, cw + ce + ca + south),
+            (west * nz + j, -cw),
+            (east * nz + j, -ce),
+            (k.saturating_sub(1), -south),
+            ((k + 1).min(nt * nz - 1), -north),
+        ];
+        let (up_east, up_west) = if speed >= 0.0 { (i, west) } else { (east, i) };
+        let volume = self.dtheta * rw;
+        let (own, constant) = if self.inverse_step > 0.0 {
+            let s = 2.0 * volume * self.inverse_step;
+            (s * self.h_node[i], -s * self.content_old[k])
+        } else {
+            let v = self.journal_velocity;
+            let squeeze = -v[0] * self.cos_node[i] - v[1] * self.sin_node[i];
+            (2.0 * volume * squeeze, 0.0)
+        };
+        let phi_terms = [
+            (k, own),
+            (up_east * nz + j, rw * speed * self.h_face[i]),
+            (up_west * nz + j, -rw * speed * self.h_face[west]),
+        ];
+        MixedRow {
+            pi: pi_terms,
+            phi: phi_terms,
+            constant,
+        }
+    }
+
+    /// Assembles and solves (M3) for the current full / ruptured sets, and stores Π and φ.
+    fn solve_mixed_system(&mut self) -> Result<(), FilmError> {
+        let nz = self.grid.n_z;
+        let n = self.order_unknowns();
+        let mut lu = std::mem::replace(&mut self.lu, PivotedBandLu::with_capacity(0, 0));
+        lu.reset(n, nz, nz);
+        let speed = self.speed_now;
+        for r in 0..n {
+            let (i, j) = (self.order[r].0 as usize, self.order[r].1 as usize);
+            let row = self.mixed_row(i, j, speed);
+            let mut rhs = -row.constant;
+            for (m, a) in row.pi {
+                if a == 0.0 {
+                    continue;
+                }
+                let s = self.slot[m];
+                if s == NOT_FREE {
+                    rhs -= a * self.pi[m];
+                } else if self.free[m] {
+                    lu.add(r, s as usize, a);
+                }
+            }
+            for (m, a) in row.phi {
+                let s = self.slot[m];
+                if s == NOT_FREE || self.free[m] {
+                    rhs -= a;
+                } else {
+                    lu.add(r, s as usize, a);
+                }
+            }
+            self.rhs[r] = rhs;
+        }
+        let ok = lu.factor();
+        if ok {
+            lu.solve(&mut self.rhs[..n]);
+        }
+        self.lu = lu;
+        if !ok {
+            self.warm = false;
+            return Err(FilmError::SingularFilm);
+        }
+        for r in 0..n {
+            let k = self.order[r].0 as usize * nz + self.order[r].1 as usize;
+            if self.free[k] {
+                (self.pi[k], self.phi[k]) = (self.rhs[r], 1.0);
+            } else {
+                (self.pi[k], self.phi[k]) = (0.0, self.rhs[r]);
+            }
+        }
+        Ok(())
+    }
+
+    /// One update of the full / ruptured sets by (M2); true if anything changed.
+    fn update_mixed_sets(&mut self) -> bool {
+        let scale = self.pi.iter().fold(0.0_f64, |m, p| m.max(p.abs()));
+        let mut changed = false;
+        for k in 0..self.pi.len() {
+            if self.slot[k] == NOT_FREE {
+                continue;
+            }
+            if self.free[k] && self.pi[k] < -1e-12 * scale {
+                self.free[k] = false;
+                changed = true;
+            } else if !self.free[k] && self.phi[k] > 1.0 + 1e-12 {
+                self.free[k] = true;
+                changed = true;
+            }
+        }
+        changed
+    }
+
+    /// The eight coefficients of the mass-conserving film by central differences of the film
+    /// force (a position step of 10⁻⁴ c, a velocity step of 10⁻⁴ cω); leaves the model as a
+    /// solve at `kin`.
+    pub(super) fn mass_conserving_coefficients(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let c = self.geometry.radial_clearance_m;
+        let dq = 1e-4 * c;
+        let dv = dq * kin.speed_rad_s.abs().max(1.0);
+        let mut out = FilmCoefficients::default();
+        for q in 0..4 {
+            let step = if q < 2 { dq } else { dv };
+            let mut force = [[0.0; 2]; 2];
+            for (side, sign) in [(0, 1.0), (1, -1.0)] {
+                let mut moved = *kin;
+                if q < 2 {
+                    moved.position_m[q] += sign * step;
+                } else {
+                    moved.velocity_m_s[q - 2] += sign * step;
+                }
+                force[side] = self.solve_mass_conserving_at(&moved)?.force_n;
+            }
+            for i in 0..2 {
+                let slope = (force[0][i] - force[1][i]) / (2.0 * step);
+                if q < 2 {
+                    out.stiffness_n_per_m[(i, q)] = -slope;
+                } else {
+                    out.damping_n_s_per_m[(i, q - 2)] = -slope;
+                }
+            }
+        }
+        let result = self.solve_mass_conserving_at(kin)?;
+        Ok((result, out))
+    }
+
+    /// Film shape and mass-conserving solve at `kin`.
+    pub(super) fn solve_mass_conserving_at(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<FilmResult, FilmError> {
+        kin.validate(self.geometry.radial_clearance_m)?;
+        self.update_film_shape(kin);
+        self.solve_mass_conserving(kin)
+    }
+
+    /// The fluid volume ∫φh dA of the last solve over the nodes that are not fed, both halves
+    /// (m³).
+    pub fn fluid_volume_m3(&self) -> f64 {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let mut sum = 0.0;
+        for i in (0..nt).filter(|&i| self.fixed_pi(i).is_none()) {
+            for j in 0..nz {
+                sum += self.row_width(j) * self.phi[i * nz + j] * self.h_node[i];
+            }
+        }
+        let r = self.geometry.radius_m();
+        2.0 * r * r * self.geometry.radial_clearance_m * self.dtheta * sum
+    }
+
+    /// The flow balance of the last solve (both halves), from the same finite-volume fluxes
+    /// as (M3); with the Reynolds condition φ = 1 everywhere.
+    pub fn flow_balance(&self) -> FlowBalance {
+        let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
+        let (mut feed, mut side, mut storage) = (0.0, 0.0, 0.0);
+        let speed = self.speed_now;
+        for i in 0..nt {
+            if self.fixed_pi(i).is_some() {
+                continue;
+            }
+            let west = if i == 0 { nt - 1 } else { i - 1 };
+            let east = if i + 1 == nt { 0 } else { i + 1 };
+            for j in 0..nz {
+                let k = i * nz + j;
+                let row = self.mixed_row(i, j, speed);
+                // flow into node k across the faces it shares with a fed column
+                for (nb, face) in [(west, west), (east, i)] {
+                    if self.fixed_pi(nb).is_none() {
+                        continue;
+                    }
+                    let m = nb * nz + j;
+                    let cond = self.row_width(j) / self.dtheta * self.h3_face[face];
+                    let poiseuille = cond * (self.pi[m] - self.pi[k]);
+                    let up = if (speed >= 0.0) == (nb == west) { m } else { k };
+                    let couette = self.row_width(j) * speed * self.h_face[face] * self.phi[up];
+                    feed += poiseuille + if nb == west { couette } else { -couette };
+                }
+                if j + 1 == nz {
+                    // the face to the bearing edge, Π = 0 there
+                    side += self.dtheta * self.h3_node[i] / self.dz * self.pi[k];
+                }
+                storage += row.phi[0].1 * self.phi[k] + row.constant;
+            }
+        }
+        let r = self.geometry.radius_m();
+        let scale = r * r * self.geometry.radial_clearance_m;
+        FlowBalance {
+            feed_m3_s: scale * feed,
+            side_m3_s: scale * side,
+            storage_m3_s: scale * storage,
+        }
+    }
+}
