@@ -180,28 +180,14 @@ fn coefficients_at_the_equilibrium_agree() {
 }
 
 /// The direct solver's linearised coefficients (8 grid phases) averaged over 4 further
-/// sub-phases (32 in all): a reference whose own phase dependence is below 0.2 % of the scale.
+/// sub-phases (32 in all): a reference whose own phase dependence (against 128 phases) is
+/// ≤ 0.25 % of the coefficient scale up to ε 0.98 and ≤ 0.45 % beyond (measured by
+/// `coefficient_reference_diagnosis`).
 fn finer_phase_average(
     direct: &mut FiniteFilm,
     kin: &JournalKinematics,
 ) -> rotor_twin::film::FilmCoefficients {
-    let mut out = rotor_twin::film::FilmCoefficients::default();
-    for k in 0..4 {
-        let a = k as f64 * TAU / 60.0 / 32.0;
-        let (ca, sa) = (a.cos(), a.sin());
-        let turn = |v: [f64; 2]| [ca * v[0] - sa * v[1], sa * v[0] + ca * v[1]];
-        let turned = JournalKinematics {
-            position_m: turn(kin.position_m),
-            velocity_m_s: turn(kin.velocity_m_s),
-            speed_rad_s: kin.speed_rad_s,
-        };
-        let l = direct.linearised_coefficients(&turned).unwrap();
-        // back to the unturned frame: Rᵀ A R
-        let r = nalgebra::Matrix2::new(ca, -sa, sa, ca);
-        out.stiffness_n_per_m += 0.25 * r.transpose() * l.stiffness_n_per_m * r;
-        out.damping_n_s_per_m += 0.25 * r.transpose() * l.damping_n_s_per_m * r;
-    }
-    out
+    analytic_reference(direct, kin, 60, 4)
 }
 
 /// Over the domain a whip visits (ε 0.3–0.95, whirl and squeeze velocities up to ±0.3 c ω, any
@@ -254,13 +240,13 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
 /// 20 states a band) against the direct solver averaged over 32 grid phases (force: of |F|;
 /// coefficients: of the state's coefficient scale, `coefficient_error`). Measured, by band
 /// (`BANDS`), this table (u = atanh ε, 160 × 192, 8 phases, U with the grid's Couette factor
-/// κ): force 0.001, 0.001, 0.001, 0.002, 0.010, 0.011, 0.025, 0.117 %; coefficients 0.77,
-/// 0.10, 0.16, 0.18, 0.23, 0.32, 0.57, 1.54 %. Main's table (u = −ln(1 − ε), no κ) on the same
-/// states: force up to 0.80 % (ε 0.5–0.8, where whirl nearly cancels rotation), coefficients
-/// 6.53 % at the centre and 1.64 % at the wall: it fails here. The issue's 0.5 % is NOT met for
-/// the coefficients at the centre (ε < 0.03) and beyond ε 0.95: those stay where they are when
-/// the table is refined (240 × 288, 16 phases: README "The film table's resolution"); the
-/// bounds there hold the measured figures.
+/// κ, the force held in the source's frame): force 0.001, 0.001, 0.001, 0.001, 0.009, 0.010,
+/// 0.024, 0.118 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32, 0.46, 1.31 %. With the
+/// force held along the line of centres (session 10) the coefficients were 0.77 % at the
+/// centre and 0.57 % in ε 0.95–0.98: it fails here. The issue's 0.5 % is NOT met for the
+/// coefficients in ε 0.98–0.995 (1.31 %), where the 60 × 10 reference is itself ≈ 1 % off the
+/// grid-converged film (`coefficient_reference_diagnosis`, README "The film table's
+/// resolution"); the bound there holds the measured figure.
 #[test]
 fn force_and_coefficients_over_the_whole_domain() {
     let (mut table, _, _, _) = models();
@@ -274,7 +260,7 @@ fn force_and_coefficients_over_the_whole_domain() {
     }
     // allowed, % by band
     let force = [0.5; 8];
-    let coefficients = [1.0, 0.5, 0.5, 0.5, 0.5, 0.5, 0.8, 1.8];
+    let coefficients = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.5];
     for (b, range) in BANDS.iter().enumerate() {
         assert!(
             100.0 * ef[b] < force[b],
@@ -287,6 +273,49 @@ fn force_and_coefficients_over_the_whole_domain() {
             ec[b]
         );
     }
+}
+
+/// The coefficients near the centre, where those across the line of centres are the
+/// difference of two terms of order 1/ε (the frame's turn and ∂f/∂ψ): at ε 0.001–0.03, any
+/// attitude and velocities up to ±0.6 c ω, against the direct solver's perturbation
+/// coefficients averaged over 32 grid phases (`finer_phase_average`), within 0.5 % of the
+/// state's coefficient scale (`coefficient_error`). With the force held along the line of
+/// centres (session 10) the interpolation error of ∂f/∂ψ was multiplied by 1/ε: measured
+/// 0.77 % in ε 0–0.03 and growing toward the centre, so this failed there.
+#[test]
+fn coefficients_near_the_centre_agree() {
+    let (mut table, _, _, _) = models();
+    let (worst, worst_at) = centre_error(&mut table);
+    println!("centre: worst {:.4} % at ε {worst_at}", 100.0 * worst);
+    assert!(worst < 0.005, "worst {worst} at ε {worst_at}");
+}
+
+/// The worst coefficient error of `table` at the states of `coefficients_near_the_centre_agree`
+/// and the ε where it is.
+fn centre_error(table: &mut TabulatedFilm) -> (f64, f64) {
+    let geometry = seed_bearing(0.5);
+    let c = geometry.radial_clearance_m;
+    let mut direct = FiniteFilm::new(geometry, mdm(), FilmGrid::new(60, 10).unwrap()).unwrap();
+    let mut rng = Rng(0xCE47);
+    let (mut worst, mut worst_at) = (0.0_f64, 0.0);
+    for eps in [0.001, 0.002, 0.005, 0.01, 0.02, 0.03] {
+        for _ in 0..4 {
+            let kin = state(
+                c,
+                eps,
+                TAU * rng.next(),
+                1.2 * (rng.next() - 0.5),
+                1.2 * (rng.next() - 0.5),
+            );
+            let a = finer_phase_average(&mut direct, &kin);
+            let (_, b) = table.solve_with_coefficients(&kin).unwrap();
+            let e = coefficient_error(&a, &b, OMEGA_9000_RPM);
+            if e > worst {
+                (worst, worst_at) = (e, eps);
+            }
+        }
+    }
+    (worst, worst_at)
 }
 
 /// Which 60 × 10 answer is the converged one: at the 3 states (of 150 with ε 0.9–0.995 in the
@@ -463,7 +492,7 @@ fn banded_errors(model: &mut TabulatedFilm, states: &[Referenced]) -> ([f64; 8],
 #[test]
 #[ignore]
 fn resolution_study() {
-    use rotor_twin::film::{EccentricityMap, TableResolution};
+    use rotor_twin::film::{EccentricityMap, ForceFrame, TableResolution};
     let geometry = seed_bearing(0.5);
     let grid = FilmGrid::new(60, 10).unwrap();
     let per_band: usize = std::env::var("ROTOR_TWIN_TABLE_STUDY_N")
@@ -472,7 +501,7 @@ fn resolution_study() {
         .unwrap_or(STATES_PER_BAND);
     let states = banded_states(per_band);
     let list = std::env::var("ROTOR_TWIN_TABLE_STUDY")
-        .unwrap_or_else(|_| "log:160x192x8,atanh:160x192x8".into());
+        .unwrap_or_else(|_| "atanh-loc:160x192x8,atanh:160x192x8".into());
     for spec in list.split(',') {
         let (map, dims) = spec.split_once(':').expect("map:NxMxP");
         let d: Vec<usize> = dims
@@ -483,10 +512,16 @@ fn resolution_study() {
             n_ecc: d[0],
             n_psi: d[1],
             grid_phases: d[2],
-            map: if map == "log" {
+            map: if map.starts_with("log") {
                 EccentricityMap::Log
             } else {
                 EccentricityMap::Atanh
+            },
+            // `atanh-loc:…`: the force held along the line of centres (session 10)
+            frame: if map.ends_with("-loc") {
+                ForceFrame::LineOfCentres
+            } else {
+                ForceFrame::Source
             },
         };
         let t0 = std::time::Instant::now();
@@ -496,6 +531,7 @@ fn resolution_study() {
         let t1 = std::time::Instant::now();
         let (ef, ec) = banded_errors(&mut model, &states);
         let eval_us = t1.elapsed().as_secs_f64() * 1e6 / states.len() as f64;
+        let (centre, centre_at) = centre_error(&mut model);
         let pct = |v: &[f64; 8]| {
             v.iter()
                 .map(|e| format!("{:.2}", 100.0 * e))
@@ -503,10 +539,11 @@ fn resolution_study() {
                 .join(" ")
         };
         println!(
-            "STUDY {spec}: solves {} build {build_s:.1} s eval {eval_us:.2} µs | force % by band: {} | coefficients %: {}",
+            "STUDY {spec}: solves {} build {build_s:.1} s eval {eval_us:.2} µs | force % by band: {} | coefficients %: {} | centre (ε 0.001–0.03) {:.3} % at ε {centre_at}",
             res.solves(),
             pct(&ef),
-            pct(&ec)
+            pct(&ec),
+            100.0 * centre
         );
     }
 }
@@ -591,5 +628,134 @@ fn worst_states_diagnosis() {
             100.0 * d(f0),
             100.0 * d(f128)
         );
+    }
+}
+
+/// The direct solver's perturbation coefficients averaged over 8 × `sub` grid phases (the
+/// 8-phase `linearised_coefficients` at `sub` sub-phases; `finer_phase_average` is `sub` = 4).
+fn analytic_reference(
+    direct: &mut FiniteFilm,
+    kin: &JournalKinematics,
+    nt: usize,
+    sub: usize,
+) -> rotor_twin::film::FilmCoefficients {
+    let mut out = rotor_twin::film::FilmCoefficients::default();
+    for k in 0..sub {
+        let a = k as f64 * TAU / nt as f64 / (8 * sub) as f64;
+        let (ca, sa) = (a.cos(), a.sin());
+        let turn = |v: [f64; 2]| [ca * v[0] - sa * v[1], sa * v[0] + ca * v[1]];
+        let turned = JournalKinematics {
+            position_m: turn(kin.position_m),
+            velocity_m_s: turn(kin.velocity_m_s),
+            speed_rad_s: kin.speed_rad_s,
+        };
+        let l = direct.linearised_coefficients(&turned).unwrap();
+        let r = nalgebra::Matrix2::new(ca, -sa, sa, ca);
+        let w = 1.0 / sub as f64;
+        out.stiffness_n_per_m += w * r.transpose() * l.stiffness_n_per_m * r;
+        out.damping_n_s_per_m += w * r.transpose() * l.damping_n_s_per_m * r;
+    }
+    out
+}
+
+/// The eight coefficients as central differences of the direct force averaged over 8 × `sub`
+/// grid phases (`force_reference`): position steps `h` c, velocity steps `h` c ω.
+fn difference_reference(
+    direct: &mut FiniteFilm,
+    kin: &JournalKinematics,
+    nt: usize,
+    sub: usize,
+    h: f64,
+) -> rotor_twin::film::FilmCoefficients {
+    let c = seed_bearing(0.5).radial_clearance_m;
+    let (dq, dv) = (h * c, h * c * kin.speed_rad_s);
+    let mut out = rotor_twin::film::FilmCoefficients::default();
+    for j in 0..2 {
+        let (mut p, mut m) = (*kin, *kin);
+        p.position_m[j] += dq;
+        m.position_m[j] -= dq;
+        let (fp, fm) = (
+            force_reference(direct, &p, nt, sub),
+            force_reference(direct, &m, nt, sub),
+        );
+        let (mut pv, mut mv) = (*kin, *kin);
+        pv.velocity_m_s[j] += dv;
+        mv.velocity_m_s[j] -= dv;
+        let (gp, gm) = (
+            force_reference(direct, &pv, nt, sub),
+            force_reference(direct, &mv, nt, sub),
+        );
+        for i in 0..2 {
+            out.stiffness_n_per_m[(i, j)] = -(fp[i] - fm[i]) / (2.0 * dq);
+            out.damping_n_s_per_m[(i, j)] = -(gp[i] - gm[i]) / (2.0 * dv);
+        }
+    }
+    out
+}
+
+/// Which reference of the coefficients is right where the table and the 32-phase analytic
+/// reference differ (the centre and beyond ε 0.95; a diagnosis, run by hand:
+/// `-- --ignored --nocapture coefficient_reference_diagnosis`). Per state of the study: the
+/// table against A (32 phases of the perturbation coefficients), A128 (128 phases), D(h)
+/// (central differences of the 32-phase force, steps h c and h c ω); then at the band's
+/// worst states the same against the grid-refined film (120 × 20, 240 × 40, 8 phases of its
+/// own grid, perturbation coefficients and differences of the force).
+#[test]
+#[ignore]
+fn coefficient_reference_diagnosis() {
+    let (mut table, mut direct, _, nt) = models();
+    let states = banded_states(STATES_PER_BAND);
+    let bands: Vec<usize> = std::env::var("ROTOR_TWIN_DIAG_BANDS")
+        .ok()
+        .map(|v| v.split(',').map(|b| b.parse().expect("band")).collect())
+        .unwrap_or_else(|| vec![0, 3, 6, 7]);
+    let w = OMEGA_9000_RPM;
+    let mut fine: Vec<(usize, FiniteFilm)> = [(120, 20), (240, 40)]
+        .iter()
+        .map(|&(a, b)| {
+            (
+                a,
+                FiniteFilm::new(seed_bearing(0.5), mdm(), FilmGrid::new(a, b).unwrap()).unwrap(),
+            )
+        })
+        .collect();
+    for &band in &bands {
+        let mut rows = Vec::new();
+        for (b, kin, _, a32) in states.iter().filter(|s| s.0 == band) {
+            let (_, t) = table.solve_with_coefficients(kin).unwrap();
+            let a128 = analytic_reference(&mut direct, kin, nt, 16);
+            let d: Vec<_> = [1e-4, 1e-3]
+                .iter()
+                .map(|&h| difference_reference(&mut direct, kin, nt, 4, h))
+                .collect();
+            let e = |x: &rotor_twin::film::FilmCoefficients,
+                     y: &rotor_twin::film::FilmCoefficients| {
+                100.0 * coefficient_error(x, y, w)
+            };
+            let eps =
+                kin.position_m[0].hypot(kin.position_m[1]) / seed_bearing(0.5).radial_clearance_m;
+            println!(
+                "band {b} ε {eps:.5}: T–A {:.3} T–A128 {:.3} T–D1e-4 {:.3} T–D1e-3 {:.3} | A–A128 {:.3} A–D1e-4 {:.3} A–D1e-3 {:.3} D1e-4–D1e-3 {:.3}",
+                e(a32, &t), e(&a128, &t), e(&d[0], &t), e(&d[1], &t),
+                e(&a128, a32), e(&d[0], a32), e(&d[1], a32), e(&d[1], &d[0])
+            );
+            rows.push((e(a32, &t), *kin, t, *a32, d[0]));
+        }
+        rows.sort_by(|x, y| y.0.total_cmp(&x.0));
+        for (_, kin, t, a, d) in rows.iter().take(2) {
+            for (n, film) in fine.iter_mut() {
+                let ntf = *n;
+                let lin = film.linearised_coefficients(kin).unwrap();
+                let dif = difference_reference(film, kin, ntf, 1, 1e-4);
+                let e = |x: &rotor_twin::film::FilmCoefficients,
+                         y: &rotor_twin::film::FilmCoefficients| {
+                    100.0 * coefficient_error(x, y, w)
+                };
+                println!(
+                    "  band {band} {n}: lin–dif {:.3} | vs lin: T {:.3} A {:.3} D {:.3} | vs dif: T {:.3} A {:.3} D {:.3}",
+                    e(&lin, &dif), e(&lin, t), e(&lin, a), e(&lin, d), e(&dif, t), e(&dif, a), e(&dif, d)
+                );
+            }
+        }
     }
 }

@@ -50,6 +50,19 @@ pub struct TableResolution {
     pub grid_phases: usize,
     /// How the rows are spread in ε.
     pub map: EccentricityMap,
+    /// The frame the force is held in.
+    pub frame: ForceFrame,
+}
+
+/// The frame in which the table holds the film force per unit V.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ForceFrame {
+    /// Along and across the line of centres (up to session 10): the centre's coefficients
+    /// carry the interpolation error of ∂f/∂ψ times 1/ε ([`source_frame`]).
+    LineOfCentres,
+    /// Turned by −ψ from the line of centres, g = R(−ψ) f ([`source_frame`]): constant along
+    /// the centre's row.
+    Source,
 }
 
 /// The coordinate u(ε) in which the table's rows are equally spaced.
@@ -96,6 +109,7 @@ impl TableResolution {
         n_psi: 192,
         grid_phases: 8,
         map: EccentricityMap::Atanh,
+        frame: ForceFrame::Source,
     };
 
     fn validate(&self) -> Result<(), FilmError> {
@@ -137,7 +151,8 @@ const TABLE_SOURCES: [&str; 4] = [
 /// Quantities tabulated at each node, per unit V (1/s) unless said otherwise.
 #[derive(Debug, Clone, Copy, Default)]
 struct Node {
-    /// Film force along the line of centres and 90° ahead of it (N·s).
+    /// Film force in the frame of the source direction ψ: turned by −ψ from the line of
+    /// centres ([`source_frame`]) (N·s).
     force: [f64; 2],
     /// Largest pressure (Pa·s).
     p_max: f64,
@@ -156,13 +171,14 @@ struct Node {
 }
 
 impl Node {
-    /// Adds `w` × `m`, field by field; `sign` −1 for a mirrored row, whose force and angles
-    /// turn by π while its scalars stay the same.
+    /// Adds `w` × `m`, field by field; `sign` [angles, force] −1 for a mirrored row, whose
+    /// angles turn by π (and its force, held in the line of centres; in the source's frame,
+    /// [`source_frame`], it stays the same, as do the scalars).
     #[inline]
-    fn add(&mut self, w: f64, sign: f64, m: &Node) {
+    fn add(&mut self, w: f64, [sign, force_sign]: [f64; 2], m: &Node) {
         let ws = sign * w;
-        self.force[0] += ws * m.force[0];
-        self.force[1] += ws * m.force[1];
+        self.force[0] += force_sign * w * m.force[0];
+        self.force[1] += force_sign * w * m.force[1];
         self.p_max += w * m.p_max;
         for k in 0..3 {
             self.angles[k][0] += ws * m.angles[k][0];
@@ -408,6 +424,10 @@ impl FilmTable {
         Stencil {
             rows,
             mirrored: [mirror, false, false, false],
+            mirrored_force_sign: match self.res.frame {
+                ForceFrame::Source => 1.0,
+                ForceFrame::LineOfCentres => -1.0,
+            },
             cols,
             n_psi,
             wr: fold(catmull_rom(tu)),
@@ -424,7 +444,7 @@ impl FilmTable {
         let mut out = [[0.0; 2]; 3];
         for a in 0..4 {
             for b in 0..4 {
-                let (index, sign) = st.node(a, b);
+                let (index, [_, sign]) = st.node(a, b);
                 let m = &self.nodes[index];
                 let w = [
                     sign * st.wr[a] * st.wc[b],
@@ -437,10 +457,15 @@ impl FilmTable {
                 }
             }
         }
-        out
+        if self.res.frame == ForceFrame::LineOfCentres {
+            return out;
+        }
+        let [g, g_eps, g_psi] = out;
+        let (f, f_eps, f_psi) = from_source_frame(psi, g, g_eps, g_psi);
+        [f, f_eps, f_psi]
     }
 
-    /// The interpolated node at (ε, ψ).
+    /// The interpolated node at (ε, ψ), its force turned to the line of centres.
     fn node_at(&self, eps: f64, psi: f64) -> Node {
         let st = self.stencil_with_slopes(eps, psi);
         let mut n = Node::default();
@@ -449,6 +474,9 @@ impl FilmTable {
                 let (index, sign) = st.node(a, b);
                 n.add(st.wr[a] * st.wc[b], sign, &self.nodes[index]);
             }
+        }
+        if self.res.frame == ForceFrame::Source {
+            n.force = source_frame(psi, n.force, 1.0);
         }
         n
     }
@@ -465,13 +493,21 @@ impl FilmTable {
                 let (index, sign) = st.node(a, b);
                 let m = &self.nodes[index];
                 n.add(st.wr[a] * st.wc[b], sign, m);
-                let (w_eps, w_psi) = (sign * st.dwr[a] * st.wc[b], sign * st.wr[a] * st.dwc[b]);
+                let (w_eps, w_psi) = (
+                    sign[1] * st.dwr[a] * st.wc[b],
+                    sign[1] * st.wr[a] * st.dwc[b],
+                );
                 f_eps[0] += w_eps * m.force[0];
                 f_eps[1] += w_eps * m.force[1];
                 f_psi[0] += w_psi * m.force[0];
                 f_psi[1] += w_psi * m.force[1];
             }
         }
+        if self.res.frame == ForceFrame::LineOfCentres {
+            return (n, f_eps, f_psi);
+        }
+        let (f, f_eps, f_psi) = from_source_frame(psi, n.force, f_eps, f_psi);
+        n.force = f;
         (n, f_eps, f_psi)
     }
 
@@ -576,8 +612,11 @@ impl FilmTable {
 /// Rows and columns of a 4 × 4 interpolation stencil, the weights and their derivatives.
 struct Stencil {
     rows: [usize; 4],
-    /// rows read as their mirror image through the centre, f(−ε, ψ) = −f(ε, ψ + π)
+    /// rows read as their mirror image through the centre, f(−ε, ψ) = −f(ε, ψ + π), i.e.
+    /// g(−ε, ψ) = g(ε, ψ + π) for the force in the source's frame ([`source_frame`])
     mirrored: [bool; 4],
+    /// the sign of a mirrored row's force: −1 in the line of centres, +1 in the source's frame
+    mirrored_force_sign: f64,
     cols: [usize; 4],
     n_psi: usize,
     wr: [f64; 4],
@@ -589,13 +628,18 @@ struct Stencil {
 }
 
 impl Stencil {
-    /// The index of node (a, b) of the stencil in the table, and the sign of its force.
-    fn node(&self, a: usize, b: usize) -> (usize, f64) {
+    /// The index of node (a, b) of the stencil in the table, and the signs of its angles' unit
+    /// vectors and of its force (−1 in a mirrored row; a force in the source's frame keeps its
+    /// sign there).
+    fn node(&self, a: usize, b: usize) -> (usize, [f64; 2]) {
         if self.mirrored[a] {
             let col = (self.cols[b] + self.n_psi / 2) % self.n_psi;
-            (self.rows[a] * self.n_psi + col, -1.0)
+            (
+                self.rows[a] * self.n_psi + col,
+                [-1.0, self.mirrored_force_sign],
+            )
         } else {
-            (self.rows[a] * self.n_psi + self.cols[b], 1.0)
+            (self.rows[a] * self.n_psi + self.cols[b], [1.0, 1.0])
         }
     }
 }
@@ -661,7 +705,10 @@ fn row(
             }
             let unit = |a: f64| [(a - alpha).cos(), (a - alpha).sin()];
             let share = 1.0 / m as f64;
-            let f = back(pressure.force_n);
+            let f = match res.frame {
+                ForceFrame::Source => source_frame(psi, back(pressure.force_n), -1.0),
+                ForceFrame::LineOfCentres => back(pressure.force_n),
+            };
             node.force[0] += share * f[0];
             node.force[1] += share * f[1];
             node.p_max += share * pressure.max_pressure_pa;
@@ -700,6 +747,41 @@ fn row(
 fn couette_factor(grid: FilmGrid) -> f64 {
     let half = 0.5 * TAU / grid.n_theta as f64;
     half.sin() / half
+}
+
+/// `v` (a force per unit V in the line of centres) turned by `sign` × ψ: −1 into the frame of
+/// the source direction ψ, where the table holds it, +1 back.
+///
+/// Why the table holds the force in the source's frame: at the centre the film is round, so
+/// turning the source (U, W) by ψ turns the pressure field and the force with it,
+/// f(0, ψ) = R(ψ) f(0, 0); in the source's frame g = R(−ψ) f the centre's row is constant and
+/// g's ψ-dependence grows from zero with ε. The position coefficients across the line of
+/// centres are (J f − ∂f/∂ψ)/ε c + … (J the quarter turn): two terms of order 1/ε that cancel,
+/// leaving R(ψ) ∂g/∂ψ / ε. Interpolating f, the interpolation error of ∂f/∂ψ (≈ 10⁻⁴ of |f| on
+/// 192 columns) was multiplied by 1/ε: 0.77 % of the coefficient scale at ε < 0.03. Interpolating
+/// g, that error is itself of order ε. The mirror row reads g(−ε, ψ) = g(ε, ψ + π).
+#[inline]
+fn source_frame(psi: f64, v: [f64; 2], sign: f64) -> [f64; 2] {
+    let (s, c) = psi.sin_cos();
+    let s = sign * s;
+    [c * v[0] - s * v[1], s * v[0] + c * v[1]]
+}
+
+/// The force per unit V in the line of centres and its slopes d/dε, d/dψ from those of the
+/// tabulated g = R(−ψ) f: f = R(ψ) g, f_ε = R(ψ) g_ε, f_ψ = R(ψ) (g_ψ + J g).
+#[inline]
+fn from_source_frame(
+    psi: f64,
+    g: [f64; 2],
+    g_eps: [f64; 2],
+    g_psi: [f64; 2],
+) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    let turn = |v: [f64; 2]| source_frame(psi, v, 1.0);
+    (
+        turn(g),
+        turn(g_eps),
+        turn([g_psi[0] - g[1], g_psi[1] + g[0]]),
+    )
 }
 
 /// A journal state in the frame of its line of centres.
