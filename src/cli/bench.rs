@@ -238,7 +238,11 @@ fn node_case(args: &BenchArgs) -> anyhow::Result<()> {
     let rows = [
         ("twin step alone", f.twin, None),
         ("+ monitor (Monitor::record)", f.twin_monitor, Some(f.twin)),
-        ("+ session outputs (Session::step)", f.session, Some(f.twin_monitor)),
+        (
+            "+ session outputs (Session::step)",
+            f.session,
+            Some(f.twin_monitor),
+        ),
         ("+ driver at the node's wakes", f.driver, Some(f.session)),
     ];
     for (name, c, below) in rows {
