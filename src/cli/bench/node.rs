@@ -143,15 +143,19 @@ pub fn run(rpm: f64, simulated_s: f64) -> anyhow::Result<NodeFigures> {
 
     let mut driver = Driver::new(rotor.clone(), settings);
     driver.set_threshold(crate::session::linear_threshold(&rotor));
-    let mut now = 0;
-    let mut counts = (0, 0);
-    feed_wakes(&mut driver, &mut now, omega, warmup, &mut counts);
-    let mut counts = (0, 0);
+    let mut wakes = Wakes {
+        now: 0,
+        omega,
+        counts: (0, 0),
+    };
+    wakes.run(&mut driver, warmup);
+    wakes.counts = (0, 0);
     let mut driver_steps = 0;
     let (cpu, wall) = timed(|| {
-        driver_steps = measure_driver(&mut driver, &mut now, omega, measured, &mut counts);
+        driver_steps = measure_driver(&mut wakes, &mut driver, measured);
         Ok(())
     })?;
+    let counts = wakes.counts;
     let sim = driver_steps as f64 * h;
     let driver_cost = LayerCost {
         cpu_s_per_sim_s: cpu / sim,
@@ -205,14 +209,16 @@ fn measure_session(
 }
 
 #[inline(never)]
-fn measure_driver(
-    driver: &mut Driver,
-    now: &mut i64,
+fn measure_driver(wakes: &mut Wakes, driver: &mut Driver, steps: usize) -> usize {
+    wakes.run(driver, steps)
+}
+
+/// The node's wakes of a driver: its clock (ns), the speed fed (rad/s), and the messages
+/// emitted and of those the ones published without readers.
+struct Wakes {
+    now: i64,
     omega: f64,
-    steps: usize,
-    counts: &mut (u64, u64),
-) -> usize {
-    feed_wakes(driver, now, omega, steps, counts)
+    counts: (u64, u64),
 }
 
 /// Wakes the driver as the node's model thread does until it has taken `steps` steps (a wake's
@@ -221,6 +227,13 @@ fn measure_driver(
 /// `feed_inputs`), and every [`WAKE_PERIOD_NS`] the steps due, one `advance_to` call each,
 /// each timed with two clock reads as the node's `step_until`. Returns the steps taken;
 /// `counts`: messages emitted, and of those the ones published without readers.
+impl Wakes {
+    fn run(&mut self, driver: &mut Driver, steps: usize) -> usize {
+        let (now, omega, counts) = (&mut self.now, self.omega, &mut self.counts);
+        feed_wakes(driver, now, omega, steps, counts)
+    }
+}
+
 fn feed_wakes(
     driver: &mut Driver,
     now: &mut i64,
