@@ -22,7 +22,14 @@ enum Workload {
     /// ORC-9000's renewal of the step factor after a speed change (three substep levels), by
     /// the band LU and by faer's dense LU.
     Factor,
+    /// The node's model thread without the bus: the driver of the microturbine with the node's
+    /// defaults (64 steps a revolution, tabulated film) at 9,000 rpm in developed whip, fed and
+    /// woken as the node is; CPU seconds per simulated second (`--seconds`: simulated seconds
+    /// measured), split into the step, the monitor, the session's outputs and the driver.
+    Node,
 }
+
+mod node;
 
 /// Measure the cost of the hot paths.
 #[derive(Debug, Clone, Args)]
@@ -77,6 +84,7 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Workload::Film => film_cases(args)?,
         Workload::Orc9000 => return orc_9000(args),
         Workload::Factor => factor_cases(args)?,
+        Workload::Node => return node_case(args),
     };
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&figures)?);
@@ -213,6 +221,45 @@ fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()>
             fig.max_eccentricity_ratio, 100.0 * fig.contact_step_fraction
         );
     }
+    Ok(())
+}
+
+/// `bench node`: the figures of [`node::run`], as a table or JSON.
+fn node_case(args: &BenchArgs) -> anyhow::Result<()> {
+    let f = node::run(9000.0, args.seconds)?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&f)?);
+        return Ok(());
+    }
+    outln!(
+        "node's model thread without the bus: microturbine at 9,000 rpm in developed whip, {} steps/rev ({:.0} steps/s), tabulated film, {:.2} s simulated per layer",
+        f.steps_per_rev, f.steps_per_s, f.simulated_s
+    );
+    let rows = [
+        ("twin step alone", f.twin, None),
+        ("+ monitor (Monitor::record)", f.twin_monitor, Some(f.twin)),
+        (
+            "+ session outputs (Session::step)",
+            f.session,
+            Some(f.twin_monitor),
+        ),
+        ("+ driver at the node's wakes", f.driver, Some(f.session)),
+    ];
+    for (name, c, below) in rows {
+        let added = below.map_or(String::new(), |b| {
+            format!("   (+{:.4})", c.cpu_s_per_sim_s - b.cpu_s_per_sim_s)
+        });
+        outln!(
+            "  {name:<36} {:.4} CPU s per simulated s{added}; wall {:.4}",
+            c.cpu_s_per_sim_s,
+            c.wall_s_per_sim_s
+        );
+    }
+    outln!(
+        "  messages made {} ({} published without readers of states, orbits and residuals)",
+        f.messages,
+        f.messages_published
+    );
     Ok(())
 }
 

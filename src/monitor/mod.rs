@@ -254,6 +254,8 @@ pub struct Monitor {
     /// smallest film thickness of full-film lubrication (m), for `pressure_valid`
     full_film_min_thickness_m: f64,
     spectrum: Vec<OrderComponent>,
+    /// the spectrum's samples (x, y, angle), gathered from the ring (capacity reserved)
+    picked: Vec<[f64; 3]>,
     profile: Vec<f64>,
     report: RevolutionReport,
 }
@@ -292,6 +294,7 @@ impl Monitor {
             contact_onset_ratio: twin.config().contact.onset_eccentricity_ratio,
             full_film_min_thickness_m: twin.config().contact.full_film_min_thickness_m,
             spectrum: vec![OrderComponent::default(); SPECTRUM_REVOLUTIONS],
+            picked: Vec::with_capacity(capacity),
             profile: vec![0.0; PRESSURE_POINTS],
             report: RevolutionReport {
                 bearings: vec![BearingRevolution::default(); n],
@@ -323,7 +326,7 @@ impl Monitor {
         (0..n)
             .rev()
             .map(|back| {
-                let i = (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+                let i = self.idx(back);
                 [h.x[i], h.y[i]]
             })
             .collect()
@@ -337,7 +340,7 @@ impl Monitor {
         (0..n)
             .rev()
             .map(|back| {
-                let i = (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+                let i = self.idx(back);
                 h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS].to_vec()
             })
             .collect()
@@ -347,7 +350,7 @@ impl Monitor {
     pub fn full_spectrum(&self, bearing: usize) -> Vec<OrderComponent> {
         let window = self.recent_samples(SPECTRUM_REVOLUTIONS);
         let h = &self.bearings[bearing];
-        let idx = |back: usize| (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+        let idx = |back: usize| ring_index(self.head, self.capacity, back);
         let mut out = vec![OrderComponent::default(); 2 * SPECTRUM_REVOLUTIONS];
         if window > 0 {
             order_spectrum(
@@ -367,7 +370,7 @@ impl Monitor {
         let out: &StepOutput = twin.output();
         let slot = self.head;
         let previous_angle = if self.len > 0 {
-            self.angle[(self.head + self.capacity - 1) % self.capacity]
+            self.angle[self.idx(0)]
         } else {
             out.angle_rad
         };
@@ -383,7 +386,11 @@ impl Monitor {
             h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS]
                 .copy_from_slice(&self.profile);
         }
-        self.head = (self.head + 1) % self.capacity;
+        self.head = if self.head + 1 == self.capacity {
+            0
+        } else {
+            self.head + 1
+        };
         self.len = (self.len + 1).min(self.capacity);
         self.current_rev_len += 1;
         let completed = (out.angle_rad / TAU).floor() > (previous_angle / TAU).floor();
@@ -402,7 +409,7 @@ impl Monitor {
 
     /// Ring index of the sample `back` steps before the newest.
     fn idx(&self, back: usize) -> usize {
-        (self.head + 2 * self.capacity - 1 - back) % self.capacity
+        ring_index(self.head, self.capacity, back)
     }
 
     /// Extremes of the last `last` samples of bearing `bi`: x and y ranges (m), largest
@@ -462,21 +469,15 @@ impl Monitor {
             let nodes = [k - 1, k, k + 1, k + 2];
             let w = lagrange_weights(nodes.map(angle), target);
             let i = self.idx(back);
-            let at = |v: &[f64]| {
-                nodes
-                    .iter()
-                    .zip(&w)
-                    .map(|(&n, w)| w * v[self.idx(n)])
-                    .sum::<f64>()
-            };
+            // the nodes' ring positions once (not once per pressure point: the same sums)
+            let slots = nodes.map(|n| self.idx(n));
+            let at = |v: &[f64]| slots.iter().zip(&w).map(|(&n, w)| w * v[n]).sum::<f64>();
             d2 += (h.x[i] - at(&h.x)).powi(2) + (h.y[i] - at(&h.y)).powi(2);
             let a = &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS];
+            let profiles =
+                slots.map(|n| &h.pressure[n * PRESSURE_POINTS..(n + 1) * PRESSURE_POINTS]);
             for (m, u) in a.iter().enumerate() {
-                let v: f64 = nodes
-                    .iter()
-                    .zip(&w)
-                    .map(|(&n, w)| w * h.pressure[self.idx(n) * PRESSURE_POINTS + m])
-                    .sum();
+                let v: f64 = profiles.iter().zip(&w).map(|(p, w)| w * p[m]).sum();
                 pd2 += (u - v).powi(2);
                 p2 += u * u;
             }
@@ -501,11 +502,15 @@ impl Monitor {
             let p = self.idx(back);
             let (px, py) = (h.x[p], h.y[p]);
             let mut best = f64::MAX;
-            for seg in last..3 * last - 1 {
-                let (a, b) = (self.idx(seg), self.idx(seg + 1));
+            // the segments from `last` back to 3 last − 1 samples before the newest: the ring
+            // position one sample further back is one slot lower (wrapping)
+            let mut a = self.idx(last);
+            for _ in last..3 * last - 1 {
+                let b = if a == 0 { self.capacity - 1 } else { a - 1 };
                 best = best.min(point_segment_distance2(
                     px, py, h.x[a], h.y[a], h.x[b], h.y[b],
                 ));
+                a = b;
             }
             sum += best;
         }
@@ -517,14 +522,21 @@ impl Monitor {
     /// far below that rate's Nyquist order of 16.
     fn window_spectrum(&mut self, bi: usize, window: usize) {
         let h = &self.bearings[bi];
-        let idx = |back: usize| (self.head + 2 * self.capacity - 1 - back) % self.capacity;
+        let idx = |back: usize| ring_index(self.head, self.capacity, back);
         let per_rev = window / self.rev_lengths.len().clamp(1, SPECTRUM_REVOLUTIONS);
         let stride = per_rev.div_ceil(32).max(1);
         let picks = window.div_ceil(stride);
+        // the picked samples gathered once, oldest first (the spectrum reads each twice)
+        let picked = &mut self.picked;
+        picked.clear();
+        picked.extend((0..picks).map(|k| {
+            let i = idx(window - 1 - k * stride);
+            [h.x[i], h.y[i], self.angle[i]]
+        }));
         order_spectrum(
-            (0..picks).map(|k| h.x[idx(window - 1 - k * stride)]),
-            (0..picks).map(|k| h.y[idx(window - 1 - k * stride)]),
-            (0..picks).map(|k| self.angle[idx(window - 1 - k * stride)]),
+            picked.iter().map(|p| p[0]),
+            picked.iter().map(|p| p[1]),
+            picked.iter().map(|p| p[2]),
             picks,
             SPECTRUM_REVOLUTIONS,
             &mut self.spectrum,
@@ -722,6 +734,22 @@ struct LastRevolution {
     rub_sum_w: f64,
 }
 
+/// Ring position of the sample `back` (< 2 `capacity`) steps before the newest, the newest at
+/// `head` − 1: (head + 2 capacity − 1 − back) mod capacity, by subtraction (the value lies in
+/// [0, 3 capacity)): the monitor indexes its ring tens of thousands of times a revolution, and
+/// an integer division costs tens of cycles.
+fn ring_index(head: usize, capacity: usize, back: usize) -> usize {
+    debug_assert!(head < capacity && back < 2 * capacity);
+    let v = head + 2 * capacity - 1 - back;
+    if v >= 2 * capacity {
+        v - 2 * capacity
+    } else if v >= capacity {
+        v - capacity
+    } else {
+        v
+    }
+}
+
 /// Weights of the cubic Lagrange interpolant through nodes `x` (distinct) at `t`.
 fn lagrange_weights(x: [f64; 4], t: f64) -> [f64; 4] {
     let mut w = [1.0; 4];
@@ -746,4 +774,27 @@ fn point_segment_distance2(px: f64, py: f64, ax: f64, ay: f64, bx: f64, by: f64)
     };
     let (cx, cy) = (ax + t * dx - px, ay + t * dy - py);
     cx * cx + cy * cy
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ring position by subtraction is the remainder the monitor took before, (head + 2
+    /// capacity − 1 − back) mod capacity, for every head and every look-back it uses (under
+    /// two capacities), for rings of one to 40 slots.
+    #[test]
+    fn ring_index_is_the_remainder() {
+        for capacity in 1..=40 {
+            for head in 0..capacity {
+                for back in 0..2 * capacity {
+                    assert_eq!(
+                        ring_index(head, capacity, back),
+                        (head + 2 * capacity - 1 - back) % capacity,
+                        "head {head}, back {back}, capacity {capacity}"
+                    );
+                }
+            }
+        }
+    }
 }

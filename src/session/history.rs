@@ -39,8 +39,14 @@ impl ProbeHistory {
         }
     }
 
+    /// Physical index of the `i`-th entry (i < len), wrapped by subtraction (no division).
     fn slot(&self, i: usize) -> usize {
-        (self.oldest + i) % self.times.len()
+        let (v, cap) = (self.oldest + i, self.times.len());
+        if v >= cap {
+            v - cap
+        } else {
+            v
+        }
     }
 
     /// Appends one step's outputs (the oldest is overwritten when full).
@@ -56,7 +62,11 @@ impl ProbeHistory {
             self.slot(self.len - 1)
         } else {
             let at = self.oldest;
-            self.oldest = (self.oldest + 1) % cap;
+            self.oldest = if self.oldest + 1 == cap {
+                0
+            } else {
+                self.oldest + 1
+            };
             at
         };
         self.times[at] = time_s;

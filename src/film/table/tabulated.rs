@@ -86,11 +86,14 @@ impl FilmModel for TabulatedFilm {
         let shift = s.phi() / TAU * t.n_theta as f64;
         let scale = t.n_theta as f64 / len as f64;
         let nt = t.n_theta as i64;
+        // the column of each output angle and the next, wrapped by additions (x lies within a
+        // turn or two of the grid: two integer divisions an angle cost more than the blend)
         let at = |k: usize| {
             let x = k as f64 * scale - shift;
             let i = x.floor();
-            let i0 = (i as i64).rem_euclid(nt) as usize;
-            (i0, (i0 + 1) % t.n_theta, x - i)
+            let i0 = wrap_column(i as i64, nt);
+            let i1 = if i0 + 1 == t.n_theta { 0 } else { i0 + 1 };
+            (i0, i1, x - i)
         };
         // blend the four nodes' profiles first (on the stack, for grids of up to 512 columns),
         // then sample the blend; larger grids blend at each output angle
@@ -128,6 +131,20 @@ impl FilmModel for TabulatedFilm {
             *p = (s.v * *p).max(0.0);
         }
     }
+}
+
+/// Column `i` of a grid of `n` columns around the circumference, wrapped into 0..n: equal to
+/// `i.rem_euclid(n)`, by additions (the profile's columns lie within a turn or two of the grid,
+/// and an integer division costs tens of cycles).
+fn wrap_column(i: i64, n: i64) -> usize {
+    let mut i = i;
+    while i < 0 {
+        i += n;
+    }
+    while i >= n {
+        i -= n;
+    }
+    i as usize
 }
 
 /// The film's result at state `s` (line-of-centres frame) from the interpolated node `n`, at
@@ -256,6 +273,21 @@ mod tests {
                         da[(i, j)]
                     );
                 }
+            }
+        }
+    }
+
+    /// The profile's column wrap is the Euclidean remainder for every column within three turns
+    /// either way (the reference: `i64::rem_euclid`), for grids of one to 61 columns.
+    #[test]
+    fn column_wrap_is_the_euclidean_remainder() {
+        for n in 1..=61_i64 {
+            for i in -3 * n..3 * n {
+                assert_eq!(
+                    wrap_column(i, n),
+                    i.rem_euclid(n) as usize,
+                    "column {i} of {n}"
+                );
             }
         }
     }
