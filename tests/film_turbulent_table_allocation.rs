@@ -58,8 +58,14 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
             let eps = 0.95 * (0.5 + 0.5 * (0.11 * x).cos()) + if k % 97 == 0 { -0.94 } else { 0.0 };
             let w = re / re_per_speed;
             let kin = JournalKinematics {
-                position_m: [eps.max(1e-4) * 40e-6 * (0.7 * x).cos(), eps.max(1e-4) * 40e-6 * (0.7 * x).sin()],
-                velocity_m_s: [0.1 * 40e-6 * w * (0.3 * x).sin(), -0.1 * 40e-6 * w * (0.2 * x).cos()],
+                position_m: [
+                    eps.max(1e-4) * 40e-6 * (0.7 * x).cos(),
+                    eps.max(1e-4) * 40e-6 * (0.7 * x).sin(),
+                ],
+                velocity_m_s: [
+                    0.1 * 40e-6 * w * (0.3 * x).sin(),
+                    -0.1 * 40e-6 * w * (0.2 * x).cos(),
+                ],
                 speed_rad_s: w,
             };
             film.solve_with_coefficients(&kin).unwrap();

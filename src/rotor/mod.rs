@@ -87,15 +87,7 @@ pub struct FilmBearing {
     pub inertia: Option<crate::film::FilmInertia>,
     /// Laminar, turbulent or auto (finite model; `src/film/turbulence.rs`).
     pub flow: crate::film::FlowRegime,
-    /// The largest speed a turbulent or auto film's table covers (rad/s):
-    /// [`TURBULENT_TABLE_SPEED_OVER_RATED`] × the machine's rated speed.
-    pub table_max_speed_rad_s: f64,
 }
-
-/// The speeds a turbulent film's table covers, over the machine's rated speed: run-ups to
-/// overspeed trips (≈ 1.1–1.2 ×) and the threshold searches of `modes` with margin; beyond it
-/// the tabulated film refuses the speed by name (the direct film has no such bound).
-pub const TURBULENT_TABLE_SPEED_OVER_RATED: f64 = 2.5;
 
 // --- oil supply temperature (issue 12) ---
 impl FilmBearing {
@@ -267,23 +259,21 @@ impl FilmBearing {
     pub fn reference_tabulated_solver(
         &self,
     ) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        if self.flow != crate::film::FlowRegime::Laminar {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "flow (tabulated film)",
+                value: 0.0,
+                rule: "the table is laminar: a turbulent film is not homogeneous in the speed \
+                       (the flow factors depend on Re = ρωRc/µ, a third table dimension not built); \
+                       use the direct film (--film direct) with flow: turbulent or auto",
+            });
+        }
         if self.short {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "film model (tabulated film)",
                 value: 0.0,
                 rule: "the table tabulates the finite model; this bearing uses the short-bearing model",
             });
-        }
-        if self.flow != crate::film::FlowRegime::Laminar {
-            // a turbulent film tabulated over (ε, ψ, Re): `src/film/table/reynolds.rs`
-            let (l, g) = (self.lubricant, &self.geometry);
-            let re_max =
-                l.density_kg_m3 * self.table_max_speed_rad_s * g.radius_m() * g.radial_clearance_m
-                    / l.viscosity_pa_s;
-            let table = crate::film::ReynoldsTable::shared(g, l, self.grid, self.flow, re_max)?;
-            return Ok(Box::new(crate::film::ReynoldsTabulatedFilm::new(
-                std::sync::Arc::new(table),
-            )));
         }
         let table = crate::film::FilmTable::shared(&self.geometry, self.lubricant, self.grid)?;
         Ok(Box::new(crate::film::TabulatedFilm::new(table)))
@@ -528,7 +518,7 @@ fn bearing_sites(desc: &MachineDescription, nodes: usize) -> Vec<BearingSite> {
                 node: b.node,
                 journal_dofs: [4 * b.node, 4 * b.node + 1],
                 pedestal_dofs,
-                model: bearing_model(b, rpm_to_rad_s(desc.rated_speed_rpm)),
+                model: bearing_model(b),
             }
         })
         .collect()
@@ -553,7 +543,7 @@ fn discs(desc: &MachineDescription) -> Vec<Disc> {
         .collect()
 }
 
-fn bearing_model(b: &BearingSpec, rated_speed_rad_s: f64) -> BearingModel {
+fn bearing_model(b: &BearingSpec) -> BearingModel {
     match &b.model {
         BearingModelSpec::Finite(f) | BearingModelSpec::Short(f) => {
             BearingModel::Film(FilmBearing {
@@ -567,7 +557,6 @@ fn bearing_model(b: &BearingSpec, rated_speed_rad_s: f64) -> BearingModel {
                 viscosity_scale: 1.0,
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
                 flow: f.flow,
-                table_max_speed_rad_s: TURBULENT_TABLE_SPEED_OVER_RATED * rated_speed_rad_s,
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),

@@ -263,8 +263,8 @@ impl ReynoldsTable {
             return Err(FilmError::InvalidParameter {
                 name: "journal speed (turbulent film table), rad/s",
                 value: omega,
-                rule: "within the table's film Reynolds range (it covers the machine's speeds up \
-                       to TURBULENT_TABLE_SPEED_OVER_RATED × rated); use --film direct beyond",
+                rule: "within the table's film Reynolds range (the table was built up to a \
+                       largest Re); use the direct film beyond",
             });
         }
         Ok(self.axis.stencil(re))
