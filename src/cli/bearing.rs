@@ -531,7 +531,7 @@ fn print_table(r: &BearingReport) -> anyhow::Result<()> {
 }
 
 /// `--flow laminar | turbulent | auto`.
-fn parse_flow(s: &str) -> Result<crate::film::FlowRegime, String> {
+pub(crate) fn parse_flow(s: &str) -> Result<crate::film::FlowRegime, String> {
     match s {
         "laminar" => Ok(crate::film::FlowRegime::Laminar),
         "turbulent" => Ok(crate::film::FlowRegime::Turbulent),

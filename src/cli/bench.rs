@@ -54,6 +54,9 @@ pub struct BenchArgs {
     /// Film evaluation for ORC-9000: direct or table.
     #[arg(long, value_enum, default_value_t = super::simulate::FilmArg::Direct)]
     film: super::simulate::FilmArg,
+    /// ORC-9000: the films' flow regime (laminar, turbulent or auto; issue 18).
+    #[arg(long, default_value = "laminar", value_parser = super::bearing::parse_flow)]
+    flow: crate::film::FlowRegime,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
@@ -132,10 +135,15 @@ struct TwinFigures {
 fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig};
     use crate::rotor::{MachineDescription, Rotor};
-    let rotor = crate::transient::with_grid(
+    let mut rotor = crate::transient::with_grid(
         &Rotor::from_description(&MachineDescription::builtin_default()),
         Some(args.grid),
     );
+    for b in &mut rotor.bearings {
+        if let crate::rotor::BearingModel::Film(f) = &mut b.model {
+            f.flow = args.flow;
+        }
+    }
     let omega = rpm_to_rad_s(9000.0);
     let config = TwinConfig {
         film: args.film.into(),

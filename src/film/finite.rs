@@ -79,6 +79,9 @@ pub struct FiniteFilm {
     flow: FlowRegime,
     /// The flow factors of the last film shape.
     factors: FlowFactors,
+    /// The film Reynolds number ρωRc/µ the flow factors are taken at whatever the speed, if
+    /// frozen (the turbulent table's slices, built at ω = 0 for one Re; None: from the speed).
+    frozen_reynolds: Option<f64>,
     /// Per column: ω ∂H/∂θ + 2 ∂H/∂t (1/s).
     source: Vec<f64>,
     /// Per node: true where the film is pressurised (the free set of the complementarity problem).
@@ -178,6 +181,7 @@ impl FiniteFilm {
             viscosity_ratio: Vec::new(),
             flow: FlowRegime::Laminar,
             factors: FlowFactors::new(FlowRegime::Laminar, 0.0, 1.0),
+            frozen_reynolds: None,
             source: vec![0.0; nt],
             free: vec![false; nodes],
             pi: vec![0.0; nodes],
@@ -233,6 +237,16 @@ impl FiniteFilm {
         self.viscosity_ratio.clear();
         self.viscosity_ratio.extend_from_slice(ratio);
         Ok(())
+    }
+
+    /// This solver with the flow factors of `flow` taken at the film Reynolds number `reynolds`
+    /// = ρωRc/µ whatever the journal's speed (the turbulent table's slices: at a fixed Re the
+    /// turbulent problem is homogeneous in the source, as the laminar one).
+    pub fn with_frozen_reynolds(mut self, flow: FlowRegime, reynolds: f64) -> Self {
+        self.flow = flow;
+        self.frozen_reynolds = Some(reynolds);
+        self.warm = false;
+        self
     }
 
     /// The flow regime.
@@ -311,8 +325,9 @@ impl FiniteFilm {
         (self.journal_velocity, self.speed_now) = ([vx, vy], kin.speed_rad_s);
         let nt = self.grid.n_theta;
         let r = self.geometry.radius_m();
-        let reynolds =
-            self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / self.lubricant.viscosity_pa_s;
+        let reynolds = self.frozen_reynolds.unwrap_or(
+            self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / self.lubricant.viscosity_pa_s,
+        );
         self.factors = FlowFactors::new(self.flow, reynolds, r / c);
         for i in 0..nt {
             let hn = 1.0 - x * self.cos_node[i] - y * self.sin_node[i];

@@ -42,7 +42,10 @@ pub use table::{
     disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,
     FORMAT_VERSION as TABLE_FORMAT_VERSION, SOLVER_VERSION as TABLE_SOLVER_VERSION,
 };
-pub use table::{EccentricityMap, FilmTable, ForceFrame, TableResolution, TabulatedFilm};
+pub use table::{
+    EccentricityMap, FilmTable, ForceFrame, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
+    SliceFlow, TableResolution, TabulatedFilm,
+};
 pub use thermal::{ThermalFilm, ThermalOil, ThermalState};
 pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};
 pub use viscosity::{

@@ -18,7 +18,7 @@
 //! and load the result), bounded in time: a cold fleet builds each table once.
 
 use super::TABLE_SOURCES;
-use super::{FilmTable, Node, TableResolution, MAX_ECCENTRICITY_RATIO, ROW_ECC_CAP};
+use super::{FilmTable, Node, SliceFlow, TableResolution, MAX_ECCENTRICITY_RATIO, ROW_ECC_CAP};
 use crate::film::{BearingGeometry, FilmError, FilmGrid, Lubricant};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -137,14 +137,36 @@ impl TableCache {
         lubricant: Lubricant,
         grid: FilmGrid,
     ) -> PathBuf {
-        let key = key_for(geometry, lubricant, grid, &TableResolution::DEFAULT);
+        self.path_for_slice(geometry, lubricant, grid, None)
+    }
+
+    /// [`TableCache::path_for`] for a table of flow `flow` (a turbulent slice, or laminar).
+    pub fn path_for_slice(
+        &self,
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        flow: SliceFlow,
+    ) -> PathBuf {
+        let key = key_for(geometry, lubricant, grid, &TableResolution::DEFAULT, flow);
         self.dir
             .join(format!("film-table-{:x}.bin", md5::compute(key.as_bytes())))
     }
 
     /// The table of these inputs if its file exists and verifies.
     pub fn load(&self, geometry: &BearingGeometry, lubricant: Lubricant, grid: FilmGrid) -> Lookup {
-        let path = self.path_for(geometry, lubricant, grid);
+        self.load_slice(geometry, lubricant, grid, None)
+    }
+
+    /// [`TableCache::load`] for a table of flow `flow`.
+    pub fn load_slice(
+        &self,
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        flow: SliceFlow,
+    ) -> Lookup {
+        let path = self.path_for_slice(geometry, lubricant, grid, flow);
         let bytes = match std::fs::read(&path) {
             Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Lookup::Miss,
@@ -155,13 +177,14 @@ impl TableCache {
                 })
             }
         };
-        let key = table_key(geometry, lubricant, grid);
         let res = TableResolution::DEFAULT;
+        let key = key_for(geometry, lubricant, grid, &res, flow);
         match decode(&bytes, &key, grid, &res) {
             Ok((nodes, profiles, u_max)) => Lookup::Hit(FilmTable {
                 geometry: geometry.clone(),
                 lubricant,
                 grid,
+                flow,
                 nodes,
                 profiles,
                 n_theta: grid.n_theta,
@@ -179,7 +202,7 @@ impl TableCache {
     /// Writes `table` to its file: a temporary file in the directory, renamed over the target.
     /// Only tables of the default resolution are cached.
     pub fn store(&self, table: &FilmTable) -> Result<PathBuf, CacheWarning> {
-        let path = self.path_for(&table.geometry, table.lubricant, table.grid);
+        let path = self.path_for_slice(&table.geometry, table.lubricant, table.grid, table.flow);
         let warn = |what: String| CacheWarning {
             path: path.clone(),
             what,
@@ -195,7 +218,13 @@ impl TableCache {
                 "cannot create the directory ({e}); table not cached"
             ))
         })?;
-        let key = key_for(&table.geometry, table.lubricant, table.grid, &table.res);
+        let key = key_for(
+            &table.geometry,
+            table.lubricant,
+            table.grid,
+            &table.res,
+            table.flow,
+        );
         let bytes = encode(table, &key);
         let mut tmp = tempfile::Builder::new()
             .prefix(".film-table-")
@@ -233,13 +262,25 @@ impl TableCache {
         grid: FilmGrid,
         warn: &mut dyn FnMut(CacheWarning),
     ) -> Result<(FilmTable, TableOrigin), FilmError> {
-        let path = self.path_for(geometry, lubricant, grid);
-        let mut lookup = self.load(geometry, lubricant, grid);
+        self.load_or_build_slice(geometry, lubricant, grid, None, warn)
+    }
+
+    /// [`TableCache::load_or_build`] for a table of flow `flow`.
+    pub fn load_or_build_slice(
+        &self,
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        flow: SliceFlow,
+        warn: &mut dyn FnMut(CacheWarning),
+    ) -> Result<(FilmTable, TableOrigin), FilmError> {
+        let path = self.path_for_slice(geometry, lubricant, grid, flow);
+        let mut lookup = self.load_slice(geometry, lubricant, grid, flow);
         // held until the table is stored (dropped on return)
         let _lock = if matches!(lookup, Lookup::Miss) {
             let lock = self.builder_lock(&path, warn);
             // whoever held the lock may have stored the table meanwhile
-            lookup = self.load(geometry, lubricant, grid);
+            lookup = self.load_slice(geometry, lubricant, grid, flow);
             lock
         } else {
             None
@@ -249,7 +290,8 @@ impl TableCache {
             Lookup::Rejected(w) => warn(w),
             Lookup::Miss => {}
         }
-        let table = FilmTable::build(geometry, lubricant, grid)?;
+        let table =
+            FilmTable::build_slice(geometry, lubricant, grid, TableResolution::DEFAULT, flow)?;
         let stored = match self.store(&table) {
             Ok(p) => Some(p),
             Err(w) => {
@@ -308,7 +350,7 @@ impl TableCache {
 /// Everything that determines a table of the default resolution, spelled out (f64 in Rust's
 /// shortest round-trip form).
 pub fn table_key(geometry: &BearingGeometry, lubricant: Lubricant, grid: FilmGrid) -> String {
-    key_for(geometry, lubricant, grid, &TableResolution::DEFAULT)
+    key_for(geometry, lubricant, grid, &TableResolution::DEFAULT, None)
 }
 
 /// The key of a table of resolution `res`.
@@ -317,6 +359,7 @@ fn key_for(
     lubricant: Lubricant,
     grid: FilmGrid,
     res: &TableResolution,
+    flow: SliceFlow,
 ) -> String {
     let grooves: Vec<String> = geometry
         .grooves
@@ -348,7 +391,9 @@ fn key_for(
         lubricant.viscosity_pa_s,
         grid.n_theta,
         grid.n_z,
-    )
+    ) + &flow.map_or(String::new(), |(regime, reynolds)| {
+        format!("flow {regime:?} reynolds {reynolds:?}\n")
+    })
 }
 
 /// MD5 of the source files that compute a table's numbers (the finite solver, its band

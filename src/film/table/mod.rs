@@ -17,8 +17,8 @@
 //! the direct solver at random states in `tests/film_table.rs`.
 
 use super::{
-    wrap_angle_rad, BearingGeometry, FilmError, FilmGrid, FilmModel, FiniteFilm, JournalKinematics,
-    Lubricant, MAX_ECCENTRICITY_RATIO,
+    turbulence::FlowRegime, wrap_angle_rad, BearingGeometry, FilmError, FilmGrid, FilmModel,
+    FiniteFilm, JournalKinematics, Lubricant, MAX_ECCENTRICITY_RATIO,
 };
 use nalgebra::Matrix2;
 use std::collections::HashMap;
@@ -26,11 +26,13 @@ use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
 
 mod cache;
+mod reynolds;
 mod tabulated;
 pub use cache::{
     disk_cache, set_disk_cache, table_key, CacheWarning, Lookup, TableCache, TableOrigin,
     FORMAT_VERSION, SOLVER_VERSION,
 };
+pub use reynolds::{ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm};
 pub use tabulated::TabulatedFilm;
 
 /// The table's resolution and map of ε, and the grid phases each node averages: what the
@@ -141,8 +143,9 @@ impl TableResolution {
 /// Largest ε of the solves on the last row (the row itself sits at [`MAX_ECCENTRICITY_RATIO`]).
 const ROW_ECC_CAP: f64 = 0.9989;
 /// The source of everything that computes a table's numbers: part of the cache key.
-const TABLE_SOURCES: [&str; 4] = [
+const TABLE_SOURCES: [&str; 5] = [
     include_str!("../finite.rs"),
+    include_str!("../turbulence.rs"),
     include_str!("../finite/outputs.rs"),
     include_str!("../banded.rs"),
     include_str!("mod.rs"),
@@ -195,12 +198,18 @@ impl Node {
 /// One row of the table as built: its index, nodes and mid-plane profiles.
 type Row = (usize, Vec<Node>, Vec<f64>);
 
+/// The flow factors a table is built with: None laminar, else the regime and the film Reynolds
+/// number ρωRc/µ they are frozen at (one slice of a [`ReynoldsTable`]).
+pub type SliceFlow = Option<(FlowRegime, f64)>;
+
 /// The film functions of one bearing over (ε, ψ).
 pub struct FilmTable {
     geometry: BearingGeometry,
-    /// The lubricant and grid it was built with (its cache key, with the geometry).
+    /// The lubricant and grid it was built with (its cache key, with the geometry and flow).
     lubricant: Lubricant,
     grid: FilmGrid,
+    /// Laminar (None), or the turbulent slice's regime and frozen Re.
+    flow: SliceFlow,
     nodes: Vec<Node>,
     /// mid-plane pressure per unit V at the grid's n_θ angles from the line of centres (Pa·s)
     profiles: Vec<f64>,
@@ -231,18 +240,28 @@ impl FilmTable {
         lubricant: Lubricant,
         grid: FilmGrid,
     ) -> Result<(Arc<FilmTable>, TableOrigin), FilmError> {
+        Self::shared_slice(geometry, lubricant, grid, None)
+    }
+
+    /// [`FilmTable::shared_with_origin`] for the flow `flow` (a turbulent slice, or laminar).
+    pub fn shared_slice(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        flow: SliceFlow,
+    ) -> Result<(Arc<FilmTable>, TableOrigin), FilmError> {
         static CACHE: OnceLock<Mutex<HashMap<String, Arc<FilmTable>>>> = OnceLock::new();
-        let key = format!("{geometry:?}|{lubricant:?}|{grid:?}");
+        let key = format!("{geometry:?}|{lubricant:?}|{grid:?}|{flow:?}");
         let cache = CACHE.get_or_init(Default::default);
         if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
             return Ok((t.clone(), TableOrigin::InProcess));
         }
         let (table, origin) = match disk_cache() {
-            Some(disk) => disk.load_or_build(geometry, lubricant, grid, &mut |w| {
+            Some(disk) => disk.load_or_build_slice(geometry, lubricant, grid, flow, &mut |w| {
                 eprintln!("rotor-twin: warning: {w}")
             })?,
             None => (
-                Self::build(geometry, lubricant, grid)?,
+                Self::build_slice(geometry, lubricant, grid, TableResolution::DEFAULT, flow)?,
                 TableOrigin::Built(None),
             ),
         };
@@ -281,6 +300,17 @@ impl FilmTable {
         grid: FilmGrid,
         res: TableResolution,
     ) -> Result<FilmTable, FilmError> {
+        Self::build_slice(geometry, lubricant, grid, res, None)
+    }
+
+    /// [`FilmTable::build_with`] with the flow factors of `flow` (None: laminar).
+    pub fn build_slice(
+        geometry: &BearingGeometry,
+        lubricant: Lubricant,
+        grid: FilmGrid,
+        res: TableResolution,
+        flow: SliceFlow,
+    ) -> Result<FilmTable, FilmError> {
         res.validate()?;
         if !geometry.grooves.is_empty() {
             return Err(FilmError::InvalidParameter {
@@ -302,6 +332,9 @@ impl FilmTable {
                     let geometry = geometry.clone();
                     s.spawn(move || {
                         let mut film = FiniteFilm::new(geometry.clone(), lubricant, grid)?;
+                        if let Some((regime, reynolds)) = flow {
+                            film = film.with_frozen_reynolds(regime, reynolds);
+                        }
                         let mut out = Vec::new();
                         for &i in chunk.iter() {
                             let eps = res.map.eps(i as f64 * u_max / (n_ecc - 1) as f64);
@@ -331,6 +364,7 @@ impl FilmTable {
             geometry: geometry.clone(),
             lubricant,
             grid,
+            flow,
             nodes,
             profiles,
             n_theta,

@@ -24,6 +24,11 @@ impl TabulatedFilm {
             last: JournalKinematics::default(),
         }
     }
+
+    /// A model reading `table` whose last state was `last` (for its mid-plane profile).
+    pub(super) fn at(table: Arc<FilmTable>, last: JournalKinematics) -> Self {
+        Self { table, last }
+    }
 }
 
 impl FilmModel for TabulatedFilm {
@@ -150,7 +155,7 @@ fn wrap_column(i: i64, n: i64) -> usize {
 /// The film's result at state `s` (line-of-centres frame) from the interpolated node `n`, at
 /// speed `omega` (rad/s): the force turned back to the fixed frame, the angles of p_max, ζ1 and
 /// ζ2 from the attitude (computed once) and their unit vectors in the node.
-fn result_of(s: &LineOfCentres, n: &Node, omega: f64) -> FilmResult {
+pub(super) fn result_of(s: &LineOfCentres, n: &Node, omega: f64) -> FilmResult {
     let zone = s.v > 0.0 && n.p_max > 0.0;
     let phi = if zone { s.phi() } else { 0.0 };
     let angle = |k: usize| {
