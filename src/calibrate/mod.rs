@@ -120,7 +120,7 @@ pub fn journal_orbits(
         .map(|(u, p)| crate::rotor::Unbalance {
             magnitude_kg_m: p.magnitude_g_mm * 1e-6,
             phase_rad: p.phase_deg.to_radians(),
-            ..u.clone()
+            ..*u
         })
         .collect();
     speeds_rad_s
