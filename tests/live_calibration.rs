@@ -545,3 +545,71 @@ fn nonlinear_onset_after_live_calibration() {
     assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 1));
     assert!((own - plant).abs() < 30.0);
 }
+
+/// The twin's films on `n_theta × n_z`.
+fn on_grid(rotor: &Rotor, n_theta: usize, n_z: usize) -> Rotor {
+    let mut r = rotor.clone();
+    for b in &mut r.bearings {
+        if let BearingModel::Film(f) = &mut b.model {
+            f.grid.n_theta = n_theta;
+            f.grid.n_z = n_z;
+        }
+    }
+    r
+}
+
+/// The study of the nonlinear onset against the twin's film grid (README, "The onset after a
+/// live calibration"): the machine file's rotor (its oil and unbalance) as nonlinear twins on
+/// the tabulated film of each grid (60 × 10, 72 × 12, 90 × 15, 120 × 20; a table built per
+/// grid), fed one plant (the machine file's, direct film) from 8,000 rpm (16 revolutions) and
+/// then the same 400 rpm/s run-up to 9,400 rpm as `nonlinear_onset_after_live_calibration`, the
+/// onset by the replay's rule; and the linear threshold per grid. A study, not a check: ignored
+/// (several minutes: the tables), run with `-- --ignored --nocapture`; it asserts only that every
+/// twin finds an onset and a threshold.
+#[test]
+#[ignore]
+fn onset_against_the_film_grid() {
+    let machine = twin_rotor();
+    let grids = [(60, 10), (72, 12), (90, 15), (120, 20)];
+    let drivers: Vec<Driver> = grids
+        .iter()
+        .map(|&(nt, nz)| {
+            let settings = DriverSettings::new(
+                ModelKind::Nonlinear,
+                FilmEvaluation::Table,
+                machine.rated_speed_rad_s,
+            );
+            Driver::new(on_grid(&machine, nt, nz), settings)
+        })
+        .collect();
+    let w8 = 8000.0 * PI / 30.0;
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w8, 64);
+    let plant = Twin::new(&machine, config, w8).unwrap();
+    let mut rig = Rig::new(plant, drivers, 0.0, PlantProbes::Pairs);
+    rig.run(8000.0, 16.0, true);
+    rig.ramp(8000.0, 9400.0, 3.5, true);
+    for (comparisons, d) in rig.comparisons.iter_mut().zip(&rig.drivers) {
+        for c in comparisons.iter_mut() {
+            c.finish(Some(d.keyphasor_events()));
+        }
+    }
+    let onset = |i: usize, predicted: bool| {
+        rig.comparisons[i]
+            .iter()
+            .map(|c| c.onset(predicted).expect("an onset").1)
+            .fold(f64::INFINITY, f64::min)
+    };
+    println!(
+        "plant (60 × 10, direct film): onset {:.0} rpm",
+        onset(0, false)
+    );
+    for (i, &(nt, nz)) in grids.iter().enumerate() {
+        let threshold = rpm(rotor_twin::session::linear_threshold(&on_grid(
+            &machine, nt, nz,
+        )));
+        println!(
+            "grid {nt} × {nz}: nonlinear onset {:.0} rpm, linear threshold {threshold:.1} rpm",
+            onset(i, true)
+        );
+    }
+}

@@ -27,7 +27,10 @@ pub use unbalance::{
     estimate_unbalance, CorrectionMass, PlaneEstimate, UnbalanceEstimate,
     DEFAULT_CORRECTION_RADIUS_M,
 };
-pub use viscosity::{estimate_viscosity, static_probe_positions, ViscosityEstimate};
+pub use viscosity::{
+    estimate_viscosity, estimate_viscosity_under_orbits, static_probe_positions, JournalOrbits,
+    ViscosityEstimate, ORBIT_POINTS,
+};
 
 use serde::Serialize;
 use thiserror::Error;
@@ -98,4 +101,79 @@ pub enum CalibrationError {
     /// measurements).
     #[error("singular problem: {0}")]
     Singular(String),
+}
+
+/// The journals' 1X orbits of `rotor`'s linear model (at its viscosity) under the estimated
+/// `unbalance`, at each speed of `speeds_rad_s` (the viscosity fit's orbits,
+/// [`estimate_viscosity_under_orbits`]).
+pub fn journal_orbits(
+    rotor: &crate::rotor::Rotor,
+    unbalance: &UnbalanceEstimate,
+    speeds_rad_s: &[f64],
+) -> Result<Vec<JournalOrbits>, CalibrationError> {
+    let model = |e: crate::rotor::RotorError| CalibrationError::Model(e.to_string());
+    let statics = crate::rotor::static_solution(rotor).map_err(model)?;
+    let planes: Vec<crate::rotor::Unbalance> = rotor
+        .unbalance
+        .iter()
+        .zip(&unbalance.planes)
+        .map(|(u, p)| crate::rotor::Unbalance {
+            magnitude_kg_m: p.magnitude_g_mm * 1e-6,
+            phase_rad: p.phase_deg.to_radians(),
+            ..*u
+        })
+        .collect();
+    speeds_rad_s
+        .iter()
+        .map(|&w| {
+            let rpm = crate::units::rad_s_to_rpm(w);
+            let journals =
+                crate::rotor::journal_orbits(rotor, &statics, rpm, &planes).map_err(model)?;
+            Ok(JournalOrbits {
+                speed_rad_s: w,
+                journals,
+            })
+        })
+        .collect()
+}
+
+/// The viscosity scale (from `means`) and the unbalance at it (from `vectors`), as the live
+/// calibration fits them: the static fit of [`estimate_viscosity`] and the unbalance at it, then
+/// the viscosity again with the mean positions under the journal orbits that unbalance gives
+/// ([`journal_orbits`], [`estimate_viscosity_under_orbits`]) and the unbalance at that. Without
+/// an unbalance (no 1X vector) the static fit stands. `rotor` at the machine file's viscosity.
+pub fn estimate_viscosity_and_unbalance(
+    rotor: &crate::rotor::Rotor,
+    means: &[MeanPosition],
+    vectors: &[OneXVector],
+    correction_radius_m: f64,
+) -> (
+    Result<ViscosityEstimate, CalibrationError>,
+    Result<UnbalanceEstimate, CalibrationError>,
+) {
+    let unbalance_at = |v: &Result<ViscosityEstimate, CalibrationError>| {
+        let mut at = rotor.clone();
+        if let Ok(v) = v {
+            at.set_viscosity_scale(v.scale)
+                .map_err(|e| CalibrationError::Model(format!("fitted scale {}: {e}", v.scale)))?;
+        }
+        if vectors.is_empty() {
+            return Err(CalibrationError::TooFewMeasurements(
+                "no keyphasor-referenced 1X vector yet (a 1X phase needs the keyphasor)".into(),
+            ));
+        }
+        Ok((estimate_unbalance(&at, vectors, correction_radius_m)?, at))
+    };
+    let viscosity = estimate_viscosity(rotor, means);
+    let (unbalance, at) = match (&viscosity, unbalance_at(&viscosity)) {
+        (Ok(_), Ok(u)) => u,
+        (_, u) => return (viscosity, u.map(|u| u.0)),
+    };
+    let mut speeds: Vec<f64> = means.iter().map(|m| m.speed_rad_s).collect();
+    speeds.sort_by(f64::total_cmp);
+    speeds.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    let refined = journal_orbits(&at, &unbalance, &speeds)
+        .and_then(|orbits| estimate_viscosity_under_orbits(rotor, means, &orbits));
+    let unbalance = unbalance_at(&refined).map(|u| u.0);
+    (refined, unbalance)
 }

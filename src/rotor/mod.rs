@@ -38,8 +38,9 @@ pub use modal::{
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};
 pub use unbalance_response::{
-    influence_coefficients, required_separation_margin_pct, response_peaks, response_stations,
-    unbalance_response, ResponsePeak, Station, StationResponse, UnbalanceResponse,
+    influence_coefficients, journal_orbits, required_separation_margin_pct, response_peaks,
+    response_stations, unbalance_response, ResponsePeak, Station, StationResponse,
+    UnbalanceResponse,
 };
 
 use crate::film::{

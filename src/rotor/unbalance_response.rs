@@ -163,6 +163,35 @@ pub fn influence_coefficients(
     }
     Ok(out)
 }
+
+/// The journals' 1X orbits of the linear model at `speed_rpm` (rpm) under `unbalance` instead of
+/// the machine's: per bearing of `rotor.bearings` (in its order) the complex amplitudes `[X, Y]`
+/// (m) of the journal relative to its pedestal (x = Re(X e^{iΩt})). The viscosity fit's orbits
+/// (`calibrate::journal_orbits`).
+pub fn journal_orbits(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speed_rpm: f64,
+    unbalance: &[super::Unbalance],
+) -> Result<Vec<[c64; 2]>, RotorError> {
+    let omega = rpm_to_rad_s(speed_rpm);
+    let mut solvers = BearingSolvers::new(rotor);
+    let (coefs, _) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;
+    let q = harmonic_solution_for(rotor, omega, &coefs, unbalance)?;
+    Ok(rotor
+        .bearings
+        .iter()
+        .map(|b| {
+            let st = Station {
+                name: b.name.clone(),
+                kind: "bearing",
+                node: b.node,
+            };
+            let (x, y) = station_motion(rotor, &st, &q);
+            [x, y]
+        })
+        .collect())
+}
 // --- end calibration from measurements ---
 
 /// Complex 1X amplitudes of every global DOF (held DOFs zero) at spin `omega` (rad/s).
