@@ -41,6 +41,11 @@ pub struct BenchArgs {
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
+    /// ORC-9000: measure exactly this many steps instead of `--seconds` (a fixed amount of work,
+    /// e.g. for counting instructions under `valgrind --tool=callgrind`, which a loaded machine
+    /// does not change).
+    #[arg(long)]
+    steps: Option<usize>,
     /// Film grid over the half bearing.
     #[arg(long, default_value = "60x10", value_parser = FilmGrid::parse)]
     grid: FilmGrid,
@@ -144,6 +149,11 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         "--ramp-rpm-s {:?} must lie between 0 and 10,000 rpm/s",
         args.ramp_rpm_s
     );
+    anyhow::ensure!(
+        args.steps.is_none_or(|n| (1..=1 << 24).contains(&n)),
+        "--steps {:?} must be 1 to 16,777,216",
+        args.steps
+    );
     let mut trace = open_trace(args)?;
     if args.whip {
         eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
@@ -158,7 +168,11 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let (mut contact_steps, mut max_eps) = (0usize, 0.0_f64);
     let start = Instant::now();
     let t0 = twin.time_s();
-    while start.elapsed() < budget && times.len() < (1 << 20) {
+    let more = |done: usize| match args.steps {
+        Some(n) => done < n,
+        None => start.elapsed() < budget && done < (1 << 20),
+    };
+    while more(times.len()) {
         if ramp > 0.0 {
             // at most 1.5× the start speed: the ramp stays below the twin's limit
             let t = twin.time_s() - t0 + config.time_step_s;
@@ -291,7 +305,11 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
     let mut times = Vec::with_capacity(1 << 20);
     let start = Instant::now();
     let mut k = 0usize;
-    while start.elapsed() < budget && times.len() < (1 << 20) {
+    let more = |done: usize| match args.steps {
+        Some(n) => done < n,
+        None => start.elapsed() < budget && done < (1 << 20),
+    };
+    while more(times.len()) {
         let q = if k.is_multiple_of(2) { moved } else { q0 };
         let t = Instant::now();
         let (r, c) = tabulated.solve_with_coefficients(&at(q))?;
