@@ -78,6 +78,7 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "--seconds {} must be between 0 and 600",
         args.seconds
     );
+    check_steps(args.steps)?;
     let figures = match args.workload {
         Workload::Film => film_cases(args)?,
         Workload::Orc9000 => return orc_9000(args),
@@ -149,11 +150,6 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         "--ramp-rpm-s {:?} must lie between 0 and 10,000 rpm/s",
         args.ramp_rpm_s
     );
-    anyhow::ensure!(
-        args.steps.is_none_or(|n| (1..=1 << 24).contains(&n)),
-        "--steps {:?} must be 1 to 16,777,216",
-        args.steps
-    );
     let mut trace = open_trace(args)?;
     if args.whip {
         eprintln!("bench: letting the whip develop (500 revolutions, not measured)...");
@@ -168,11 +164,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let (mut contact_steps, mut max_eps) = (0usize, 0.0_f64);
     let start = Instant::now();
     let t0 = twin.time_s();
-    let more = |done: usize| match args.steps {
-        Some(n) => done < n,
-        None => start.elapsed() < budget && done < (1 << 20),
-    };
-    while more(times.len()) {
+    while measure_more(args.steps, start, budget, times.len()) {
         if ramp > 0.0 {
             // at most 1.5× the start speed: the ramp stays below the twin's limit
             let t = twin.time_s() - t0 + config.time_step_s;
@@ -214,6 +206,23 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         max_eccentricity_ratio: max_eps,
     };
     print_twin_figures(args, &fig)
+}
+
+/// ORC-9000's `--steps`, if given: 1 to 2²⁴ measured steps.
+fn check_steps(steps: Option<usize>) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        steps.is_none_or(|n| (1..=1 << 24).contains(&n)),
+        "--steps {steps:?} must be 1 to 16,777,216"
+    );
+    Ok(())
+}
+
+/// Whether to measure another step: up to `--steps`, else while the time budget lasts.
+fn measure_more(steps: Option<usize>, start: Instant, budget: Duration, done: usize) -> bool {
+    match steps {
+        Some(n) => done < n,
+        None => start.elapsed() < budget && done < (1 << 20),
+    }
 }
 
 fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()> {
@@ -305,11 +314,7 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
     let mut times = Vec::with_capacity(1 << 20);
     let start = Instant::now();
     let mut k = 0usize;
-    let more = |done: usize| match args.steps {
-        Some(n) => done < n,
-        None => start.elapsed() < budget && done < (1 << 20),
-    };
-    while more(times.len()) {
+    while measure_more(args.steps, start, budget, times.len()) {
         let q = if k.is_multiple_of(2) { moved } else { q0 };
         let t = Instant::now();
         let (r, c) = tabulated.solve_with_coefficients(&at(q))?;
