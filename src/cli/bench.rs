@@ -48,6 +48,11 @@ pub struct BenchArgs {
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
+    /// ORC-9000: measure exactly this many steps instead of `--seconds` (a fixed amount of work,
+    /// e.g. for counting instructions under `valgrind --tool=callgrind`, which a loaded machine
+    /// does not change).
+    #[arg(long)]
+    steps: Option<usize>,
     /// Film grid over the half bearing.
     #[arg(long, default_value = "60x10", value_parser = FilmGrid::parse)]
     grid: FilmGrid,
@@ -83,6 +88,7 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
         "--seconds {} must be between 0 and 600",
         args.seconds
     );
+    check_steps(args.steps)?;
     let figures = match args.workload {
         Workload::Film => film_cases(args)?,
         Workload::Orc9000 => return orc_9000(args),
@@ -174,7 +180,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let (mut contact_steps, mut max_eps) = (0usize, 0.0_f64);
     let start = Instant::now();
     let t0 = twin.time_s();
-    while start.elapsed() < budget && times.len() < (1 << 20) {
+    while measure_more(args.steps, start, budget, times.len()) {
         if ramp > 0.0 {
             // at most 1.5× the start speed: the ramp stays below the twin's limit
             let t = twin.time_s() - t0 + config.time_step_s;
@@ -216,6 +222,23 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         max_eccentricity_ratio: max_eps,
     };
     print_twin_figures(args, &fig)
+}
+
+/// ORC-9000's `--steps`, if given: 1 to 2²⁴ measured steps.
+fn check_steps(steps: Option<usize>) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        steps.is_none_or(|n| (1..=1 << 24).contains(&n)),
+        "--steps {steps:?} must be 1 to 16,777,216"
+    );
+    Ok(())
+}
+
+/// Whether to measure another step: up to `--steps`, else while the time budget lasts.
+fn measure_more(steps: Option<usize>, start: Instant, budget: Duration, done: usize) -> bool {
+    match steps {
+        Some(n) => done < n,
+        None => start.elapsed() < budget && done < (1 << 20),
+    }
 }
 
 fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()> {
@@ -346,7 +369,7 @@ fn film_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
     let mut times = Vec::with_capacity(1 << 20);
     let start = Instant::now();
     let mut k = 0usize;
-    while start.elapsed() < budget && times.len() < (1 << 20) {
+    while measure_more(args.steps, start, budget, times.len()) {
         let q = if k.is_multiple_of(2) { moved } else { q0 };
         let t = Instant::now();
         let (r, c) = tabulated.solve_with_coefficients(&at(q))?;

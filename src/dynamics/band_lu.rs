@@ -93,26 +93,76 @@ impl BandLu {
 
     /// x = A⁻¹ r from the factors (`x` may not alias `r`). Allocates nothing.
     pub(crate) fn solve(&self, r: &[f64], x: &mut [f64]) {
+        // the half-bandwidths of rotors numbered node by node (4 DOFs a node: 7; a pedestal
+        // or a coarser model less), with the band's length known to the compiler
+        match self.b {
+            7 => self.solve_band::<7>(r, x),
+            6 => self.solve_band::<6>(r, x),
+            5 => self.solve_band::<5>(r, x),
+            3 => self.solve_band::<3>(r, x),
+            _ => self.solve_any(r, x),
+        }
+    }
+
+    /// [`solve`](Self::solve) for any half-bandwidth.
+    fn solve_any(&self, r: &[f64], x: &mut [f64]) {
         let (n, b, w) = (self.n, self.b, 2 * self.b + 1);
         // L y = r: row i's multipliers are the b entries left of its diagonal
         for i in 0..n {
-            let first = i.saturating_sub(b);
-            let row = &self.data[i * w + (first + b - i)..i * w + b];
-            let s: f64 = row.iter().zip(&x[first..i]).map(|(l, y)| l * y).sum();
-            x[i] = r[i] - s;
+            x[i] = r[i] - self.lower_sum(i, x);
         }
         // U x = y: row i's diagonal and the b entries right of it
         for i in (0..n).rev() {
             let last = (i + b).min(n - 1);
             let row = &self.data[i * w + b..i * w + b + (last - i) + 1];
-            let s: f64 = row[1..]
-                .iter()
-                .zip(&x[i + 1..=last])
-                .map(|(u, v)| u * v)
-                .sum();
-            x[i] = (x[i] - s) * self.inverse_diagonal[i];
+            x[i] = (x[i] - dot(&row[1..], &x[i + 1..=last])) * self.inverse_diagonal[i];
         }
     }
+
+    /// Row i's sum Σ L[i][j] y[j] over the band left of the diagonal.
+    fn lower_sum(&self, i: usize, y: &[f64]) -> f64 {
+        let (b, w) = (self.b, 2 * self.b + 1);
+        let first = i.saturating_sub(b);
+        dot(&self.data[i * w + (first + b - i)..i * w + b], &y[first..i])
+    }
+
+    /// [`solve`](Self::solve) with the half-bandwidth B a constant: the rows whose band is
+    /// whole take fixed-length sums (the same products summed in the same order as
+    /// [`solve_any`](Self::solve_any): the same result, bit for bit), the ends the general ones.
+    fn solve_band<const B: usize>(&self, r: &[f64], x: &mut [f64]) {
+        let (n, w) = (self.n, 2 * B + 1);
+        if n <= 2 * B {
+            return self.solve_any(r, x);
+        }
+        for i in 0..B {
+            x[i] = r[i] - self.lower_sum(i, x);
+        }
+        for i in B..n {
+            let row: &[f64; B] = fixed(&self.data[i * w..]);
+            x[i] = r[i] - dot(row, fixed::<B>(&x[i - B..]));
+        }
+        for i in (n - B..n).rev() {
+            let row = &self.data[i * w + B + 1..i * w + B + (n - i)];
+            x[i] = (x[i] - dot(row, &x[i + 1..n])) * self.inverse_diagonal[i];
+        }
+        for i in (0..n - B).rev() {
+            let row: &[f64; B] = fixed(&self.data[i * w + B + 1..]);
+            x[i] = (x[i] - dot(row, fixed::<B>(&x[i + 1..]))) * self.inverse_diagonal[i];
+        }
+    }
+}
+
+/// Σ a_k b_k in order (the triangular solves' row sums).
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(u, v)| u * v).sum()
+}
+
+/// The first N entries of `v` as an array (v has at least N: the band's rows do).
+#[inline(always)]
+fn fixed<const N: usize>(v: &[f64]) -> &[f64; N] {
+    v.first_chunk::<N>()
+        .expect("a band row holds its half-bandwidth's entries")
 }
 
 #[cfg(test)]
@@ -147,6 +197,35 @@ mod tests {
             .map(|i| ((0..n).map(|j| a[(i, j)] * x[j]).sum::<f64>() - r[i]).abs())
             .fold(0.0, f64::max);
         assert!(worst < 1e-13, "residual {worst}");
+    }
+
+    /// The fixed-bandwidth solves against the general one (the same sums in the same order):
+    /// equal bit for bit, for every specialised half-bandwidth and sizes around 2b.
+    #[test]
+    fn fixed_band_solves_equal_the_general_solve_exactly() {
+        for b in [3, 5, 6, 7] {
+            for n in [2 * b, 2 * b + 1, 4 * b + 3, 124] {
+                let a = Mat::<f64>::from_fn(n, n, |i, j| {
+                    let d = i.abs_diff(j);
+                    if d > b {
+                        0.0
+                    } else if d == 0 {
+                        10.0 + (i % 5) as f64
+                    } else {
+                        ((i * 7 + j * 3) as f64 * 0.61).sin() / d as f64
+                    }
+                });
+                let mut lu = BandLu::zeros(n, b);
+                lu.fill(|i, j| a[(i, j)]);
+                assert!(lu.factor());
+                let r: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos() * 1e3).collect();
+                let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+                lu.solve(&r, &mut x);
+                lu.solve_any(&r, &mut y);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&x), bits(&y), "b {b}, n {n}");
+            }
+        }
     }
 
     #[test]

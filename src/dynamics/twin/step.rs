@@ -35,8 +35,12 @@ impl Twin {
         self.fallbacks = 0;
         for level in 0..3 {
             let substeps = 1usize << level;
-            // the state to return to if the step must be retried (scratch reused: no allocation)
-            self.saved.copy_from(&self.state);
+            // the state to return to if the step must be retried (scratch reused: no
+            // allocation); a failed `advance` leaves the state as it was, so one substep
+            // (level 0) needs no copy
+            if level > 0 {
+                self.saved.copy_from(&self.state);
+            }
             let mut ok = true;
             for s in 1..=substeps {
                 let speed =
@@ -44,7 +48,9 @@ impl Twin {
                 match self.advance(level, speed, input.accel_rad_s2) {
                     Ok(it) => iterations += it,
                     Err(Some(e)) => {
-                        self.state.copy_from(&self.saved);
+                        if level > 0 {
+                            self.state.copy_from(&self.saved);
+                        }
                         return Err(e);
                     }
                     Err(None) => {
@@ -57,7 +63,9 @@ impl Twin {
                 self.fill_output(iterations, substeps);
                 return Ok(&self.output);
             }
-            self.state.copy_from(&self.saved);
+            if level > 0 {
+                self.state.copy_from(&self.saved);
+            }
         }
         Err(TwinError::NotConverged {
             time_s: self.state.time_s,
