@@ -7,7 +7,7 @@ mod common;
 use common::{mdm, seed_bearing, test_cache_dir};
 use rotor_twin::film::{
     EccentricityMap, FilmCoefficients, FilmGrid, FilmModel, FilmTable, FiniteFilm, FlowRegime,
-    JournalKinematics, Lubricant, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
+    ForceFrame, JournalKinematics, Lubricant, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
     TableResolution, TabulatedFilm,
 };
 use std::f64::consts::TAU;
@@ -78,6 +78,7 @@ const COARSE: TableResolution = TableResolution {
     n_psi: 32,
     grid_phases: 1,
     map: EccentricityMap::Atanh,
+    frame: ForceFrame::Source,
 };
 
 /// The worst force and coefficient errors of the Re interpolation of a table with slices

@@ -5,8 +5,9 @@
 //! default table's.
 
 use rotor_twin::film::{
-    BearingGeometry, EccentricityMap, FilmGrid, FilmModel, FlowRegime, JournalKinematics,
-    Lubricant, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm, TableResolution,
+    BearingGeometry, EccentricityMap, FilmGrid, FilmModel, FlowRegime, ForceFrame,
+    JournalKinematics, Lubricant, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
+    TableResolution,
 };
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -43,6 +44,7 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
         n_psi: 16,
         grid_phases: 1,
         map: EccentricityMap::Atanh,
+        frame: ForceFrame::Source,
     };
     let re_per_speed = 900.0 * 0.03 * 40e-6 / 0.0008;
     for regime in [FlowRegime::Turbulent, FlowRegime::Auto] {

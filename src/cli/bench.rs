@@ -138,8 +138,8 @@ struct TwinFigures {
     max_eccentricity_ratio: f64,
 }
 
-fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
-    use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig};
+/// The built-in microturbine on the bench's film grid and flow regime.
+fn orc_9000_rotor(args: &BenchArgs) -> crate::rotor::Rotor {
     use crate::rotor::{MachineDescription, Rotor};
     let mut rotor = crate::transient::with_grid(
         &Rotor::from_description(&MachineDescription::builtin_default()),
@@ -150,6 +150,12 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
             f.flow = args.flow;
         }
     }
+    rotor
+}
+
+fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
+    use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig};
+    let rotor = orc_9000_rotor(args);
     let omega = rpm_to_rad_s(9000.0);
     let config = TwinConfig {
         film: args.film.into(),

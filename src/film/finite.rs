@@ -45,6 +45,21 @@ pub const LINEARISATION_GRID_PHASES: usize = 8;
 /// Most active-set passes allowed before the solve is declared failed.
 const MAX_ACTIVE_SET_PASSES: usize = 200;
 
+/// The column sequence 0, 1, n−1, 2, n−2, … that keeps a periodic ring of `nt` columns banded.
+fn folded_columns(nt: usize) -> Vec<u32> {
+    (0..nt as u32)
+        .map(|m| {
+            if m == 0 {
+                0
+            } else if m % 2 == 1 {
+                m.div_ceil(2)
+            } else {
+                nt as u32 - m / 2
+            }
+        })
+        .collect()
+}
+
 /// Finite-length film solver with its workspace (allocated once, reused by every solve).
 #[derive(Debug, Clone)]
 pub struct FiniteFilm {
@@ -154,17 +169,7 @@ impl FiniteFilm {
                     .map_or(f64::NAN, |g| g.supply_pressure_pa / pressure_scale)
             })
             .collect();
-        let folded_columns = (0..nt as u32)
-            .map(|m| {
-                if m == 0 {
-                    0
-                } else if m % 2 == 1 {
-                    m.div_ceil(2)
-                } else {
-                    nt as u32 - m / 2
-                }
-            })
-            .collect();
+        let folded_columns = folded_columns(nt);
         let nodes = nt * nz;
         Ok(Self {
             cos_node: (0..nt).map(|i| theta(i).cos()).collect(),

@@ -306,7 +306,7 @@ impl ReynoldsTabulatedFilm {
                 continue;
             }
             let (n, f_eps, f_psi) = self.table.slices[j].node_with_slopes(s.eps, s.psi);
-            node.add(wj, 1.0, &n);
+            node.add(wj, [1.0, 1.0], &n);
             for k in 0..2 {
                 slopes[0][k] += wj * f_eps[k];
                 slopes[1][k] += wj * f_psi[k];
