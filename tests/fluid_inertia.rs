@@ -495,8 +495,9 @@ fn kicked_table_growth(rotor: &Rotor, rpm: f64, (from, revs): (usize, usize)) ->
 ///   pressure zone ζ1, ζ2 and κ follow the journal's state, and the inertia pressure does not
 ///   vanish at ζ1, ζ2, so the eigenvalues must be taken with the zone following (central
 ///   differences of the table's film at the moved journal; the table's ζ1, ζ2 are smooth). Steps
-///   of 0.1 % and 1 % of the clearance give the same growth within 2 % (the plateau; measured
-///   0.00468 and 0.00459/rev, 0.00465 at 0.3 %), and the transient grows at that rate within
+///   of 0.1 % and 0.3 % of the clearance give the same growth within 2 % (the plateau; measured
+///   0.00468 and 0.00465/rev; at 1 % the nonlinearity shows: 0.00459, 0.00460 on the table of
+///   session 11's force frame, 1.9–2.0 % off), and the transient grows at that rate within
 ///   5 % (measured 0.00470/rev; the tolerance: the 2 % step plateau plus the 0.3 % spread of the
 ///   fit window, with margin for the table's ±0.5 % coefficients). The held zone (`modes`)
 ///   says 2.5 times more and must miss it; the same transient without film inertia matches
@@ -508,7 +509,7 @@ fn the_time_step_and_the_eigenvalues_agree_on_the_convective_inertia() {
     let t2 = transient_growth(&full, 9000.0, Coupling::Linear, FilmEvaluation::Direct);
     assert!((t2 - e2).abs() < 0.02 * e2.abs(), "{t2} vs {e2}");
     let held = table_eigen_growth(&full, 9000.0, None);
-    let [fine, coarse] = [1e-3, 1e-2].map(|s| table_eigen_growth(&full, 9000.0, Some(s)));
+    let [fine, coarse] = [1e-3, 3e-3].map(|s| table_eigen_growth(&full, 9000.0, Some(s)));
     let kicked = kicked_table_growth(&full, 9000.0, (50, 200));
     let (bare_eigen, bare_kicked) = (
         table_eigen_growth(&bare, 9000.0, None),
@@ -516,7 +517,7 @@ fn the_time_step_and_the_eigenvalues_agree_on_the_convective_inertia() {
     );
     println!(
         "9000 rpm growth/rev with full: linear coupling {t2:.5} vs eigen {e2:.5}; table: eigen \
-         held {held:.5}, following {fine:.5} (0.1 % c) {coarse:.5} (1 % c), kicked transient \
+         held {held:.5}, following {fine:.5} (0.1 % c) {coarse:.5} (0.3 % c), kicked transient \
          {kicked:.5}; without film inertia eigen {bare_eigen:.5}, kicked {bare_kicked:.5}"
     );
     assert!((coarse / fine - 1.0).abs() < 0.02, "{fine} vs {coarse}");
