@@ -16,7 +16,7 @@
 
 use super::OneXBlock;
 use crate::calibrate::{
-    estimate_unbalance, estimate_viscosity, CalibrationError, MeanPosition, OneXVector,
+    estimate_viscosity_and_unbalance, CalibrationError, MeanPosition, OneXVector,
     UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
 };
 use crate::replay::calibration::MAX_WINDOW_RESIDUAL_SHARE;
@@ -155,7 +155,8 @@ impl LiveCalibration {
 /// The fit of `measured` (as [`LiveCalibration::measurements`] gives them) for the machine
 /// `rotor` describes (at its file's viscosity): the viscosity scale from the mean positions
 /// (when there are at least two), then the unbalance at that viscosity (at the file's when the
-/// viscosity cannot be fitted).
+/// viscosity cannot be fitted), then the viscosity again under the journal orbits of that
+/// unbalance and the unbalance at it (`calibrate::estimate_viscosity_and_unbalance`).
 pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
     let (vectors, positions) = measured;
     let mut reference = rotor.clone();
@@ -163,27 +164,15 @@ pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
     // result cannot be an error)
     let _ = reference.set_viscosity_scale(1.0);
     let text = |e: CalibrationError| e.to_string();
-    let viscosity = estimate_viscosity(&reference, positions).map_err(text);
-    let mut at = reference.clone();
-    if let Ok(v) = &viscosity {
-        if let Err(e) = at.set_viscosity_scale(v.scale) {
-            return LiveEstimate {
-                viscosity: Err(format!("fitted scale {}: {e}", v.scale)),
-                unbalance: Err("not fitted: the viscosity was refused".into()),
-                vectors: vectors.len(),
-                positions: positions.len(),
-            };
-        }
-    }
-    let unbalance = match vectors.is_empty() {
-        true => {
-            Err("no keyphasor-referenced 1X vector yet (a 1X phase needs the keyphasor)".into())
-        }
-        false => estimate_unbalance(&at, vectors, DEFAULT_CORRECTION_RADIUS_M).map_err(text),
-    };
+    let (viscosity, unbalance) = estimate_viscosity_and_unbalance(
+        &reference,
+        positions,
+        vectors,
+        DEFAULT_CORRECTION_RADIUS_M,
+    );
     LiveEstimate {
-        viscosity,
-        unbalance,
+        viscosity: viscosity.map_err(text),
+        unbalance: unbalance.map_err(text),
         vectors: vectors.len(),
         positions: positions.len(),
     }
