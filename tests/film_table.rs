@@ -24,16 +24,7 @@ impl Rng {
 /// A journal state at eccentricity ratio ε, attitude φ, radial and tangential velocities
 /// (fractions of c ω), turning at 9,000 rpm.
 fn state(c: f64, eps: f64, phi: f64, vr: f64, vt: f64) -> JournalKinematics {
-    let w = OMEGA_9000_RPM;
-    let (vr, vt) = (vr * c * w, vt * c * w);
-    JournalKinematics {
-        position_m: [eps * c * phi.cos(), eps * c * phi.sin()],
-        velocity_m_s: [
-            vr * phi.cos() - vt * phi.sin(),
-            vr * phi.sin() + vt * phi.cos(),
-        ],
-        speed_rad_s: w,
-    }
+    common::journal_state(c, OMEGA_9000_RPM, eps, phi, vr, vt)
 }
 
 fn models() -> (TabulatedFilm, FiniteFilm, f64, usize) {
@@ -211,7 +202,7 @@ fn coefficients_agree_over_the_whip_domain() {
         );
         let a = finer_phase_average(&mut direct, &kin);
         let (_, b) = table.solve_with_coefficients(&kin).unwrap();
-        let e = coefficient_error(&a, &b, OMEGA_9000_RPM);
+        let e = common::coefficient_error(&a, &b, OMEGA_9000_RPM);
         if e > worst {
             (worst, worst_at) = (e, eps);
         }
@@ -309,7 +300,7 @@ fn centre_error(table: &mut TabulatedFilm) -> (f64, f64) {
             );
             let a = finer_phase_average(&mut direct, &kin);
             let (_, b) = table.solve_with_coefficients(&kin).unwrap();
-            let e = coefficient_error(&a, &b, OMEGA_9000_RPM);
+            let e = common::coefficient_error(&a, &b, OMEGA_9000_RPM);
             if e > worst {
                 (worst, worst_at) = (e, eps);
             }
@@ -360,35 +351,6 @@ fn the_phase_average_is_nearer_the_converged_film() {
             off(s)
         );
     }
-}
-
-/// The largest difference between two sets of eight coefficients, over the coefficient scale
-/// of `reference`: max over the 8 entries of |k|, |c ω| (N/m). The scale is the state's own
-/// (so the wall's stiff film and the centre's soft one are each measured against themselves)
-/// and finite everywhere, also at ε = 0, where the centred journal's direct stiffnesses vanish
-/// but its cross-coupled stiffness ±c_d ω/2 and direct damping c_d do not; an entry's own
-/// magnitude would not do, as entries pass through zero.
-fn coefficient_error(
-    reference: &rotor_twin::film::FilmCoefficients,
-    other: &rotor_twin::film::FilmCoefficients,
-    omega: f64,
-) -> f64 {
-    let (mut scale, mut e) = (0.0_f64, 0.0_f64);
-    for i in 0..2 {
-        for j in 0..2 {
-            let (ka, kb) = (
-                reference.stiffness_n_per_m[(i, j)],
-                other.stiffness_n_per_m[(i, j)],
-            );
-            let (ca, cb) = (
-                reference.damping_n_s_per_m[(i, j)] * omega,
-                other.damping_n_s_per_m[(i, j)] * omega,
-            );
-            scale = scale.max(ka.abs()).max(ca.abs());
-            e = e.max((ka - kb).abs()).max((ca - cb).abs());
-        }
-    }
-    e / scale
 }
 
 /// The direct force averaged over 32 grid phases (4 sub-phases of the 8-phase average): the
@@ -478,7 +440,7 @@ fn banded_errors(model: &mut TabulatedFilm, states: &[Referenced]) -> ([f64; 8],
         let (r, k) = model.solve_with_coefficients(kin).unwrap();
         let f = r.force_n;
         ef[*b] = ef[*b].max((f[0] - fr[0]).hypot(f[1] - fr[1]) / fr[0].hypot(fr[1]));
-        ec[*b] = ec[*b].max(coefficient_error(cr, &k, kin.speed_rad_s));
+        ec[*b] = ec[*b].max(common::coefficient_error(cr, &k, kin.speed_rad_s));
     }
     (ef, ec)
 }
@@ -730,7 +692,7 @@ fn coefficient_reference_diagnosis() {
                 .collect();
             let e = |x: &rotor_twin::film::FilmCoefficients,
                      y: &rotor_twin::film::FilmCoefficients| {
-                100.0 * coefficient_error(x, y, w)
+                100.0 * common::coefficient_error(x, y, w)
             };
             let eps =
                 kin.position_m[0].hypot(kin.position_m[1]) / seed_bearing(0.5).radial_clearance_m;
@@ -749,7 +711,7 @@ fn coefficient_reference_diagnosis() {
                 let dif = difference_reference(film, kin, ntf, 1, 1e-4);
                 let e = |x: &rotor_twin::film::FilmCoefficients,
                          y: &rotor_twin::film::FilmCoefficients| {
-                    100.0 * coefficient_error(x, y, w)
+                    100.0 * common::coefficient_error(x, y, w)
                 };
                 println!(
                     "  band {band} {n}: lin–dif {:.3} | vs lin: T {:.3} A {:.3} D {:.3} | vs dif: T {:.3} A {:.3} D {:.3}",

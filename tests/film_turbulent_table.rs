@@ -37,34 +37,7 @@ fn seed_re_max() -> f64 {
 /// A journal state at ε, attitude φ, radial and tangential velocities (fractions of c ω), at
 /// speed ω.
 fn state(eps: f64, phi: f64, vr: f64, vt: f64, w: f64) -> JournalKinematics {
-    let c = 40e-6;
-    let (vr, vt) = (vr * c * w, vt * c * w);
-    JournalKinematics {
-        position_m: [eps * c * phi.cos(), eps * c * phi.sin()],
-        velocity_m_s: [
-            vr * phi.cos() - vt * phi.sin(),
-            vr * phi.sin() + vt * phi.cos(),
-        ],
-        speed_rad_s: w,
-    }
-}
-
-/// Largest difference between two sets of eight coefficients over the reference's scale
-/// max|K_ij|, |B_ij ω| (as in `film_table.rs`).
-fn coefficient_error(a: &FilmCoefficients, b: &FilmCoefficients, omega: f64) -> f64 {
-    let (mut scale, mut e) = (0.0_f64, 0.0_f64);
-    for i in 0..2 {
-        for j in 0..2 {
-            let (ka, kb) = (a.stiffness_n_per_m[(i, j)], b.stiffness_n_per_m[(i, j)]);
-            let (ca, cb) = (
-                a.damping_n_s_per_m[(i, j)] * omega,
-                b.damping_n_s_per_m[(i, j)] * omega,
-            );
-            scale = scale.max(ka.abs()).max(ca.abs());
-            e = e.max((ka - kb).abs()).max((ca - cb).abs());
-        }
-    }
-    e / scale
+    common::journal_state(40e-6, w, eps, phi, vr, vt)
 }
 
 fn force_error(a: [f64; 2], reference: [f64; 2]) -> f64 {
@@ -107,7 +80,7 @@ fn re_axis_error(regime: FlowRegime, spacing: f64) -> (f64, f64, usize) {
             let (a, ka) = model.solve_with_coefficients(&kin).unwrap();
             let (b, kb) = reference.solve_with_coefficients(&kin).unwrap();
             ef = ef.max(force_error(a.force_n, b.force_n));
-            ec = ec.max(coefficient_error(&kb, &ka, w));
+            ec = ec.max(common::coefficient_error(&kb, &ka, w));
         }
     }
     (ef, ec, axis.len())
@@ -178,7 +151,7 @@ fn at_vanishing_density_the_turbulent_table_is_the_laminar_table() {
             }
             assert!(force_error(b.force_n, a.force_n) < 1e-9, "{kin:?}");
             assert!((b.power_loss_w / a.power_loss_w - 1.0).abs() < 1e-9);
-            assert!(coefficient_error(&ka, &kb, w) < 1e-9, "{kin:?}");
+            assert!(common::coefficient_error(&ka, &kb, w) < 1e-9, "{kin:?}");
         }
     }
 }
@@ -270,7 +243,7 @@ fn the_turbulent_table_agrees_with_the_direct_turbulent_solver() {
                 let (fr, kr) = direct_reference(&mut direct, &kin);
                 let (a, ka) = model.solve_with_coefficients(&kin).unwrap();
                 ef[b] = ef[b].max(force_error(a.force_n, fr));
-                ec[b] = ec[b].max(coefficient_error(&kr, &ka, w));
+                ec[b] = ec[b].max(common::coefficient_error(&kr, &ka, w));
             }
         }
         let pct = |v: &[f64; 8]| v.map(|e| format!("{:.2}", 100.0 * e)).join(" ");

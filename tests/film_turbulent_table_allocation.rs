@@ -9,29 +9,11 @@ use rotor_twin::film::{
     JournalKinematics, Lubricant, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
     TableResolution,
 };
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "common/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 /// One test only: the counter is global to the process.
 #[test]
@@ -52,7 +34,7 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
         let table = ReynoldsTable::build_with(&g, oil, grid, axis, res).unwrap();
         let mut film = ReynoldsTabulatedFilm::new(Arc::new(table));
         let mut profile = [0.0; 120];
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         let mut evaluated = 0;
         for k in 0..1000 {
             let x = k as f64;
@@ -76,6 +58,6 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
             evaluated += 1;
         }
         assert_eq!(evaluated, 1000);
-        assert_eq!(ALLOCATIONS.load(Ordering::SeqCst) - before, 0, "{regime:?}");
+        assert_eq!(allocations() - before, 0, "{regime:?}");
     }
 }

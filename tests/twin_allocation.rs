@@ -6,28 +6,10 @@
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::film::FluidInertia;
 use rotor_twin::rotor::{MachineDescription, Rotor};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "common/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 /// How the counted steps are reached.
 #[derive(Clone, Copy)]
@@ -82,7 +64,7 @@ fn allocations_in_steps(
             );
         }
     }
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut contact_steps = 0;
     for k in 0..steps {
         if k % 250 == 100 {
@@ -98,7 +80,7 @@ fn allocations_in_steps(
         let out = twin.step(&input).unwrap();
         contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
     }
-    (ALLOCATIONS.load(Ordering::SeqCst) - before, contact_steps)
+    (allocations() - before, contact_steps)
 }
 
 /// One test only: the counter is global to the process, and tests run in parallel threads.

@@ -220,3 +220,46 @@ pub fn rated_nonlinear_session() -> (
     };
     (rotor, config, session, input)
 }
+
+/// A journal state at eccentricity ratio ε, attitude φ (rad), radial and tangential velocities
+/// (fractions of c ω) in a clearance `c` (m), turning at `w` (rad/s).
+pub fn journal_state(c: f64, w: f64, eps: f64, phi: f64, vr: f64, vt: f64) -> JournalKinematics {
+    let (vr, vt) = (vr * c * w, vt * c * w);
+    JournalKinematics {
+        position_m: [eps * c * phi.cos(), eps * c * phi.sin()],
+        velocity_m_s: [
+            vr * phi.cos() - vt * phi.sin(),
+            vr * phi.sin() + vt * phi.cos(),
+        ],
+        speed_rad_s: w,
+    }
+}
+
+/// The largest difference between two sets of eight coefficients, over the coefficient scale
+/// of `reference`: max over the 8 entries of |k|, |c ω| (N/m). The scale is the state's own
+/// (so the wall's stiff film and the centre's soft one are each measured against themselves)
+/// and finite everywhere, also at ε = 0, where the centred journal's direct stiffnesses vanish
+/// but its cross-coupled stiffness ±c_d ω/2 and direct damping c_d do not; an entry's own
+/// magnitude would not do, as entries pass through zero.
+pub fn coefficient_error(
+    reference: &FilmCoefficients,
+    other: &FilmCoefficients,
+    omega: f64,
+) -> f64 {
+    let (mut scale, mut e) = (0.0_f64, 0.0_f64);
+    for i in 0..2 {
+        for j in 0..2 {
+            let (ka, kb) = (
+                reference.stiffness_n_per_m[(i, j)],
+                other.stiffness_n_per_m[(i, j)],
+            );
+            let (ca, cb) = (
+                reference.damping_n_s_per_m[(i, j)] * omega,
+                other.damping_n_s_per_m[(i, j)] * omega,
+            );
+            scale = scale.max(ka.abs()).max(ca.abs());
+            e = e.max((ka - kb).abs()).max((ca - cb).abs());
+        }
+    }
+    e / scale
+}
