@@ -389,18 +389,7 @@ fn force_reference(
     f
 }
 
-/// The ε bands of the study and of the accuracy tests: the centre, the small orbits, the static
-/// equilibria, the whip's approach and the wall.
-const BANDS: [(f64, f64); 8] = [
-    (0.0, 0.03),
-    (0.03, 0.3),
-    (0.3, 0.5),
-    (0.5, 0.8),
-    (0.8, 0.9),
-    (0.9, 0.95),
-    (0.95, 0.98),
-    (0.98, 0.995),
-];
+use common::ECC_BANDS as BANDS;
 
 /// States a band of [`BANDS`] in the tests of the whole domain (and the study's default).
 const STATES_PER_BAND: usize = 20;

@@ -198,17 +198,7 @@ fn regimes() -> Vec<FlowRegime> {
         .collect()
 }
 
-/// The ε bands of the check (as `film_table.rs`).
-const BANDS: [(f64, f64); 8] = [
-    (0.0, 0.03),
-    (0.03, 0.3),
-    (0.3, 0.5),
-    (0.5, 0.8),
-    (0.8, 0.9),
-    (0.9, 0.95),
-    (0.95, 0.98),
-    (0.98, 0.995),
-];
+use common::ECC_BANDS as BANDS;
 
 /// The default turbulent table of the seed bearing (disk-cached in the tests' cache) against
 /// the direct turbulent solver (32-phase reference) over 8 ε bands at Re 500–3,000: force (of

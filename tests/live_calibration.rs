@@ -91,6 +91,24 @@ impl Rig {
         self.drivers = drivers;
     }
 
+    /// Finishes every driver's comparison blocks against its own keyphasor events.
+    fn finish_comparisons(&mut self) {
+        for (comparisons, d) in self.comparisons.iter_mut().zip(&self.drivers) {
+            for c in comparisons.iter_mut() {
+                c.finish(Some(d.keyphasor_events()));
+            }
+        }
+    }
+
+    /// Driver `i`'s onset speed (rpm) by the replay's rule, the earlier station: predicted, or
+    /// measured (the plant's).
+    fn onset_rpm(&self, i: usize, predicted: bool) -> f64 {
+        self.comparisons[i]
+            .iter()
+            .map(|c| c.onset(predicted).expect("an onset").1)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     fn now_ns(&self) -> i64 {
         EPOCH_NS + (self.plant.time_s() * 1e9).round() as i64
     }
@@ -523,17 +541,8 @@ fn nonlinear_onset_after_live_calibration() {
     rig.drivers[2].apply_calibration(applied).unwrap();
     check_and_apply(&mut rig, &before, &e, 120.0);
     rig.ramp(8000.0, 9400.0, 3.5, true);
-    for (comparisons, d) in rig.comparisons.iter_mut().zip(&rig.drivers) {
-        for c in comparisons.iter_mut() {
-            c.finish(Some(d.keyphasor_events()));
-        }
-    }
-    let onset = |i: usize, predicted: bool| {
-        rig.comparisons[i]
-            .iter()
-            .map(|c| c.onset(predicted).expect("an onset").1)
-            .fold(f64::INFINITY, f64::min)
-    };
+    rig.finish_comparisons();
+    let onset = |i: usize, predicted: bool| rig.onset_rpm(i, predicted);
     let plant = onset(1, false);
     let [before, after, own] = [1, 2, 3].map(|i| onset(i, true));
     println!(
@@ -589,17 +598,8 @@ fn onset_against_the_film_grid() {
     let mut rig = Rig::new(plant, drivers, 0.0, PlantProbes::Pairs);
     rig.run(8000.0, 16.0, true);
     rig.ramp(8000.0, 9400.0, 3.5, true);
-    for (comparisons, d) in rig.comparisons.iter_mut().zip(&rig.drivers) {
-        for c in comparisons.iter_mut() {
-            c.finish(Some(d.keyphasor_events()));
-        }
-    }
-    let onset = |i: usize, predicted: bool| {
-        rig.comparisons[i]
-            .iter()
-            .map(|c| c.onset(predicted).expect("an onset").1)
-            .fold(f64::INFINITY, f64::min)
-    };
+    rig.finish_comparisons();
+    let onset = |i: usize, predicted: bool| rig.onset_rpm(i, predicted);
     println!(
         "plant (60 × 10, direct film): onset {:.0} rpm",
         onset(0, false)

@@ -72,7 +72,7 @@ pub struct ThermalState {
     pub inlet_temperature_k: f64,
     /// Temperature of the oil reaching the rupture ζ2 (K).
     pub rupture_temperature_k: f64,
-    /// Highest and flow-weighted mean film temperature (K).
+    /// Highest film temperature (K).
     pub max_temperature_k: f64,
     /// Mean temperature over the columns, weighted by their oil flow (K).
     pub mean_temperature_k: f64,

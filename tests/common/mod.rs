@@ -263,3 +263,16 @@ pub fn coefficient_error(
     }
     e / scale
 }
+
+/// The ε bands of the film table's study and accuracy tests (laminar and turbulent): the centre,
+/// the small orbits, the static equilibria, the whip's approach and the wall.
+pub const ECC_BANDS: [(f64, f64); 8] = [
+    (0.0, 0.03),
+    (0.03, 0.3),
+    (0.3, 0.5),
+    (0.5, 0.8),
+    (0.8, 0.9),
+    (0.9, 0.95),
+    (0.95, 0.98),
+    (0.98, 0.995),
+];
