@@ -82,7 +82,11 @@ def main():
     speed_w = DataWriter(dp, Topic(dp, "rt/rotor_twin/speed", RotorSpeed), qos=best_effort)
     one_x = DataReader(dp, Topic(dp, "rt/rotor_twin/one_x", OneXVectors), qos=reliable)
     warnings = DataReader(dp, Topic(dp, "rt/rotor_twin/warning", InstabilityWarning), qos=latched)
-    time.sleep(1.0)  # discovery: the node's readers match before the first sample
+    # discovery: every writer matched by the node's reader before the first sample (a lossy link
+    # can drop discovery datagrams too, and a loaded machine starts the node late), then 0.5 s for
+    # the node's side of the match
+    wait_matched([kp_w, speed_w] + [w for w, _, _ in probe_w], timeout_s=60.0)
+    time.sleep(0.5)
     omega = rpm * math.pi / 30.0
     period_ns = 2 * math.pi / omega * 1e9
     dt = period_ns / 16 * 1e-9
@@ -119,6 +123,15 @@ def main():
     time.sleep(1.0)
     read(one_x, warnings, out, t0)
     print(json.dumps(out))
+
+
+def wait_matched(writers, timeout_s):
+    """Waits until each writer has a matched subscription; exits with a message after timeout_s."""
+    deadline = time.time() + timeout_s
+    while any(w.get_publication_matched_status().current_count == 0 for w in writers):
+        if time.time() > deadline:
+            sys.exit(f"signal_peer: no subscriber matched within {timeout_s} s")
+        time.sleep(0.05)
 
 
 def read(one_x, warnings, out, t0):

@@ -19,7 +19,8 @@ rm -rf "$out/bag"
 node=$!
 sleep 1
 if [ "$loss" != "0" ]; then
-  export CYCLONEDDS_URI="<CycloneDDS><Domain><Internal><Test><XmitLossiness>$loss</XmitLossiness></Test></Internal></Domain></CycloneDDS>"
+  # SPDP every second (default 30 s): a lost announcement is repeated within the discovery wait
+  export CYCLONEDDS_URI="<CycloneDDS><Domain><Discovery><SPDPInterval>1s</SPDPInterval></Discovery><Internal><Test><XmitLossiness>$loss</XmitLossiness></Test></Internal></Domain></CycloneDDS>"
 fi
 param=""
 if [ "$unapply" != "0" ]; then
