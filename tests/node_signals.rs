@@ -61,8 +61,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// 185°) and amplitude. The peer computes each value for the instant it sends it, and a Float64
 /// is timed by its receive time, so the lag reads late by ω × the transport latency (1° is
 /// 0.11 ms here) and the scheduling jitter of both processes is phase noise: the median over the
-/// blocks within 5° (the tolerance) and 3 %, each block within 15° (one block may stall) and 10 % (a loaded
-/// machine: 3.6° and 3 % seen with another test running). When the keyphasor stops at 4 s (the
+/// blocks within 5° (the tolerance) and 3 %, each block within 15° and 10 % but one
+/// (a stalled block; a loaded machine: 3.6° and 3 % seen with another test running). When the keyphasor stops at 4 s (the
 /// speed topic goes on), the blocks after it have empty phase lags with the reason and the node
 /// warns "keyphasor stopped"; the amplitudes go on.
 #[test]
@@ -71,12 +71,16 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
     let blocks = peer["one_x"].as_array().unwrap();
     let stop = peer["keyphasor_stopped_at_s"].as_f64().unwrap();
     let (mut gaps, mut amps, mut null) = ([Vec::new(), Vec::new()], Vec::new(), 0);
-    let mut outliers = 0;
+    let (mut outliers, mut amp_outliers) = (0, 0);
     for b in blocks {
         let t = b["t_s"].as_f64().unwrap();
         for a in b["measured_amplitudes"].as_array().unwrap() {
             let r = a.as_f64().unwrap() / 2e-6 - 1.0;
-            assert!(r.abs() < 0.1, "{b}");
+            if r.abs() >= 0.1 {
+                // the same stall as a phase outlier (below): a block's samples timed late
+                println!("block at {t:.3} s: an amplitude outlier beyond 10 %: {b}");
+                amp_outliers += 1;
+            }
             amps.push(r);
         }
         let lags = b["measured_phase_lags_deg"].as_array().unwrap();
@@ -117,6 +121,7 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
     assert!(locked >= 6 && null >= 4, "{peer}");
     // at most one block (both its axes) beyond 15°: the rest of the blocks hold the lag
     assert!(outliers <= 2, "{outliers} axis readings beyond 15°");
+    assert!(amp_outliers <= 2, "{amp_outliers} amplitudes beyond 10 %");
     assert!(g0.abs() < 5.0 && g1.abs() < 5.0 && a.abs() < 0.03);
     let stale = peer["warnings"]["stale_input"].to_string();
     assert!(stale.contains("keyphasor stopped"), "{stale}");
