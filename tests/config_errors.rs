@@ -206,6 +206,16 @@ fn bearing_entries_are_parsed_by_their_model() {
     };
     let e = error_of(&probe("mm", "ac"));
     says(&e, "proximity_probes[0].unit", "", "unknown variant `mm`");
+    // a linear range that is empty or beyond any probe's reach is named with its value
+    let e = error_of(&format!(
+        "{DEFAULT_MACHINE_YAML}\nproximity_probes:\n  - {{name: px, station: probe_outboard, angle_deg: 45.0, linear_range: [250.0, 250.0]}}\n"
+    ));
+    says(
+        &e,
+        "proximity_probes[0].linear_range",
+        "[250.0, 250.0]",
+        "two different finite readings",
+    );
     let e = error_of(&probe("µm", "AC"));
     says(
         &e,

@@ -75,3 +75,29 @@ fn linearised_coefficients_do_not_depend_on_the_grid_phase() {
         assert!((lo - reference[n]).abs() < 0.01 * scale, "{name} lo");
     }
 }
+
+/// The default film grid's stability threshold is converged (issue 11): the built-in machine's
+/// linear threshold on the default 60 × 10 grid within 0.5 % of the threshold on 180 × 30, and
+/// one refinement below that (120 × 20 → 180 × 30) moves it by less than 0.5 % (README, "Grid
+/// convergence of the threshold": 8,471.3 / 8,457.2 / 8,453.9 rpm; 8,454 ± 1 on 180 × 30 to
+/// 360 × 60). The reference is the same solver on grids 9× finer, not a stored figure.
+#[test]
+fn the_default_grids_threshold_is_within_half_a_percent_of_the_converged_one() {
+    use rotor_twin::rotor::{
+        stability_threshold, static_solution, MachineDescription, Rotor, DEFAULT_MACHINE_YAML,
+    };
+    let threshold = |grid: &str| {
+        let yaml = DEFAULT_MACHINE_YAML.replace("grid: 60x10", &format!("grid: {grid}"));
+        assert_eq!(yaml.matches(&format!("grid: {grid}")).count(), 2, "two bearings");
+        let rotor = Rotor::from_description(&MachineDescription::from_yaml(&yaml, grid).unwrap());
+        let st = static_solution(&rotor).unwrap();
+        stability_threshold(&rotor, &st, 8000.0, 9000.0, 500.0)
+            .unwrap()
+            .expect("a threshold below 9,000 rpm")
+            .speed_rpm
+    };
+    let [t60, t120, t180] = ["60x10", "120x20", "180x30"].map(threshold);
+    println!("threshold: {t60:.1} / {t120:.1} / {t180:.1} rpm on 60×10 / 120×20 / 180×30");
+    assert!((t60 / t180 - 1.0).abs() < 0.005, "{t60} against {t180}");
+    assert!((t120 / t180 - 1.0).abs() < 0.005, "{t120} against {t180}");
+}

@@ -745,3 +745,59 @@ fn samples_delivered_late_in_a_burst_get_the_prediction_at_their_stamp() {
         "the stream is not late enough to matter: {newest_gap}"
     );
 }
+
+/// A saturated or out-of-range probe (issue 12): probes in volts (7.87 V/mm, DC, reference gap
+/// 7.87 V) with the linear range of an API 670 system, 2–18 V (0.25–2.29 mm of gap). Readings at
+/// the supply rail (22 V, an open channel: 2.8 mm, which the 10 mm sanity bound alone lets
+/// through) and near zero (0.5 V, a shorted channel or a shaft on the probe) are refused with
+/// the reason and counted; the readings inside the range pair into orbits and the twin steps on.
+#[test]
+fn a_saturated_probe_reading_is_refused_and_counted() {
+    let rotor = raw_machine(
+        "unit: V, sensitivity_v_per_m: 7870.0, coupling: dc, reference_gap: 7.87, linear_range: [18.0, 2.0]",
+        None,
+    );
+    assert_eq!(rotor.proximity_probes[0].linear_range, Some((2.0, 18.0)));
+    let settings = DriverSettings::new(
+        ModelKind::Nonlinear,
+        FilmEvaluation::Direct,
+        rotor.rated_speed_rad_s,
+    );
+    let mut driver = Driver::new(rotor, settings);
+    let (mut refused, mut accepted) = (Vec::new(), 0);
+    for k in 0..200i64 {
+        let t = 1_000_000_000 + k * 1_000_000;
+        let speed = Input::Speed {
+            speed_rad_s: W8000,
+            accel_rad_s2: 0.0,
+            stamp_ns: t,
+        };
+        driver.feed(t, speed, &mut |_| {});
+        let value = match k {
+            50 => 22.0,
+            120 => 0.5,
+            _ => 7.87 + 0.01 * (k as f64).sin(),
+        };
+        for name in ["probe_outboard_x", "probe_outboard_y"] {
+            let input = Input::ProbeSignal {
+                probe: ProbeRef::Name(name.into()),
+                value,
+                stamp_ns: t,
+            };
+            match driver.feed(t, input, &mut |_| {}) {
+                Fed::Refused(why) => refused.push(why),
+                _ => accepted += 1,
+            }
+        }
+    }
+    assert_eq!(refused.len(), 4, "{refused:?}");
+    assert!(
+        refused
+            .iter()
+            .all(|w| w.contains("outside its linear range 2 to 18")),
+        "{refused:?}"
+    );
+    assert_eq!(accepted, 396);
+    assert_eq!(driver.counts().refused, 4);
+    assert!(driver.session().is_some() && driver.counts().steps > 0);
+}

@@ -233,7 +233,7 @@ fn transient_onset_agrees_with_the_linear_threshold() {
 }
 
 /// The linear (constant-coefficient) model at 9,000 rpm: the seed reports it stable; on this
-/// machine description its least-damped mode is unstable (threshold 8,635 rpm, `rotor-twin
+/// machine description its least-damped mode is unstable (threshold 8,471 rpm, `rotor-twin
 /// modes`), and the time integration must agree with the eigenvalue: the non-synchronous motion
 /// grows by −δ·f_d/f_rev per revolution (δ the log decrement, f_d the mode's frequency), within
 /// 10 %. Newmark's average-acceleration rule adds no numerical damping.

@@ -96,7 +96,8 @@ enum Command {
     Modes(modes::ModesArgs),
     /// Unbalance response of the linear model (API 684): Bode/polar, peaks, AF, separation margins.
     Response(response::ResponseArgs),
-    /// Nonlinear transient at constant speed: orbits, spectrum, instability classification.
+    /// Nonlinear transient at constant speed or along a speed history (ramp, run-up, run-down),
+    /// with kicks: orbits, spectrum, instability classification.
     Simulate(simulate::SimulateArgs),
     /// Amplitude–speed characteristic: a transient at each speed, in parallel.
     Sweep(simulate::SweepArgs),

@@ -1,4 +1,5 @@
-//! `rotor-twin simulate` and `rotor-twin sweep`: nonlinear transients at constant speed.
+//! `rotor-twin simulate` and `rotor-twin sweep`: nonlinear transients at constant speed or along
+//! a speed history, with kicks.
 
 use crate::dynamics::Coupling;
 use crate::film::FilmGrid;

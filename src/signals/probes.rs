@@ -129,6 +129,10 @@ pub struct RawProbe {
     /// Slow-roll runout as given in the machine file (None: measured below the slow-roll speed,
     /// or none).
     pub runout: Option<super::OneXVector>,
+    /// The transducer system's linear range as readings in the probe's unit, (low, high) with
+    /// low < high (None: only [`MAX_GAP_M`] applies). A reading outside it is a saturated
+    /// proximitor (at its supply rail), an open or shorted channel, or a shaft out of reach.
+    pub linear_range: Option<(f64, f64)>,
 }
 
 impl RawProbe {
@@ -147,7 +151,8 @@ impl RawProbe {
 /// about 2 mm; more is a unit error or a saturated, open or shorted channel).
 pub const MAX_GAP_M: f64 = 0.01;
 
-/// Checks a raw reading: finite, and its gap within ±[`MAX_GAP_M`].
+/// Checks a raw reading: finite, its gap within ±[`MAX_GAP_M`], and within the probe's linear
+/// range when the machine file gives one.
 pub fn check_reading(p: &RawProbe, value: f64) -> Result<f64, String> {
     let gap = reading_to_m(value, p.unit, p.sensitivity_v_per_m);
     if !value.is_finite() || !gap.is_finite() || gap.abs() > MAX_GAP_M {
@@ -156,6 +161,14 @@ pub fn check_reading(p: &RawProbe, value: f64) -> Result<f64, String> {
             p.name,
             MAX_GAP_M * 1e3
         ));
+    }
+    if let Some((low, high)) = p.linear_range {
+        if !(low..=high).contains(&value) {
+            return Err(format!(
+                "probe '{}' reading {value} is outside its linear range {low} to {high} (saturated or out of range)",
+                p.name
+            ));
+        }
     }
     Ok(p.displacement_m(value))
 }

@@ -3,7 +3,9 @@
 use super::rules::{shown, Rules};
 use super::MachineDescription;
 use crate::rotor::ConfigError;
-use crate::signals::probes::{check_orthogonal, reading_to_m, ProbeCoupling, ProbeUnit, RawProbe};
+use crate::signals::probes::{
+    check_orthogonal, reading_to_m, ProbeCoupling, ProbeUnit, RawProbe, MAX_GAP_M,
+};
 use serde::{Deserialize, Serialize};
 
 /// Largest slow-roll runout accepted (m): 1 mm, far beyond any shaft a probe can look at.
@@ -51,6 +53,11 @@ pub struct ProximityProbeSpec {
     /// Slow-roll runout 1X vector, if known: amplitude (m) and phase lag (deg) from the keyphasor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub runout: Option<RunoutSpec>,
+    /// The transducer system's linear range, two readings in the probe's unit in either order
+    /// (e.g. `[-2.0, -18.0]` V for an API 670 system on a −24 V supply, `[250, 2300]` µm);
+    /// readings outside it are refused as saturated or out of range.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_range: Option<[f64; 2]>,
 }
 
 /// A slow-roll runout vector.
@@ -73,6 +80,30 @@ fn default_sensitivity() -> f64 {
 
 fn default_coupling() -> ProbeCoupling {
     ProbeCoupling::Ac
+}
+
+/// A probe's linear range `[a, b]` (readings in `unit`), checked: finite, not empty, and its
+/// gaps within ±[`MAX_GAP_M`]; returned as (low, high).
+fn check_linear_range(
+    r: [f64; 2],
+    unit: ProbeUnit,
+    sensitivity_v_per_m: f64,
+    field: &str,
+    rules: &Rules,
+) -> Result<(f64, f64), ConfigError> {
+    let (low, high) = (r[0].min(r[1]), r[0].max(r[1]));
+    let gap_ok = |v: f64| reading_to_m(v, unit, sensitivity_v_per_m).abs() <= MAX_GAP_M;
+    if !(low.is_finite() && high.is_finite() && low < high && gap_ok(low) && gap_ok(high)) {
+        return Err(rules.error(
+            field,
+            format!("{r:?}"),
+            format!(
+                "must be two different finite readings within {} mm of gap",
+                MAX_GAP_M * 1e3
+            ),
+        ));
+    }
+    Ok((low, high))
 }
 
 impl MachineDescription {
@@ -153,7 +184,12 @@ impl MachineDescription {
                 ));
             }
         }
+        let linear_range = p
+            .linear_range
+            .map(|r| check_linear_range(r, p.unit, s, &field("linear_range"), rules))
+            .transpose()?;
         Ok(RawProbe {
+            linear_range,
             name: p.name.clone(),
             station,
             axis,
