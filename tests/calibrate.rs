@@ -235,3 +235,81 @@ fn bag_at_8000_rpm(
         .expect("the bag publishes its unbalance");
     (dir, bag, published)
 }
+
+/// `replay --calibrate` fits as the live calibration does (session 12): the viscosity refitted
+/// to the mean positions under the journal orbits of the fitted unbalance
+/// (`calibrate::estimate_viscosity_and_unbalance`), not the static equilibrium alone. The plant
+/// is tests/live_calibration.rs's (common::calibration): oil × 1.10, 280 g·mm at stage 7 (node
+/// 21) at 120°, films 72 × 12 (grid × 1.2), direct film, 0.3 µm of noise, keyphasor at its angle
+/// 0; its bag holds 0.8 s at 5,000 rpm, a 0.3 s ramp and 0.8 s at 8,000 rpm (`plant::write_bag`).
+/// The fit takes 0.3 s on. Targets (the issue's): viscosity within 3 % of 1.10, unbalance within
+/// 10 % and 10°; and the orbit-averaged viscosity nearer 1.10 than the static fit on the same
+/// windows (printed: the before/after of the README).
+#[test]
+fn replay_calibrate_fits_the_viscosity_under_the_orbits() {
+    use rotor_twin::dynamics::FilmEvaluation;
+    use rotor_twin::plant::{write_bag, PlantSignals, PlantSpec, SpeedProfile};
+    use rotor_twin::replay::calibration::{bag_measurements, calibrate_bag};
+    let twin = twin_rotor();
+    let mut plant = twin.clone();
+    plant.unbalance[0].magnitude_kg_m = 0.0;
+    plant.unbalance[1].magnitude_kg_m = 280e-6;
+    plant.unbalance[1].phase_rad = 120f64.to_radians();
+    let spec = PlantSpec {
+        profile: SpeedProfile {
+            from_rpm: 5000.0,
+            to_rpm: 8000.0,
+            hold_start_s: 0.8,
+            ramp_s: 0.3,
+            hold_end_s: 0.8,
+        },
+        samples_per_rev: 16,
+        noise_m: 0.3e-6,
+        viscosity_factor: 1.10,
+        grid_factor: 1.2,
+        film: FilmEvaluation::Direct,
+        seed: 12,
+        signals: PlantSignals {
+            keyphasor_angle_deg: Some(0.0),
+            raw_probes: false,
+            runout_m: 0.0,
+        },
+    };
+    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_orbits_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let started = std::time::Instant::now();
+    let (dir, ..) = write_bag(&plant, &spec, &dir, &mut |_| {}).unwrap();
+    println!("plant bag: {:.1} s", started.elapsed().as_secs_f64());
+    let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
+    let window = [0.3, 1.9];
+    let (means, vectors, _) = bag_measurements(&bag, &twin, &[], &[], window);
+    let before = estimate_viscosity(&twin, &means).unwrap();
+    let (cal, calibrated) = calibrate_bag(&bag, &twin, &[], &[], window).unwrap();
+    let v = &cal.viscosity;
+    let p = cal.unbalance.planes[1];
+    println!(
+        "{} windows ({} left out): static fit × {:.4} ± {:.4}, orbit-averaged × {:.4} ± {:.4} (plant × 1.10); unbalance {:.1} g·mm at {:.1}° (plant 280 at 120°), stage 4 {:.1} g·mm",
+        cal.windows_used,
+        cal.windows_skipped,
+        before.scale,
+        before.scale_std,
+        v.scale,
+        v.scale_std,
+        p.magnitude_g_mm,
+        p.phase_deg,
+        cal.unbalance.planes[0].magnitude_g_mm
+    );
+    assert!(vectors.len() >= 8, "{} 1X vectors", vectors.len());
+    assert!((v.scale / 1.10 - 1.0).abs() < 0.03, "{v:?}");
+    assert!(
+        (v.scale - 1.10).abs() < (before.scale - 1.10).abs(),
+        "orbit-averaged × {} no nearer 1.10 than the static × {}",
+        v.scale,
+        before.scale
+    );
+    assert!((p.magnitude_g_mm / 280.0 - 1.0).abs() < 0.10, "{p:?}");
+    let dphi = (p.phase_deg - 120.0 + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(dphi.abs() < 10.0, "{p:?}");
+    assert!((calibrated.viscosity_scale() - v.scale).abs() < 1e-12);
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -317,3 +317,81 @@ fn the_live_twin_on_the_table_heats_within_three_hundredths_of_a_kelvin() {
     assert_eq!(d.heat_balances(), (1, None));
     assert_live_equals_offline(&d, None, 9000.0, 0.03);
 }
+
+/// A heat balance that fails reaches the bus (issue 12): a supply at 119.8 °C, inside the
+/// built-in law's 10–120 °C, with a bearing heating past the law's top (k = 1: T_eff − T_s is
+/// the whole rise, ~2 K at 40 °C). Reference: `Rotor::heat_films` on a fresh machine fails there
+/// too (and succeeds at 40 °C). The driver counts the failure, keeps the last good viscosity
+/// (the 40 °C balance's scales, to 1e-12, on the machine and in the running twin), its model
+/// status warns with the reason (`heat_balance_error`, `heat_balance_failures` 1) and the twin
+/// steps on; back at 40 °C the balance succeeds, the warning goes, the count stays and the
+/// replay's report keeps the last failure.
+#[test]
+fn a_failed_heat_balance_warns_and_the_last_good_viscosity_stays() {
+    use rotor_twin::driver::{Driver, DriverSettings, Fed, ModelKind};
+    use rotor_twin::dynamics::FilmEvaluation;
+    let rotor = heated_rotor(MDM_CP, 1.0);
+    let w = 9000.0 * std::f64::consts::PI / 30.0;
+    let hot_c = 119.8;
+    let mut offline = rotor.clone();
+    let why_offline = offline
+        .heat_films(Some(hot_c + ZERO_CELSIUS_K), w, 1.0)
+        .expect_err("the reference balance fails at 119.8 °C");
+    println!("reference at {hot_c} °C: {why_offline}");
+    assert!(why_offline.contains("beyond the viscosity law's range"));
+    let settings = DriverSettings::new(ModelKind::Nonlinear, FilmEvaluation::Direct, w);
+    let mut d = Driver::new(rotor, settings);
+    let mut emit = |_: rotor_twin::session::Outgoing| {};
+    let (t0, ms) = (1_767_225_600_000_000_000_i64, 1_000_000);
+    assert!(matches!(
+        d.feed(t0, speed_rpm(9000.0), &mut emit),
+        Fed::Started { .. }
+    ));
+    let value = |d: &Driver, key: &str| {
+        let diag = d.oil_diagnostics();
+        (diag.values.iter())
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.clone())
+    };
+    assert_eq!(d.heat_balances(), (1, None));
+    assert_eq!(d.oil_diagnostics().warning, None);
+    assert_eq!(value(&d, "heat_balance_failures").as_deref(), Some("0"));
+    let scales = |d: &Driver| -> Vec<f64> {
+        let twin = d.session().unwrap().twin();
+        (0..d.film_oil().len())
+            .map(|i| twin.film_viscosity_scale(i).unwrap())
+            .collect()
+    };
+    let good = scales(&d);
+    let good_oil = d.film_oil();
+    // the law takes 119.8 °C; the balance fails
+    assert_eq!(d.feed(t0 + ms, supply(hot_c), &mut emit), Fed::Taken);
+    let (balances, why) = d.heat_balances();
+    println!("driver at {hot_c} °C: {balances} balances, {why:?}");
+    assert_eq!(balances, 2);
+    assert!(why.unwrap().contains("beyond the viscosity law's range"));
+    assert_eq!(d.heat_balance_failures(), 1);
+    for (now, before) in scales(&d).iter().zip(&good) {
+        assert!((now / before - 1.0).abs() < 1e-12, "{now} vs {before}");
+    }
+    for (now, before) in d.film_oil().iter().zip(&good_oil) {
+        assert!((now.viscosity_scale / before.viscosity_scale - 1.0).abs() < 1e-12);
+    }
+    let diag = d.oil_diagnostics();
+    println!("diagnostics: {diag:?}");
+    assert!(diag.warning.unwrap().contains("heat balance failed"));
+    assert_eq!(value(&d, "heat_balance_failures").as_deref(), Some("1"));
+    assert!(value(&d, "heat_balance_error").is_some_and(|v| v.contains("law's range")));
+    // the twin steps on
+    d.advance_to(t0 + 20 * ms, usize::MAX, &mut emit);
+    let e = d.session().unwrap().twin().output().bearings[0].eccentricity_ratio;
+    assert!(e.is_finite() && e < 1.0, "ε {e}");
+    // back to 40 °C: a good balance, no warning, the count kept
+    assert_eq!(d.feed(t0 + 21 * ms, supply(40.0), &mut emit), Fed::Taken);
+    assert_eq!(d.heat_balances(), (3, None));
+    assert_eq!(d.oil_diagnostics().warning, None);
+    assert!(value(&d, "heat_balance_error").is_none());
+    let report = d.heat_balance_report().unwrap();
+    assert_eq!((report.balances, report.failures), (3, 1));
+    assert!(report.last_failure.unwrap().contains("law's range"));
+}

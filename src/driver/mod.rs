@@ -20,7 +20,10 @@ pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,
 };
-pub use oil::{FilmOil, HEAT_BALANCE_SPEED_STEP, HEAT_BALANCE_TEMPERATURE_STEP_K};
+pub use oil::{
+    FilmOil, HeatBalanceReport, OilDiagnostics, HEAT_BALANCE_SPEED_STEP,
+    HEAT_BALANCE_TEMPERATURE_STEP_K,
+};
 pub use one_x::{OneXBlock, OneXBlocks};
 pub use plant_signals::{SignalState, StationSource, PAIR_TOLERANCE_REVS};
 pub use settings::{film_name, parse_film, DriverSettings, ModelKind};

@@ -37,6 +37,9 @@ pub(super) struct OilState {
     heating_error: Option<String>,
     /// heat balances done
     balances: u64,
+    /// heat balances that failed (or whose scales the film refused), and the last one's reason
+    failures: u64,
+    last_failure: Option<String>,
     /// whether any film bearing models its own heating
     heating: bool,
 }
@@ -56,6 +59,16 @@ impl OilState {
     }
 }
 
+impl OilState {
+    /// A heat balance failed for `why`: counted, kept as the last failure and as the reason
+    /// in force until a balance succeeds.
+    fn failed(&mut self, why: String) {
+        self.failures += 1;
+        self.last_failure = Some(why.clone());
+        self.heating_error = Some(why);
+    }
+}
+
 /// One film bearing's oil as the driver holds it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FilmOil {
@@ -65,6 +78,27 @@ pub struct FilmOil {
     pub viscosity_scale: f64,
     /// Its effective temperature at the last heat balance (K), where it is heated.
     pub effective_temperature_k: Option<f64>,
+}
+
+/// The bearings' heat balances over a run (issue 12): each failure left the last good
+/// viscosity in force.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct HeatBalanceReport {
+    /// Heat balances done.
+    pub balances: u64,
+    /// Those that failed.
+    pub failures: u64,
+    /// Why the last failure failed (None without one).
+    pub last_failure: Option<String>,
+}
+
+/// The oil's diagnostic values ([`Driver::oil_diagnostics`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct OilDiagnostics {
+    /// (key, value) pairs, in order.
+    pub values: Vec<(String, String)>,
+    /// Why the model status warns, while the last heat balance has failed.
+    pub warning: Option<String>,
 }
 
 impl Driver {
@@ -103,7 +137,7 @@ impl Driver {
     pub(super) fn follow_speed_heating(&mut self) {
         if self.oil.heating && self.heat_if_due() {
             if let Err(why) = self.push_oil_scales() {
-                self.oil.heating_error = Some(why);
+                self.oil.failed(why);
             }
         }
     }
@@ -146,7 +180,10 @@ impl Driver {
                 }
                 self.oil.heating_error = None;
             }
-            Err(e) => self.oil.heating_error = Some(e),
+            Err(e) => {
+                // the scales of the last good balance stay in force (`push_oil_scales`)
+                self.oil.failed(e);
+            }
         }
         true
     }
@@ -205,5 +242,61 @@ impl Driver {
     /// Heat balances done, and why the last one failed if it did.
     pub fn heat_balances(&self) -> (u64, Option<&str>) {
         (self.oil.balances, self.oil.heating_error.as_deref())
+    }
+
+    /// Heat balances that failed since the start (no convergence, an effective temperature
+    /// beyond the viscosity law's range, a scale the film refuses): each leaves the last good
+    /// viscosity in force (the law's at the supply temperature before any good balance).
+    pub fn heat_balance_failures(&self) -> u64 {
+        self.oil.failures
+    }
+
+    /// The heat balances as a replay reports them: None when no film bearing is heated.
+    pub fn heat_balance_report(&self) -> Option<HeatBalanceReport> {
+        self.oil.heating.then(|| HeatBalanceReport {
+            balances: self.oil.balances,
+            failures: self.oil.failures,
+            last_failure: self.oil.last_failure.clone(),
+        })
+    }
+
+    /// The oil in force as the node's model status carries it (issue 12): the supply
+    /// temperature once one is received, each film bearing's viscosity scale and, with
+    /// `oil_heating`, its effective temperature, the heat balances done and failed and why the
+    /// last one failed; `warning` while the last heat balance has failed (the last good viscosity
+    /// in force). Keys and values as diagnostic_msgs/KeyValue holds them.
+    pub fn oil_diagnostics(&self) -> OilDiagnostics {
+        let c = |k: f64| k - crate::film::ZERO_CELSIUS_K;
+        let mut values = Vec::new();
+        if let Some(t) = self.oil_temperature_k {
+            values.push(("oil_supply_temperature_c".into(), format!("{:.2}", c(t))));
+        }
+        for f in self.film_oil() {
+            let name = &f.name;
+            let scale = format!("{:.5}", f.viscosity_scale);
+            values.push((format!("viscosity_scale {name}"), scale));
+            if let Some(t) = f.effective_temperature_k {
+                values.push((
+                    format!("effective_temperature_c {name}"),
+                    format!("{:.3}", c(t)),
+                ));
+            }
+        }
+        let mut warning = None;
+        if self.oil.heating {
+            values.push(("heat_balances".into(), self.oil.balances.to_string()));
+            values.push((
+                "heat_balance_failures".into(),
+                self.oil.failures.to_string(),
+            ));
+            if let Some(why) = &self.oil.heating_error {
+                values.push(("heat_balance_error".into(), why.clone()));
+                warning = Some(format!(
+                    "heat balance failed ({} so far): {why}; the last good viscosity stays in force",
+                    self.oil.failures
+                ));
+            }
+        }
+        OilDiagnostics { values, warning }
     }
 }

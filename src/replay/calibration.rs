@@ -12,8 +12,8 @@
 
 use crate::bag::Bag;
 use crate::calibrate::{
-    estimate_unbalance, estimate_viscosity, AngleSample, CalibrationError, UnbalanceEstimate,
-    ViscosityEstimate, WindowFits, DEFAULT_CORRECTION_RADIUS_M,
+    estimate_viscosity_and_unbalance, AngleSample, CalibrationError, MeanPosition, OneXVector,
+    UnbalanceEstimate, ViscosityEstimate, WindowFits, DEFAULT_CORRECTION_RADIUS_M,
 };
 use crate::driver::PAIR_TOLERANCE_REVS;
 use crate::messages::{self, from_cdr, RosMessage};
@@ -249,15 +249,16 @@ fn is_keyphasor_type(type_name: &str) -> bool {
     type_name == messages::Keyphasor::TYPE_NAME || type_name == messages::Header::TYPE_NAME
 }
 
-/// Fits the viscosity, then the unbalance at that viscosity, to the bag's samples in
-/// `window_s`; returns the estimates and the calibrated machine.
-pub fn calibrate_bag(
+/// The measurements `--calibrate` fits, from the bag's samples in `window_s`: the mean
+/// positions (DC-coupled stations), the keyphasor-referenced 1X vectors, and the windows left
+/// out (never completed, or non-synchronous motion).
+pub fn bag_measurements(
     bag: &Bag,
     rotor: &Rotor,
     remaps: &[(String, String)],
     probe_signals: &[(String, String)],
     window_s: [f64; 2],
-) -> Result<(BagCalibration, Rotor), CalibrationError> {
+) -> (Vec<MeanPosition>, Vec<OneXVector>, usize) {
     // the windows are fitted as the samples arrive: memory is bounded by one window a station
     // (issue 15), not by the length of `window_s`
     let mut fits = vec![WindowFits::new(CALIBRATION_WINDOW_REVS); rotor.probes.len()];
@@ -286,12 +287,30 @@ pub fn calibrate_bag(
             vectors.extend(w.one_x(station));
         }
     }
-    let viscosity = estimate_viscosity(rotor, &means)?;
+    (means, vectors, skipped)
+}
+
+/// Fits the viscosity, then the unbalance at that viscosity, to the bag's samples in
+/// `window_s` ([`bag_measurements`]) as the live calibration does (the viscosity refitted to the
+/// mean positions under the journal orbits of the unbalance:
+/// [`estimate_viscosity_and_unbalance`]); returns the estimates and the calibrated machine.
+pub fn calibrate_bag(
+    bag: &Bag,
+    rotor: &Rotor,
+    remaps: &[(String, String)],
+    probe_signals: &[(String, String)],
+    window_s: [f64; 2],
+) -> Result<(BagCalibration, Rotor), CalibrationError> {
+    let (means, vectors, skipped) = bag_measurements(bag, rotor, remaps, probe_signals, window_s);
+    // the live calibration's fit: the viscosity under the journal orbits of the unbalance
+    // fitted at the static fit's viscosity (`estimate_viscosity_and_unbalance`)
+    let (viscosity, unbalance) =
+        estimate_viscosity_and_unbalance(rotor, &means, &vectors, DEFAULT_CORRECTION_RADIUS_M);
+    let (viscosity, unbalance) = (viscosity?, unbalance?);
     let mut calibrated = rotor.clone();
     calibrated
         .set_viscosity_scale(viscosity.scale)
         .map_err(|e| CalibrationError::Model(e.to_string()))?;
-    let unbalance = estimate_unbalance(&calibrated, &vectors, DEFAULT_CORRECTION_RADIUS_M)?;
     for (u, p) in calibrated.unbalance.iter_mut().zip(&unbalance.planes) {
         u.magnitude_kg_m = (p.magnitude_g_mm * 1e-6).min(crate::driver::inputs::MAX_UNBALANCE_KG_M);
         u.phase_rad = p.phase_deg.to_radians();

@@ -338,6 +338,7 @@ impl Replaying {
             c.finish(Some(driver.keyphasor_events()));
         }
         report.finish(&comparisons, wall.elapsed().as_secs_f64());
+        report.heat_balance = driver.heat_balance_report();
         report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
         if let Some(out) = out {
             report.messages_out = out.finish()?;

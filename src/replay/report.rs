@@ -179,6 +179,10 @@ pub struct ReplayReport {
     /// The forecast's score (`--forecast`; absent without).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub forecast: Option<crate::forecast::score::ForecastScore>,
+    /// The bearings' heat balances (issue 12; absent without `oil_heating`): a failure left the
+    /// last good viscosity in force.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heat_balance: Option<crate::driver::HeatBalanceReport>,
 }
 
 impl ReplayReport {
@@ -197,6 +201,7 @@ impl ReplayReport {
             onset: OnsetReport::default(),
             states: Vec::new(),
             forecast: None,
+            heat_balance: None,
         }
     }
 
@@ -309,6 +314,14 @@ impl ReplayReport {
             s += &format!(
                 "rejected {} input(s) on {}; last: {}\n",
                 r.count, r.topic, r.last_reason
+            );
+        }
+        if let Some(h) = self.heat_balance.as_ref().filter(|h| h.failures > 0) {
+            s += &format!(
+                "WARNING: {} of {} heat balance(s) failed, the last good viscosity kept; last: {}\n",
+                h.failures,
+                h.balances,
+                h.last_failure.as_deref().unwrap_or("")
             );
         }
         for st in &self.stations {

@@ -762,7 +762,8 @@ impl ModelLoop {
                     .to_string(),
             ),
         ];
-        values.extend(self.oil_values());
+        let oil = self.driver.oil_diagnostics();
+        values.extend(oil.values.iter().map(|(k, v)| kv(k, v.clone())));
         let (level, message) = if self.counters.recording_failed.load(Ordering::Relaxed) {
             (
                 DiagnosticStatus::ERROR,
@@ -778,6 +779,8 @@ impl ModelLoop {
                 DiagnosticStatus::WARN,
                 format!("{:.3} s behind real time", t.lag_s),
             )
+        } else if let Some(why) = oil.warning {
+            (DiagnosticStatus::WARN, why)
         } else if self.driver.session().is_none() {
             (
                 DiagnosticStatus::OK,
@@ -787,30 +790,6 @@ impl ModelLoop {
             (DiagnosticStatus::OK, "keeping up".into())
         };
         self.status("model", level, message, values)
-    }
-
-    /// The oil in force (issue 12): the supply temperature once one is received, each film
-    /// bearing's viscosity scale and, with `oil_heating`, its effective temperature.
-    fn oil_values(&self) -> Vec<KeyValue> {
-        let c = |k: f64| k - crate::film::ZERO_CELSIUS_K;
-        let mut values = Vec::new();
-        if let Some(t) = self.driver.oil_temperature_k() {
-            values.push(kv("oil_supply_temperature_c", format!("{:.2}", c(t))));
-        }
-        for f in self.driver.film_oil() {
-            let name = &f.name;
-            values.push(kv(
-                &format!("viscosity_scale {name}"),
-                format!("{:.5}", f.viscosity_scale),
-            ));
-            if let Some(t) = f.effective_temperature_k {
-                values.push(kv(
-                    &format!("effective_temperature_c {name}"),
-                    format!("{:.3}", c(t)),
-                ));
-            }
-        }
-        values
     }
 
     /// `<node>: forecast`: the last and longest forecast duration, forecasts done, cycles skipped
