@@ -80,10 +80,11 @@ fn the_twin_form_conserves_the_fluid_each_step() {
     );
     // round-off of a converged solve (band LU on ~600 unknowns)
     assert!(worst_100 < 1e-9 && worst_200 < 1e-9);
-    // first order in Δt: a small share of the fed volume, halved (±30 %) with the step
-    assert!(drift_100 < 0.02, "drift {drift_100}");
+    // first order in Δt: a small share of the fed volume, halved (±15 %) with the step
+    // measured 6.8e-4 and 3.4e-4 of the fed volume
+    assert!(drift_100 < 2e-3, "drift {drift_100}");
     let ratio = drift_100 / drift_200;
-    assert!((1.4..2.6).contains(&ratio), "drift ratio {ratio}");
+    assert!((1.7..2.3).contains(&ratio), "drift ratio {ratio}");
     // the film ruptures and re-forms on this orbit (else φ is not tested)
     assert!(rupture > 0.2, "deepest rupture {rupture}");
 }
@@ -105,8 +106,8 @@ fn seed_twin(rpm: f64, cavitation: Cavitation, per_rev: usize) -> (Twin, StepInp
 
 /// At 8,000 rpm (below the seed case's threshold 8,471 rpm) from the static equilibrium, the
 /// unbalance orbit of the mass-conserving twin (its feed at the widest gap of the equilibrium)
-/// follows the Reynolds twin: journal positions within 2 % of the clearance, p_max within 2 %,
-/// the rupture angle ζ2 within 2 grid cells (12°), over 6 revolutions at 64 steps. The steady
+/// follows the Reynolds twin: journal positions within 1 % of the clearance, p_max within 1.5 %,
+/// the rupture angle ζ2 within one grid cell (6°), over 6 revolutions at 64 steps. The steady
 /// films differ by 0.54 % in load and 0.03° in ζ2 (`film_mass_conserving.rs`), the orbit is a
 /// few µm about ε ≈ 0.5, so the ruptured zone's fluid re-forms at the feed and the films stay
 /// alike.
@@ -127,7 +128,9 @@ fn a_stable_8000_rpm_orbit_agrees_with_the_reynolds_twin() {
             let d = (x.position_m[0] - y.position_m[0]).hypot(x.position_m[1] - y.position_m[1]);
             dx = dx.max(d / c[k]);
             dp = dp.max((y.max_pressure_pa / x.max_pressure_pa - 1.0).abs());
-            let z = (y.film_end_rad - x.film_end_rad).to_degrees().rem_euclid(360.0);
+            let z = (y.film_end_rad - x.film_end_rad)
+                .to_degrees()
+                .rem_euclid(360.0);
             dz = dz.max(z.min(360.0 - z));
             amplitude = amplitude.max(x.eccentricity_ratio);
             mc.midplane_fluid_fraction(k, &mut phi);
@@ -139,9 +142,10 @@ fn a_stable_8000_rpm_orbit_agrees_with_the_reynolds_twin() {
          {dz:.2}°; ε up to {amplitude:.3}; JFO deepest rupture 1 − φ {ruptured:.3}",
         100.0 * dp
     );
-    assert!(dx < 0.02, "position gap {dx} c");
-    assert!(dp < 0.02, "p_max gap {dp}");
-    assert!(dz < 12.0, "ζ2 gap {dz}°");
+    // measured 0.0056 c, 0.69 %, 3.01° (64 steps, 6 rev)
+    assert!(dx < 0.01, "position gap {dx} c");
+    assert!(dp < 0.015, "p_max gap {dp}");
+    assert!(dz < 6.0, "ζ2 gap {dz}°");
     // the JFO film does rupture (else nothing of φ was in the run)
     assert!(ruptured > 0.3, "deepest rupture {ruptured}");
 }
@@ -175,7 +179,10 @@ fn a_fluid_fraction_disturbance_drifts_out_at_half_the_shaft_speed() {
     }
     let first = missing[0];
     let revs_to = |share: f64| {
-        let n = missing.iter().position(|&m| m < share * first).unwrap_or(missing.len());
+        let n = missing
+            .iter()
+            .position(|&m| m < share * first)
+            .unwrap_or(missing.len());
         (n + 1) as f64 / per_rev as f64
     };
     let (half, tenth, hundredth) = (revs_to(0.5), revs_to(0.1), revs_to(0.01));
@@ -193,6 +200,56 @@ fn a_fluid_fraction_disturbance_drifts_out_at_half_the_shaft_speed() {
     );
     // and the film forgets: 99 % of the disturbance gone within two revolutions
     assert!(hundredth < 2.0, "99 % gone after {hundredth} rev");
+}
+
+/// `simulate` and `sweep` run the mass-conserving film (the JSON says so) and refuse it with the
+/// film table, naming the reason.
+#[test]
+fn the_cli_runs_the_mass_conserving_film_and_refuses_the_table() {
+    let (ok, out, err) = run_cli(&[
+        "simulate",
+        "--speed-rpm",
+        "8000",
+        "--revs",
+        "2",
+        "--steps-per-rev",
+        "32",
+        "--cavitation",
+        "mass-conserving",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["cavitation"], "mass-conserving", "{out}");
+    // the 8,000 rpm static film: p_max ≈ 0.37–0.46 MPa over the unbalance orbit (README)
+    let p = v["bearings"][0]["max_pressure_pa"].as_f64().unwrap();
+    assert!((0.3e6..0.6e6).contains(&p), "p_max {p}");
+    for cmd in ["simulate", "sweep"] {
+        let mut args = vec![
+            cmd,
+            "--revs",
+            "2",
+            "--cavitation",
+            "mass-conserving",
+            "--film",
+            "table",
+        ];
+        if cmd == "simulate" {
+            args.extend(["--speed-rpm", "8000"]);
+        } else {
+            args.extend([
+                "--from-rpm",
+                "8000",
+                "--to-rpm",
+                "8000",
+                "--step-rpm",
+                "100",
+            ]);
+        }
+        let (ok, _, err) = run_cli(&args);
+        assert!(!ok, "{cmd} ran the table with mass conservation");
+        assert!(err.contains("needs --film direct"), "{cmd}: {err}");
+    }
 }
 
 /// The seed case with both cavitation models (ignored: minutes; `MCAV_REVS` revolutions,
@@ -220,13 +277,20 @@ fn seed_case_comparison() {
             let h = twin.config().time_step_s;
             let mut monitor = Monitor::new(&twin, per_rev + 2, ClassifierSettings::default());
             let n = twin.bearing_clearances_m().len();
-            let (mut maps, mut zeta) = (vec![Vec::new(); n], vec![[f64::MAX, f64::MIN, f64::MAX, f64::MIN]; n]);
+            let (mut maps, mut zeta) = (
+                vec![Vec::new(); n],
+                vec![[f64::MAX, f64::MIN, f64::MAX, f64::MIN]; n],
+            );
             let (mut pmax, mut phimin) = (vec![0.0_f64; n], vec![1.0_f64; n]);
             let start = std::time::Instant::now();
             let total = revs * per_rev;
             for step in 0..total {
                 let t = twin.time_s();
-                let kick = if t <= 0.05 && 0.05 < t + h { 2.0 / h } else { 0.0 };
+                let kick = if t <= 0.05 && 0.05 < t + h {
+                    2.0 / h
+                } else {
+                    0.0
+                };
                 twin.set_external_force(15, [kick, 0.0]).unwrap();
                 let out = twin.step(&input).unwrap().clone();
                 monitor.record(&twin);
@@ -237,7 +301,16 @@ fn seed_case_comparison() {
                         phimin[b] = phimin[b].min(phi.iter().copied().fold(1.0, f64::min));
                         maps[b].push(phi);
                         pmax[b] = pmax[b].max(s.max_pressure_pa);
-                        let rel = |a: f64| (a - s.attitude_rad).to_degrees().rem_euclid(360.0);
+                        // from the journal's line of centres (the thinnest film), in (−270°, 90°]: ζ1
+                        // before it, ζ2 after
+                        let rel = |a: f64| {
+                            let d = (a - s.attitude_rad).to_degrees().rem_euclid(360.0);
+                            if d > 90.0 {
+                                d - 360.0
+                            } else {
+                                d
+                            }
+                        };
                         let (z1, z2) = (rel(s.film_start_rad), rel(s.film_end_rad));
                         let z = &mut zeta[b];
                         *z = [z[0].min(z1), z[1].max(z1), z[2].min(z2), z[3].max(z2)];
@@ -264,10 +337,21 @@ fn seed_case_comparison() {
                     phimin[b],
                 );
                 if cav == Cavitation::MassConserving {
+                    let csv: String = maps[b]
+                        .iter()
+                        .map(|row| {
+                            let cells: Vec<String> =
+                                row.iter().map(|v| format!("{v:.4}")).collect();
+                            cells.join(",") + "\n"
+                        })
+                        .collect();
+                    std::fs::write(dir.join(format!("phi_{rpm:.0}_b{b}.csv")), csv).unwrap();
                     let path = dir.join(format!("phi_{rpm:.0}_b{b}.svg"));
                     fluid_fraction_map_svg(
                         &path,
-                        &format!("fluid fraction, mid-plane, bearing {b}, {rpm:.0} rpm, last 2 rev"),
+                        &format!(
+                            "fluid fraction, mid-plane, bearing {b}, {rpm:.0} rpm, last 2 rev"
+                        ),
                         &maps[b],
                         720.0,
                     )

@@ -220,9 +220,10 @@ impl Rotor {
         &mut self,
         cavitation: crate::film::Cavitation,
     ) -> Result<(), crate::film::FilmError> {
-        let short = self.bearings.iter().any(|b| {
-            matches!(&b.model, BearingModel::Film(f) if f.short)
-        });
+        let short = self
+            .bearings
+            .iter()
+            .any(|b| matches!(&b.model, BearingModel::Film(f) if f.short));
         if short && cavitation != crate::film::Cavitation::Reynolds {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "cavitation (short-bearing film)",

@@ -92,6 +92,19 @@ struct MixedRow {
 /// Most set-update passes allowed for one mass-conserving solve.
 const MAX_PASSES: usize = 200;
 
+/// The complementarity tolerance of pass `pass`: 1e-12 (round-off) for the first 40 passes,
+/// then 1e-8, 1e-6 and from pass 120 on 1e-4 — a set iteration that cycles between nodes whose
+/// violations are that small (seen in the whip at ε 0.94–0.97, 8,500 and 9,000 rpm) stops with
+/// Π ≥ −1e-4·max Π and φ ≤ 1.0001.
+fn set_tolerance(pass: usize) -> f64 {
+    match pass {
+        0..=40 => 1e-12,
+        41..=80 => 1e-8,
+        81..=120 => 1e-6,
+        _ => 1e-4,
+    }
+}
+
 impl FiniteFilm {
     /// This solver with the cavitation model `cavitation` (Reynolds by default).
     pub fn with_cavitation(mut self, cavitation: Cavitation) -> Self {
@@ -155,8 +168,7 @@ impl FiniteFilm {
     /// (steady) solve as the film's starting state and fixes a plain bearing's feed where it is.
     /// Without mass conservation, or with a step that is not positive and finite, nothing.
     pub(super) fn twin_begin_step(&mut self, step_s: f64) {
-        if self.cavitation != Cavitation::MassConserving || !(step_s.is_finite() && step_s > 0.0)
-        {
+        if self.cavitation != Cavitation::MassConserving || !(step_s.is_finite() && step_s > 0.0) {
             return;
         }
         let first = !self.twin_form || self.inverse_step == 0.0;
@@ -214,8 +226,15 @@ impl FiniteFilm {
         // was at the start of a transient (a fixed feed hole)
         let steady = self.inverse_step == 0.0;
         if self.geometry.grooves.is_empty() && (steady || self.feed_column.is_none()) {
-            self.feed_column =
-                (0..self.grid.n_theta).max_by(|&a, &b| self.h_node[a].total_cmp(&self.h_node[b]));
+            let nt = self.grid.n_theta;
+            let widest = (0..nt).max_by(|&a, &b| self.h_node[a].total_cmp(&self.h_node[b]));
+            // hysteresis: the feed stays while it is next to the widest column, so the force is
+            // continuous along a Newton path (else an equilibrium whose widest gap lies at a
+            // column boundary has no root: `sweep` at 8,100 rpm, residual 0.3 N)
+            self.feed_column = match (self.feed_column, widest) {
+                (Some(f), Some(w)) if (f + nt - w) % nt <= 1 || (w + nt - f) % nt <= 1 => Some(f),
+                _ => widest,
+            };
         }
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         for i in 0..nt {
@@ -231,7 +250,7 @@ impl FiniteFilm {
         }
         for pass in 1..=MAX_PASSES {
             self.solve_mixed_system()?;
-            if !self.update_mixed_sets() {
+            if !self.update_mixed_sets(set_tolerance(pass)) {
                 self.last_passes = pass;
                 self.warm = true;
                 return Ok(self.outputs(kin.speed_rad_s));
@@ -362,18 +381,19 @@ impl FiniteFilm {
         Ok(())
     }
 
-    /// One update of the full / ruptured sets by (M2); true if anything changed.
-    fn update_mixed_sets(&mut self) -> bool {
+    /// One update of the full / ruptured sets by (M2), violations below `tol` (of the largest
+    /// |Π|, or of φ = 1) let pass; true if anything changed.
+    fn update_mixed_sets(&mut self, tol: f64) -> bool {
         let scale = self.pi.iter().fold(0.0_f64, |m, p| m.max(p.abs()));
         let mut changed = false;
         for k in 0..self.pi.len() {
             if self.slot[k] == NOT_FREE {
                 continue;
             }
-            if self.free[k] && self.pi[k] < -1e-12 * scale {
+            if self.free[k] && self.pi[k] < -tol * scale {
                 self.free[k] = false;
                 changed = true;
-            } else if !self.free[k] && self.phi[k] > 1.0 + 1e-12 {
+            } else if !self.free[k] && self.phi[k] > 1.0 + tol {
                 self.free[k] = true;
                 changed = true;
             }
