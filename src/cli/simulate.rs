@@ -1,6 +1,7 @@
 //! `rotor-twin simulate` and `rotor-twin sweep`: nonlinear transients at constant speed or along
 //! a speed history, with kicks.
 
+use crate::cli::bearing::CavitationKind;
 use crate::dynamics::Coupling;
 use crate::film::FilmGrid;
 use crate::monitor::RotorState;
@@ -57,6 +58,10 @@ pub(crate) struct RunOptions {
     /// (the same solutions tabulated once and interpolated; plain bearings).
     #[arg(long, value_enum, default_value_t = FilmArg::Direct)]
     film: FilmArg,
+    /// Cavitation of every finite film: reynolds, or mass-conserving (JFO, the fluid fraction
+    /// carried from step to step; direct film only; issue 18).
+    #[arg(long, value_enum, default_value_t = CavitationKind::Reynolds)]
+    cavitation: CavitationKind,
 }
 
 /// `--film`.
@@ -101,6 +106,15 @@ impl RunOptions {
         }
         if self.fluid_inertia_full {
             rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
+        }
+        if self.cavitation != CavitationKind::Reynolds {
+            anyhow::ensure!(
+                self.film == FilmArg::Direct,
+                "--cavitation mass-conserving needs --film direct: the film table holds \
+                 Reynolds-condition films, and a mass-conserving film carries its fluid fraction \
+                 from step to step, which a table over (ε, ψ) cannot"
+            );
+            rotor.set_cavitation(self.cavitation.into())?;
         }
         Ok((desc, rotor))
     }
@@ -350,6 +364,8 @@ struct SimulateReport {
     machine: String,
     speed_rpm: f64,
     model: ModelArg,
+    /// Cavitation of the finite films.
+    cavitation: CavitationKind,
     delta: Option<f64>,
     revs: usize,
     steps_per_rev: usize,
@@ -459,6 +475,7 @@ fn summarise(
             .flat_map(|rev| rev.bearings.iter().map(|b| b.max_rub_power_w))
             .fold(0.0, f64::max),
         model: args.options.model,
+        cavitation: args.options.cavitation,
         delta: (args.options.model == ModelArg::Prehistory).then_some(args.options.delta),
         revs: args.options.revs,
         steps_per_rev: args.options.steps_per_rev,
@@ -534,13 +551,14 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         println!(
-            "rotor-twin simulate: {} at {:.0} rpm, {:?} coupling{}, {} revolutions × {} steps",
+            "rotor-twin simulate: {} at {:.0} rpm, {:?} coupling{}, {:?} cavitation, {} revolutions × {} steps",
             report.machine,
             report.speed_rpm,
             report.model,
             report
                 .delta
                 .map_or(String::new(), |d| format!(" (δ = {d})")),
+            report.cavitation,
             report.revs,
             report.steps_per_rev
         );
@@ -677,6 +695,8 @@ pub struct SweepArgs {
 struct SweepReport {
     machine: String,
     model: ModelArg,
+    /// Cavitation of the finite films.
+    cavitation: CavitationKind,
     onset_speed_rpm: Option<f64>,
     points: Vec<crate::sweep::SweepPoint>,
     csv: String,
@@ -764,6 +784,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let report = SweepReport {
         machine: desc.name,
         model: args.options.model,
+        cavitation: args.options.cavitation,
         onset_speed_rpm: sweep.onset_speed_rpm(),
         points: sweep.points,
         csv: csv_path.display().to_string(),
@@ -779,8 +800,8 @@ fn print_sweep(report: &SweepReport, json: bool) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "rotor-twin sweep: {} ({:?} coupling)",
-        report.machine, report.model
+        "rotor-twin sweep: {} ({:?} coupling, {:?} cavitation)",
+        report.machine, report.model, report.cavitation
     );
     for p in &report.points {
         println!(

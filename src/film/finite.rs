@@ -129,8 +129,13 @@ pub struct FiniteFilm {
     cavitation: Cavitation,
     /// Per node: fluid fraction φ of the last solve (1 with the Reynolds condition).
     phi: Vec<f64>,
-    /// Per node: φ⁰H⁰ of the last committed step (mass-conserving transient).
+    /// Per node: φ⁰H⁰ of the last committed step (mass-conserving transient), φ⁰ in the
+    /// twin's form.
     content_old: Vec<f64>,
+    /// `content_old` saved before a twin step that may be retried.
+    content_saved: Vec<f64>,
+    /// The twin's transient form of (M3): φḢ + H(φ − φ⁰)/Δt.
+    twin_form: bool,
     /// 1/Δt of the mass-conserving transient (1/s), 0 when steady.
     inverse_step: f64,
     /// The mass-conserving film's mixed system (empty with the Reynolds condition).
@@ -204,6 +209,8 @@ impl FiniteFilm {
             cavitation: Cavitation::Reynolds,
             phi: vec![1.0; nodes],
             content_old: vec![0.0; nodes],
+            content_saved: Vec::new(),
+            twin_form: false,
             inverse_step: 0.0,
             lu: PivotedBandLu::with_capacity(0, 0),
             feed_column: None,
@@ -752,6 +759,32 @@ impl FilmModel for FiniteFilm {
             // nearest grid column
             let i = (k * nt + len / 2) / len % nt;
             *p = self.pressure_scale * self.pi[i * nz];
+        }
+    }
+
+    fn midplane_fluid_fraction(&self, out: &mut [f64]) {
+        self.midplane_phi(out);
+    }
+
+    fn begin_step(&mut self, step_s: f64) {
+        self.twin_begin_step(step_s);
+    }
+
+    fn commit_step(&mut self) {
+        if self.twin_form {
+            FiniteFilm::commit_step(self);
+        }
+    }
+
+    fn save_memory(&mut self) {
+        if self.twin_form {
+            self.content_saved.copy_from_slice(&self.content_old);
+        }
+    }
+
+    fn restore_memory(&mut self) {
+        if self.twin_form {
+            self.content_old.copy_from_slice(&self.content_saved);
         }
     }
 }

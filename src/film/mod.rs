@@ -168,6 +168,25 @@ pub trait FilmModel {
     /// The mid-plane pressure of the last solve at `out.len()` equally spaced angles
     /// θ_k = 2πk/len from `+x` (Pa). Allocates nothing.
     fn midplane_pressure(&self, out: &mut [f64]);
+
+    /// The mid-plane fluid fraction φ of the last solve at `out.len()` equally spaced angles
+    /// from `+x` (1 where the film is whole; 1 everywhere for a film without memory).
+    fn midplane_fluid_fraction(&self, out: &mut [f64]) {
+        out.fill(1.0);
+    }
+
+    /// A film with memory (mass-conserving cavitation, issue 18): the next solves belong to a
+    /// time step of `step_s` (s) that starts from the last committed state. No-op otherwise.
+    fn begin_step(&mut self, _step_s: f64) {}
+
+    /// Accepts the last solve as the state the next time step starts from. No-op without memory.
+    fn commit_step(&mut self) {}
+
+    /// Saves the committed state (before a step that may be retried). No-op without memory.
+    fn save_memory(&mut self) {}
+
+    /// Returns to the state of the last [`FilmModel::save_memory`]. No-op without memory.
+    fn restore_memory(&mut self) {}
 }
 
 /// Wraps an angle (rad) to [0, 2π).

@@ -425,6 +425,25 @@ impl FilmModel for ViscosityScaledFilm {
             *p *= self.scale;
         }
     }
+    fn midplane_fluid_fraction(&self, out: &mut [f64]) {
+        self.inner.midplane_fluid_fraction(out);
+    }
+
+    fn begin_step(&mut self, step_s: f64) {
+        self.inner.begin_step(step_s);
+    }
+
+    fn commit_step(&mut self) {
+        self.inner.commit_step();
+    }
+
+    fn save_memory(&mut self) {
+        self.inner.save_memory();
+    }
+
+    fn restore_memory(&mut self) {
+        self.inner.restore_memory();
+    }
 }
 
 #[cfg(test)]

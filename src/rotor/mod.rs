@@ -88,6 +88,8 @@ pub struct FilmBearing {
     pub inertia: Option<crate::film::FilmInertia>,
     /// Laminar, turbulent or auto (finite model; `src/film/turbulence.rs`).
     pub flow: crate::film::FlowRegime,
+    /// Reynolds or mass-conserving cavitation (finite model, direct film; issue 18).
+    pub cavitation: crate::film::Cavitation,
 }
 
 // --- oil supply temperature (issue 12) ---
@@ -212,6 +214,31 @@ impl Rotor {
         }
     }
 
+    /// Sets the cavitation model of every film bearing (issue 18): mass conservation needs the
+    /// finite model and the direct film (`reference_solver`); refused with a short-bearing film.
+    pub fn set_cavitation(
+        &mut self,
+        cavitation: crate::film::Cavitation,
+    ) -> Result<(), crate::film::FilmError> {
+        let short = self
+            .bearings
+            .iter()
+            .any(|b| matches!(&b.model, BearingModel::Film(f) if f.short));
+        if short && cavitation != crate::film::Cavitation::Reynolds {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "cavitation (short-bearing film)",
+                value: 0.0,
+                rule: "mass-conserving cavitation is built in the finite model only",
+            });
+        }
+        for b in &mut self.bearings {
+            if let BearingModel::Film(f) = &mut b.model {
+                f.cavitation = cavitation;
+            }
+        }
+        Ok(())
+    }
+
     /// The viscosity scale of the first film bearing (1 without one).
     pub fn viscosity_scale(&self) -> f64 {
         self.bearings
@@ -232,7 +259,8 @@ impl FilmBearing {
             return Box::new(
                 FiniteFilm::new(self.geometry.clone(), self.lubricant, self.grid)
                     .expect("geometry checked when the machine was read")
-                    .with_flow(self.flow),
+                    .with_flow(self.flow)
+                    .with_cavitation(self.cavitation),
             );
         }
         if self.short {
@@ -260,6 +288,15 @@ impl FilmBearing {
     pub fn reference_tabulated_solver(
         &self,
     ) -> Result<Box<dyn FilmModel + Send>, crate::film::FilmError> {
+        if self.cavitation != crate::film::Cavitation::Reynolds {
+            return Err(crate::film::FilmError::InvalidParameter {
+                name: "cavitation (tabulated film)",
+                value: 0.0,
+                rule: "the table holds Reynolds-condition films: a mass-conserving film carries \
+                       its fluid fraction from step to step and cannot be tabulated over (ε, ψ); \
+                       use the direct film (--film direct) with --cavitation mass-conserving",
+            });
+        }
         if self.flow != crate::film::FlowRegime::Laminar {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "flow (tabulated film)",
@@ -558,6 +595,7 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 viscosity_scale: 1.0,
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
                 flow: f.flow,
+                cavitation: crate::film::Cavitation::Reynolds,
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),

@@ -169,6 +169,12 @@ impl Twin {
         self.links[bearing].film.midplane_pressure(out);
     }
 
+    /// Mid-plane fluid fraction φ of bearing `bearing`'s last film solve at `out.len()` equally
+    /// spaced angles from +x (1 everywhere with the Reynolds condition; issue 18).
+    pub fn midplane_fluid_fraction(&self, bearing: usize, out: &mut [f64]) {
+        self.links[bearing].film.midplane_fluid_fraction(out);
+    }
+
     // --- oil supply temperature (issue 12) ---
     /// Sets the viscosity of every film to `scale` × its reference viscosity (the machine
     /// file's): exact for the isoviscous film ([`crate::film::ViscosityScaledFilm`]). Takes effect

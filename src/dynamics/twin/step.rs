@@ -4,7 +4,7 @@ use super::{Twin, HELD};
 use crate::dynamics::bearing_link::LinkEvaluation;
 use crate::dynamics::linear::solve_small;
 use crate::dynamics::{Coupling, StepInput, StepOutput, TwinError};
-use crate::film::FilmCoefficients;
+use crate::film::{FilmCoefficients, FilmModel};
 use crate::rotor::unbalance_force;
 use nalgebra::{Matrix2, Vector2};
 
@@ -33,6 +33,10 @@ impl Twin {
         let start_speed = self.state.speed_rad_s;
         let mut iterations = 0;
         self.fallbacks = 0;
+        // a film with memory (mass-conserving) returns to this state if the step is retried
+        for l in &mut self.links {
+            l.film.save_memory();
+        }
         for level in 0..3 {
             let substeps = 1usize << level;
             // the state to return to if the step must be retried (scratch reused: no
@@ -51,6 +55,7 @@ impl Twin {
                         if level > 0 {
                             self.state.copy_from(&self.saved);
                         }
+                        self.restore_film_memory();
                         return Err(e);
                     }
                     Err(None) => {
@@ -66,11 +71,19 @@ impl Twin {
             if level > 0 {
                 self.state.copy_from(&self.saved);
             }
+            self.restore_film_memory();
         }
         Err(TwinError::NotConverged {
             time_s: self.state.time_s,
             iterations,
         })
+    }
+
+    /// Every film with memory back to its state at the start of the step.
+    fn restore_film_memory(&mut self) {
+        for l in &mut self.links {
+            l.film.restore_memory();
+        }
     }
 
     fn refactor_if_needed(&mut self, speed: f64) {
@@ -125,8 +138,14 @@ impl Twin {
         let angle = self.state.angle_rad + 0.5 * nm.h * (self.state.speed_rad_s + speed);
         let time = self.state.time_s + nm.h;
         self.linear_response(level, nm, angle, speed, accel);
+        for l in &mut self.links {
+            l.film.begin_step(nm.h);
+        }
         let (iterations, fallback) = self.iterate_bearings(level, nm, speed, time)?;
         self.correct(level, nm, time, angle, speed)?;
+        for l in &mut self.links {
+            l.film.commit_step();
+        }
         self.fallbacks += usize::from(fallback);
         if let Coupling::Prehistory { .. } = self.config.coupling {
             for (l, r) in self.links.iter_mut().zip(&self.raw) {
