@@ -127,9 +127,8 @@ impl BandLu {
     }
 
     /// [`solve`](Self::solve) with the half-bandwidth B a constant: the rows whose band is
-    /// whole take fixed-length sums in two interleaved partial sums (vector lanes; the same
-    /// products as [`solve_any`](Self::solve_any) in another order: the same result to
-    /// round-off), the ends the general ones.
+    /// whole take fixed-length sums (the same products summed in the same order as
+    /// [`solve_any`](Self::solve_any): the same result, bit for bit), the ends the general ones.
     fn solve_band<const B: usize>(&self, r: &[f64], x: &mut [f64]) {
         let (n, w) = (self.n, 2 * B + 1);
         if n <= 2 * B {
@@ -140,7 +139,7 @@ impl BandLu {
         }
         for i in B..n {
             let row: &[f64; B] = fixed(&self.data[i * w..]);
-            x[i] = r[i] - dot_pairs(row, fixed::<B>(&x[i - B..]));
+            x[i] = r[i] - dot(row, fixed::<B>(&x[i - B..]));
         }
         for i in (n - B..n).rev() {
             let row = &self.data[i * w + B + 1..i * w + B + (n - i)];
@@ -148,7 +147,7 @@ impl BandLu {
         }
         for i in (0..n - B).rev() {
             let row: &[f64; B] = fixed(&self.data[i * w + B + 1..]);
-            x[i] = (x[i] - dot_pairs_rev(row, fixed::<B>(&x[i + 1..]))) * self.inverse_diagonal[i];
+            x[i] = (x[i] - dot(row, fixed::<B>(&x[i + 1..]))) * self.inverse_diagonal[i];
         }
     }
 }
@@ -157,40 +156,6 @@ impl BandLu {
 #[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(u, v)| u * v).sum()
-}
-
-/// Σ a_k b_k as two partial sums, even and odd k (the pairs are one vector product), the
-/// last term (the forward substitution's newest unknown) added last.
-#[inline(always)]
-fn dot_pairs<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
-    let (mut s0, mut s1) = (0.0, 0.0);
-    let mut k = 0;
-    while k + 1 < N {
-        s0 += a[k] * b[k];
-        s1 += a[k + 1] * b[k + 1];
-        k += 2;
-    }
-    if N % 2 == 1 {
-        s0 += a[N - 1] * b[N - 1];
-    }
-    s0 + s1
-}
-
-/// [`dot_pairs`] from the last term down, the first term (the back substitution's newest
-/// unknown) added last.
-#[inline(always)]
-fn dot_pairs_rev<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
-    let (mut s0, mut s1) = (0.0, 0.0);
-    let mut k = N;
-    while k >= 2 {
-        s0 += a[k - 2] * b[k - 2];
-        s1 += a[k - 1] * b[k - 1];
-        k -= 2;
-    }
-    if N % 2 == 1 {
-        s0 += a[0] * b[0];
-    }
-    s0 + s1
 }
 
 /// The first N entries of `v` as an array (v has at least N: the band's rows do).
@@ -234,11 +199,10 @@ mod tests {
         assert!(worst < 1e-13, "residual {worst}");
     }
 
-    /// The fixed-bandwidth solves against the general one (the same products, summed in
-    /// another order): equal to 1e-13 of the solution's size (a few round-offs of a well
-    /// conditioned system), for every specialised half-bandwidth and sizes around 2b.
+    /// The fixed-bandwidth solves against the general one (the same sums in the same order):
+    /// equal bit for bit, for every specialised half-bandwidth and sizes around 2b.
     #[test]
-    fn fixed_band_solves_agree_with_the_general_solve() {
+    fn fixed_band_solves_equal_the_general_solve_exactly() {
         for b in [3, 5, 6, 7] {
             for n in [2 * b, 2 * b + 1, 4 * b + 3, 124] {
                 let a = Mat::<f64>::from_fn(n, n, |i, j| {
@@ -258,19 +222,8 @@ mod tests {
                 let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
                 lu.solve(&r, &mut x);
                 lu.solve_any(&r, &mut y);
-                let scale = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-                let worst = x
-                    .iter()
-                    .zip(&y)
-                    .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-                assert!(
-                    worst <= 1e-13 * scale,
-                    "b {b}, n {n}: {worst:e} of {scale:e}"
-                );
-                if n <= 2 * b {
-                    // the fixed path falls back to the general one: the same bits
-                    assert_eq!(worst, 0.0, "b {b}, n {n}");
-                }
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&x), bits(&y), "b {b}, n {n}");
             }
         }
     }
