@@ -107,7 +107,7 @@ impl McgBand {
         self.spin = omega_f;
     }
 
-    /// out[lo..hi] += M x_m + (C + Ω_f G) x_c with the fused values (see [`set_spin`]).
+    /// out[lo..hi] += M x_m + (C + Ω_f G) x_c with the fused values (see [`set_spin`](Self::set_spin)).
     fn add_fused_products(&self, x_m: &[f64], x_c: &[f64], out: &mut [f64]) {
         let w = 2 * self.b + 1;
         let blocks = self.fused.chunks_exact(2 * LANES * w);
