@@ -170,7 +170,7 @@ impl Twin {
             self.tmp[i] = nm.a0 * s.q[i] + nm.a1 * s.qd[i] + s.qdd[i];
             self.tmp_c[i] = nm.a2 * s.q[i] + s.qd[i];
         }
-        self.mcg_rows.add_products(
+        self.mcg_rows.add_step_products(
             [&self.tmp, &self.tmp_c, &s.qd],
             factored_speed,
             -(speed - factored_speed),
