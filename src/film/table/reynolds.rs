@@ -19,7 +19,7 @@
 //! Catmull–Rom over four slices (linear extrapolation past the ends), from Re = 0 (laminar) to
 //! the bearing's largest Re for `turbulent`; for `auto`, the laminar table up to Taylor's onset
 //! Re_T (exact: the factors are laminar there) and slices from one below Re_T (laminar) to the
-//! largest Re. Spacing: [`ReynoldsAxis::SPACING`], from the convergence study in the README.
+//! largest Re. Spacing: [`ReynoldsAxis::default_spacing`], from the convergence study in the README.
 
 use super::{FilmTable, LineOfCentres, Node, SliceFlow, TableResolution, TabulatedFilm};
 use crate::film::turbulence::{taylor_onset, FlowRegime};
@@ -50,8 +50,22 @@ pub struct ReynoldsAxis {
 }
 
 impl ReynoldsAxis {
-    /// The default largest spacing in x = Re^0.9 between slices (the README's study).
+    /// The default largest spacing in x = Re^0.9 between slices for `turbulent` (the README's
+    /// study: 0.020 % at 150).
     pub const SPACING: f64 = 150.0;
+
+    /// The spacing for `auto` (the README's study: 4.4 % at 150, 0.22 % at 75): its smoothstep
+    /// from Re_T to 1.5 Re_T spans only ≈ 246 in Re^0.9 and needs slices well inside it.
+    pub const AUTO_SPACING: f64 = 75.0;
+
+    /// The default spacing of `regime` ([`Self::SPACING`], [`Self::AUTO_SPACING`] for `auto`).
+    pub fn default_spacing(regime: FlowRegime) -> f64 {
+        if regime == FlowRegime::Auto {
+            Self::AUTO_SPACING
+        } else {
+            Self::SPACING
+        }
+    }
 
     /// The axis of `regime` from Re 0 to `re_max` for clearance ratio `r_over_c`, slices at
     /// most `spacing` apart in x = Re^0.9.
@@ -202,7 +216,8 @@ impl ReynoldsTable {
         regime: FlowRegime,
         re_max: f64,
     ) -> Result<Self, FilmError> {
-        let axis = ReynoldsAxis::new(regime, re_max, r_over_c(geometry), ReynoldsAxis::SPACING)?;
+        let spacing = ReynoldsAxis::default_spacing(regime);
+        let axis = ReynoldsAxis::new(regime, re_max, r_over_c(geometry), spacing)?;
         let slices = (0..axis.len())
             .map(|j| {
                 FilmTable::shared_slice(geometry, lubricant, grid, axis.slice_flow(j))
