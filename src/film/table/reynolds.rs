@@ -183,6 +183,13 @@ impl ReynoldsAxis {
             let f = t - i as f64;
             return ([0, 1, 0, 0], [1.0 - f, f, 0.0, 0.0]);
         }
+        // `auto` just past the onset (slice 1): the blend is laminar + s(Re)·(turbulent excess)
+        // with s(Re_T) = s'(Re_T) = 0 (smoothstep), so the force's slope in Re is 0 at the
+        // onset; the laminar slice 0 below it would give Catmull–Rom a wrong slope there
+        // (0.5–0.7 % force error at Re 1,170–1,260, README): an even ghost, slice 0 := slice 2
+        if self.regime == FlowRegime::Auto && i == 1 && n >= 4 {
+            return ([1, 2, 3, 0], [w[1], w[2] + w[0], w[3], 0.0]);
+        }
         // past the ends the missing slice is the linear extrapolation of the two nearest
         if i == 0 {
             ([0, 1, 2, 0], [w[1] + 2.0 * w[0], w[2] - w[0], w[3], 0.0])
