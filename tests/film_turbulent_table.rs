@@ -89,7 +89,7 @@ fn re_axis_error(regime: FlowRegime, spacing: f64) -> (f64, f64, usize) {
 /// The convergence study of the Re axis (README "Turbulent film"): the worst error of the Re
 /// interpolation for slices 600, 300, 150 and 75 apart in Re^0.9, `turbulent` and `auto`.
 /// Measured (force, coefficients %): turbulent 0.48/0.43, 0.17/0.17, 0.020/0.021,
-/// 0.0002/0.009; auto 11.8/11.2, 3.8/3.4, 4.4/3.9, 0.22/0.21. `turbulent` at the default
+/// 0.0002/0.009; auto (with the onset's even ghost) 15.1/14.3, 4.9/4.4, 2.9/2.6, 0.21/0.19. `turbulent` at the default
 /// spacing ([`ReynoldsAxis::SPACING`], 150) is within 0.5 % and moves 0.02 % when halved;
 /// `auto` is NOT at 150 (its smoothstep from Re_T to 1.5 Re_T spans 246 in Re^0.9: Catmull–Rom
 /// across its second-derivative jumps needs slices ≪ 246 apart): it meets 0.5 % at 75, which
