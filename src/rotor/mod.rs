@@ -90,7 +90,15 @@ pub struct FilmBearing {
     pub flow: crate::film::FlowRegime,
     /// Reynolds or mass-conserving cavitation (finite model, direct film; issue 18).
     pub cavitation: crate::film::Cavitation,
+    /// The largest speed a turbulent or auto film's table covers (rad/s):
+    /// [`TURBULENT_TABLE_SPEED_OVER_RATED`] × the machine's rated speed.
+    pub table_max_speed_rad_s: f64,
 }
+
+/// The speeds a turbulent film's table covers, over the machine's rated speed: run-ups to
+/// overspeed trips (≈ 1.1–1.2 ×) and the threshold searches of `modes` with margin; beyond it
+/// the tabulated film refuses the speed by name (the direct film has no such bound).
+pub const TURBULENT_TABLE_SPEED_OVER_RATED: f64 = 2.5;
 
 // --- oil supply temperature (issue 12) ---
 impl FilmBearing {
@@ -284,6 +292,14 @@ impl FilmBearing {
         Ok(Box::new(self.scaled(self.reference_tabulated_solver()?)))
     }
 
+    /// The largest film Reynolds number ρωRc/µ a turbulent or auto table of this bearing
+    /// covers: at [`Self::table_max_speed_rad_s`] and the reference viscosity.
+    pub fn table_max_reynolds(&self) -> f64 {
+        let (l, g) = (self.lubricant, &self.geometry);
+        l.density_kg_m3 * self.table_max_speed_rad_s * g.radius_m() * g.radial_clearance_m
+            / l.viscosity_pa_s
+    }
+
     /// The tabulated film at the reference viscosity `lubricant` (unscaled).
     pub fn reference_tabulated_solver(
         &self,
@@ -297,21 +313,21 @@ impl FilmBearing {
                        use the direct film (--film direct) with --cavitation mass-conserving",
             });
         }
-        if self.flow != crate::film::FlowRegime::Laminar {
-            return Err(crate::film::FilmError::InvalidParameter {
-                name: "flow (tabulated film)",
-                value: 0.0,
-                rule: "the table is laminar: a turbulent film is not homogeneous in the speed \
-                       (the flow factors depend on Re = ρωRc/µ, a third table dimension not built); \
-                       use the direct film (--film direct) with flow: turbulent or auto",
-            });
-        }
         if self.short {
             return Err(crate::film::FilmError::InvalidParameter {
                 name: "film model (tabulated film)",
                 value: 0.0,
                 rule: "the table tabulates the finite model; this bearing uses the short-bearing model",
             });
+        }
+        if self.flow != crate::film::FlowRegime::Laminar {
+            // a turbulent film tabulated over (ε, ψ, Re): `src/film/table/reynolds.rs`
+            let (l, g) = (self.lubricant, &self.geometry);
+            let re_max = self.table_max_reynolds();
+            let table = crate::film::ReynoldsTable::shared(g, l, self.grid, self.flow, re_max)?;
+            return Ok(Box::new(crate::film::ReynoldsTabulatedFilm::new(
+                std::sync::Arc::new(table),
+            )));
         }
         let table = crate::film::FilmTable::shared(&self.geometry, self.lubricant, self.grid)?;
         Ok(Box::new(crate::film::TabulatedFilm::new(table)))
@@ -556,7 +572,7 @@ fn bearing_sites(desc: &MachineDescription, nodes: usize) -> Vec<BearingSite> {
                 node: b.node,
                 journal_dofs: [4 * b.node, 4 * b.node + 1],
                 pedestal_dofs,
-                model: bearing_model(b),
+                model: bearing_model(b, rpm_to_rad_s(desc.rated_speed_rpm)),
             }
         })
         .collect()
@@ -581,7 +597,7 @@ fn discs(desc: &MachineDescription) -> Vec<Disc> {
         .collect()
 }
 
-fn bearing_model(b: &BearingSpec) -> BearingModel {
+fn bearing_model(b: &BearingSpec, rated_speed_rad_s: f64) -> BearingModel {
     match &b.model {
         BearingModelSpec::Finite(f) | BearingModelSpec::Short(f) => {
             BearingModel::Film(FilmBearing {
@@ -596,6 +612,7 @@ fn bearing_model(b: &BearingSpec) -> BearingModel {
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
                 flow: f.flow,
                 cavitation: crate::film::Cavitation::Reynolds,
+                table_max_speed_rad_s: TURBULENT_TABLE_SPEED_OVER_RATED * rated_speed_rad_s,
             })
         }
         BearingModelSpec::Linear(coef) => BearingModel::Linear(*coef),

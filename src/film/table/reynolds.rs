@@ -19,7 +19,7 @@
 //! Catmull–Rom over four slices (linear extrapolation past the ends), from Re = 0 (laminar) to
 //! the bearing's largest Re for `turbulent`; for `auto`, the laminar table up to Taylor's onset
 //! Re_T (exact: the factors are laminar there) and slices from one below Re_T (laminar) to the
-//! largest Re. Spacing: [`ReynoldsAxis::SPACING`], from the convergence study in the README.
+//! largest Re. Spacing: [`ReynoldsAxis::default_spacing`], from the convergence study in the README.
 
 use super::{FilmTable, LineOfCentres, Node, SliceFlow, TableResolution, TabulatedFilm};
 use crate::film::turbulence::{taylor_onset, FlowRegime};
@@ -50,8 +50,22 @@ pub struct ReynoldsAxis {
 }
 
 impl ReynoldsAxis {
-    /// The default largest spacing in x = Re^0.9 between slices (the README's study).
+    /// The default largest spacing in x = Re^0.9 between slices for `turbulent` (the README's
+    /// study: 0.020 % at 150).
     pub const SPACING: f64 = 150.0;
+
+    /// The spacing for `auto` (the README's study: 4.4 % at 150, 0.22 % at 75): its smoothstep
+    /// from Re_T to 1.5 Re_T spans only ≈ 246 in Re^0.9 and needs slices well inside it.
+    pub const AUTO_SPACING: f64 = 75.0;
+
+    /// The default spacing of `regime` ([`Self::SPACING`], [`Self::AUTO_SPACING`] for `auto`).
+    pub fn default_spacing(regime: FlowRegime) -> f64 {
+        if regime == FlowRegime::Auto {
+            Self::AUTO_SPACING
+        } else {
+            Self::SPACING
+        }
+    }
 
     /// The axis of `regime` from Re 0 to `re_max` for clearance ratio `r_over_c`, slices at
     /// most `spacing` apart in x = Re^0.9.
@@ -169,6 +183,13 @@ impl ReynoldsAxis {
             let f = t - i as f64;
             return ([0, 1, 0, 0], [1.0 - f, f, 0.0, 0.0]);
         }
+        // `auto` just past the onset (slice 1): the blend is laminar + s(Re)·(turbulent excess)
+        // with s(Re_T) = s'(Re_T) = 0 (smoothstep), so the force's slope in Re is 0 at the
+        // onset; the laminar slice 0 below it would give Catmull–Rom a wrong slope there
+        // (0.5–0.7 % force error at Re 1,170–1,260, README): an even ghost, slice 0 := slice 2
+        if self.regime == FlowRegime::Auto && i == 1 && n >= 4 {
+            return ([1, 2, 3, 0], [w[1], w[2] + w[0], w[3], 0.0]);
+        }
         // past the ends the missing slice is the linear extrapolation of the two nearest
         if i == 0 {
             ([0, 1, 2, 0], [w[1] + 2.0 * w[0], w[2] - w[0], w[3], 0.0])
@@ -202,7 +223,8 @@ impl ReynoldsTable {
         regime: FlowRegime,
         re_max: f64,
     ) -> Result<Self, FilmError> {
-        let axis = ReynoldsAxis::new(regime, re_max, r_over_c(geometry), ReynoldsAxis::SPACING)?;
+        let spacing = ReynoldsAxis::default_spacing(regime);
+        let axis = ReynoldsAxis::new(regime, re_max, r_over_c(geometry), spacing)?;
         let slices = (0..axis.len())
             .map(|j| {
                 FilmTable::shared_slice(geometry, lubricant, grid, axis.slice_flow(j))
