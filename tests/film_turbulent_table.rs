@@ -50,7 +50,6 @@ const COARSE: TableResolution = TableResolution {
     n_ecc: 16,
     n_psi: 32,
     grid_phases: 1,
-    wall_phases: 1,
     map: EccentricityMap::Atanh,
     frame: ForceFrame::Source,
 };

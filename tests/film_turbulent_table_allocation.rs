@@ -25,7 +25,6 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
         n_ecc: 8,
         n_psi: 16,
         grid_phases: 1,
-        wall_phases: 1,
         map: EccentricityMap::Atanh,
         frame: ForceFrame::Source,
     };

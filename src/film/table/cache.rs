@@ -18,10 +18,7 @@
 //! and load the result), bounded in time: a cold fleet builds each table once.
 
 use super::TABLE_SOURCES;
-use super::{
-    FilmTable, Node, SliceFlow, TableResolution, MAX_ECCENTRICITY_RATIO, ROW_ECC_CAP,
-    WALL_PHASE_ECC,
-};
+use super::{FilmTable, Node, SliceFlow, TableResolution, MAX_ECCENTRICITY_RATIO, ROW_ECC_CAP};
 use crate::film::{BearingGeometry, FilmError, FilmGrid, Lubricant};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -377,7 +374,6 @@ fn key_for(
     format!(
         "rotor-twin film table\nformat {FORMAT_VERSION}\nsolver {SOLVER_VERSION} source {:x}\n\
          nodes {}x{} map {:?} eps_max {:?} eps_row_cap {:?} grid_phases {}\n\
-         wall_phases {} from eps {:?}\n\
          diameter_m {:?}\nlength_m {:?}\nradial_clearance_m {:?}\ngrooves [{}]\n\
          density_kg_m3 {:?}\nviscosity_pa_s {:?}\ngrid {}x{}\n",
         source_fingerprint(),
@@ -387,8 +383,6 @@ fn key_for(
         MAX_ECCENTRICITY_RATIO,
         ROW_ECC_CAP,
         res.grid_phases,
-        res.wall_phases,
-        WALL_PHASE_ECC,
         geometry.diameter_m,
         geometry.length_m,
         geometry.radial_clearance_m,

@@ -50,10 +50,6 @@ pub struct TableResolution {
     /// scale in the whip domain on 60 × 10, `tests/film_table.rs`); the phase average is
     /// smooth, as in [`crate::film::FilmModel::linearised_coefficients`].
     pub grid_phases: usize,
-    /// Grid phases on the rows at ε ≥ [`WALL_PHASE_ECC`] (the wall): there the pressure peak is
-    /// about one grid cell wide, and the average over `grid_phases` carries its phase jitter
-    /// into the coefficients (README "The film table's resolution", session 12).
-    pub wall_phases: usize,
     /// How the rows are spread in ε.
     pub map: EccentricityMap,
     /// The frame the force is held in.
@@ -114,7 +110,6 @@ impl TableResolution {
         n_ecc: 160,
         n_psi: 192,
         grid_phases: 8,
-        wall_phases: 32,
         map: EccentricityMap::Atanh,
         frame: ForceFrame::Source,
     };
@@ -133,37 +128,17 @@ impl TableResolution {
         if self.n_psi < 4 || !self.n_psi.is_multiple_of(2) {
             return bad("table columns n_psi", self.n_psi, "even, at least 4");
         }
-        if self.grid_phases == 0 || self.wall_phases == 0 {
-            return bad("table grid_phases, wall_phases", 0, "at least 1");
+        if self.grid_phases == 0 {
+            return bad("table grid_phases", 0, "at least 1");
         }
         Ok(())
     }
 
     /// Film solves to build a table on this resolution.
     pub fn solves(&self) -> usize {
-        (0..self.n_ecc)
-            .map(|i| self.n_psi * (self.phases(self.row_eps(i)) + 1))
-            .sum()
-    }
-
-    /// ε of row `i`.
-    fn row_eps(&self, i: usize) -> f64 {
-        let u_max = self.map.u(MAX_ECCENTRICITY_RATIO);
-        self.map.eps(i as f64 * u_max / (self.n_ecc - 1) as f64)
-    }
-
-    /// Grid phases averaged on a row at `eps`.
-    fn phases(&self, eps: f64) -> usize {
-        if eps >= WALL_PHASE_ECC {
-            self.wall_phases
-        } else {
-            self.grid_phases
-        }
+        self.n_ecc * self.n_psi * (self.grid_phases + 1)
     }
 }
-
-/// From this ε on, a row's nodes average [`TableResolution::wall_phases`] grid phases.
-const WALL_PHASE_ECC: f64 = 0.95;
 
 /// Largest ε of the solves on the last row (the row itself sits at [`MAX_ECCENTRICITY_RATIO`]).
 const ROW_ECC_CAP: f64 = 0.9989;
@@ -362,7 +337,7 @@ impl FilmTable {
                         }
                         let mut out = Vec::new();
                         for &i in chunk.iter() {
-                            let eps = res.row_eps(i);
+                            let eps = res.map.eps(i as f64 * u_max / (n_ecc - 1) as f64);
                             let (nodes, profiles) =
                                 row(&mut film, &geometry, eps.min(ROW_ECC_CAP), &res)?;
                             out.push((i, nodes, profiles));
@@ -741,7 +716,7 @@ fn row(
     let n_psi = res.n_psi;
     let mut nodes = Vec::with_capacity(n_psi);
     let mut profiles = vec![0.0; n_psi * n_theta];
-    let m = res.phases(eps);
+    let m = res.grid_phases;
     let kappa = couette_factor(film.grid());
     for j in 0..n_psi {
         let psi = TAU * j as f64 / n_psi as f64;
