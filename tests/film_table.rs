@@ -228,16 +228,24 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
 
 /// The table's force and eight coefficients over the whole domain a whip visits (ε 0–0.995
 /// in 8 bands, any attitude, radial and tangential velocities up to ±0.6 c ω: `banded_states`,
-/// 20 states a band) against the direct solver averaged over 32 grid phases (force: of |F|;
+/// 20 states a band) against the direct solver averaged over 32 grid phases (128 for the
+/// coefficients in ε 0.98–0.995, [`WALL_BAND`]) (force: of |F|;
 /// coefficients: of the state's coefficient scale, `coefficient_error`). Measured, by band
 /// (`BANDS`), this table (u = atanh ε, 160 × 192, 8 phases, U with the grid's Couette factor
 /// κ, the force held in the source's frame): force 0.001, 0.001, 0.001, 0.001, 0.009, 0.010,
-/// 0.024, 0.118 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32, 0.46, 1.31 %. With the
+/// 0.024, 0.118 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32, 0.46, 1.17 % (1.31 %
+/// against the 32-phase reference, session 11). With the
 /// force held along the line of centres (session 10) the coefficients were 0.77 % at the
 /// centre and 0.57 % in ε 0.95–0.98: it fails here. The issue's 0.5 % is NOT met for the
-/// coefficients in ε 0.98–0.995 (1.31 %), where the 60 × 10 reference is itself ≈ 1 % off the
-/// grid-converged film (`coefficient_reference_diagnosis`, README "The film table's
-/// resolution"); the bound there holds the measured figure.
+/// coefficients in ε 0.98–0.995 (1.17 %), where the developed whip of the built-in rotor at
+/// 9,000 rpm spends all its time (ε 0.985–0.993). Cause (session 12,
+/// `wall_error_decomposition` and `resolution_study`): the interpolation in ψ. The worst
+/// states are those whose answer depends on the grid phase; there the table is 1.5 % off its
+/// own node definition (the phase average from a grid line at the state), which is itself
+/// within 0.4 % of the 128-phase reference. Averaging 32 grid phases on the rows beyond
+/// ε 0.95 leaves it at 1.15 %, 16 phases and 320 rows at 1.08 %; 16 phases and 384 columns
+/// bring it to 0.53 % (and ε 0.95–0.98 to 0.18 %), but the centre to 1.9 %. The bound holds
+/// the measured figure.
 #[test]
 fn force_and_coefficients_over_the_whole_domain() {
     let (mut table, _, _, _) = models();
@@ -251,7 +259,7 @@ fn force_and_coefficients_over_the_whole_domain() {
     }
     // allowed, % by band
     let force = [0.5; 8];
-    let coefficients = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.5];
+    let coefficients = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.25];
     for (b, range) in BANDS.iter().enumerate() {
         assert!(
             100.0 * ef[b] < force[b],
@@ -403,9 +411,11 @@ type Referenced = (
 );
 
 /// The first band of [`BANDS`] whose coefficient reference averages 128 grid phases, not 32
-/// (ε 0.95–0.98): there the 32-phase average still moves by 0.24–0.45 % of the coefficient
-/// scale on the way to 128 (`coefficient_reference_diagnosis`), as much as the bound.
-const WALL_BAND: usize = 6;
+/// (ε 0.98–0.995): there the 32-phase average still moves by up to 0.45 % of the coefficient
+/// scale on the way to 128 (`coefficient_reference_diagnosis`), as much as the issue's bound;
+/// two 128-phase averages (from a grid line and from the state's attitude) differ by ≤ 0.12 %
+/// (`wall_error_decomposition`).
+const WALL_BAND: usize = 7;
 
 /// `per_band` states in each band of [`BANDS`] (`whip_state`, seed 0x57D1) with their direct
 /// references (force: 32 grid phases; coefficients: 32, 128 from [`WALL_BAND`] on): the same
@@ -447,8 +457,7 @@ fn banded_errors(model: &mut TabulatedFilm, states: &[Referenced]) -> ([f64; 8],
 }
 
 /// The convergence study of the table's resolution (README "The film table's resolution"):
-/// for each resolution (`ROTOR_TWIN_TABLE_STUDY`, e.g. `atanh:160x192x8,log:160x192x8`;
-/// `atanh:160x192x8x32`: 32 phases on the rows at ε ≥ 0.95), the
+/// for each resolution (`ROTOR_TWIN_TABLE_STUDY`, e.g. `atanh:160x192x8,log:160x192x8`), the
 /// worst force and coefficient error against the 32-phase direct reference per ε band, at
 /// `ROTOR_TWIN_TABLE_STUDY_N` (default [`STATES_PER_BAND`]) states a band (`banded_states` ), the build time and
 /// the time of one force + coefficients evaluation. A study, not a check: run by hand with
@@ -476,8 +485,6 @@ fn resolution_study() {
             n_ecc: d[0],
             n_psi: d[1],
             grid_phases: d[2],
-            // `…xPxQ`: Q phases on the rows at the wall (ε ≥ 0.95), else P
-            wall_phases: d.get(3).copied().unwrap_or(d[2]),
             map: if map.starts_with("log") {
                 EccentricityMap::Log
             } else {
@@ -665,7 +672,8 @@ fn difference_reference(
 /// table against A (32 phases of the perturbation coefficients), A128 (128 phases), D(h)
 /// (central differences of the 32-phase force, steps h c and h c ω); then at the band's
 /// worst states the same against the grid-refined film (120 × 20, 240 × 40, 8 phases of its
-/// own grid, perturbation coefficients and differences of the force).
+/// own grid, perturbation coefficients and differences of the force). (In band 7,
+/// [`WALL_BAND`], A averages 128 phases since session 12.)
 #[test]
 #[ignore]
 fn coefficient_reference_diagnosis() {
