@@ -240,10 +240,11 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
 /// coefficients in ε 0.98–0.995 (1.17 %), where the developed whip of the built-in rotor at
 /// 9,000 rpm spends all its time (ε 0.985–0.993). Cause (session 12,
 /// `wall_error_decomposition` and `resolution_study`): the interpolation in ψ. The worst
-/// states are those whose answer depends on the grid phase; there the table is 1.5 % off its
-/// own node definition (the phase average from a grid line at the state), which is itself
-/// within 0.4 % of the 128-phase reference. Averaging 32 grid phases on the rows beyond
+/// states are those whose answer depends on the grid phase; there the table is 1.43 % off its
+/// own node definition (the 8-phase average from a grid line at the state), which is itself
+/// 0.26 % off the 128-phase reference. Averaging 32 grid phases on the rows beyond
 /// ε 0.95 leaves it at 1.15 %, 16 phases and 320 rows at 1.08 %; 16 phases and 384 columns
+/// (study, README; the phase knob was commit acb8c61)
 /// bring it to 0.53 % (and ε 0.95–0.98 to 0.18 %), but the centre to 1.9 %. The bound holds
 /// the measured figure.
 #[test]
