@@ -228,16 +228,25 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
 
 /// The table's force and eight coefficients over the whole domain a whip visits (ε 0–0.995
 /// in 8 bands, any attitude, radial and tangential velocities up to ±0.6 c ω: `banded_states`,
-/// 20 states a band) against the direct solver averaged over 32 grid phases (force: of |F|;
+/// 20 states a band) against the direct solver averaged over 32 grid phases (128 for the
+/// coefficients in ε 0.98–0.995, [`WALL_BAND`]) (force: of |F|;
 /// coefficients: of the state's coefficient scale, `coefficient_error`). Measured, by band
 /// (`BANDS`), this table (u = atanh ε, 160 × 192, 8 phases, U with the grid's Couette factor
 /// κ, the force held in the source's frame): force 0.001, 0.001, 0.001, 0.001, 0.009, 0.010,
-/// 0.024, 0.118 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32, 0.46, 1.31 %. With the
+/// 0.024, 0.118 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32, 0.46, 1.17 % (1.31 %
+/// against the 32-phase reference, session 11). With the
 /// force held along the line of centres (session 10) the coefficients were 0.77 % at the
 /// centre and 0.57 % in ε 0.95–0.98: it fails here. The issue's 0.5 % is NOT met for the
-/// coefficients in ε 0.98–0.995 (1.31 %), where the 60 × 10 reference is itself ≈ 1 % off the
-/// grid-converged film (`coefficient_reference_diagnosis`, README "The film table's
-/// resolution"); the bound there holds the measured figure.
+/// coefficients in ε 0.98–0.995 (1.17 %), where the developed whip of the built-in rotor at
+/// 9,000 rpm spends all its time (ε 0.985–0.993). Cause (session 12,
+/// `wall_error_decomposition` and `resolution_study`): the interpolation in ψ. The worst
+/// states are those whose answer depends on the grid phase; there the table is 1.43 % off its
+/// own node definition (the 8-phase average from a grid line at the state), which is itself
+/// 0.26 % off the 128-phase reference. Averaging 32 grid phases on the rows beyond
+/// ε 0.95 leaves it at 1.15 %, 16 phases and 320 rows at 1.08 %; 16 phases and 384 columns
+/// (study, README; the phase knob was commit acb8c61)
+/// bring it to 0.53 % (and ε 0.95–0.98 to 0.18 %), but the centre to 1.9 %. The bound holds
+/// the measured figure.
 #[test]
 fn force_and_coefficients_over_the_whole_domain() {
     let (mut table, _, _, _) = models();
@@ -251,7 +260,7 @@ fn force_and_coefficients_over_the_whole_domain() {
     }
     // allowed, % by band
     let force = [0.5; 8];
-    let coefficients = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.5];
+    let coefficients = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.25];
     for (b, range) in BANDS.iter().enumerate() {
         assert!(
             100.0 * ef[b] < force[b],
@@ -402,8 +411,16 @@ type Referenced = (
     rotor_twin::film::FilmCoefficients,
 );
 
+/// The first band of [`BANDS`] whose coefficient reference averages 128 grid phases, not 32
+/// (ε 0.98–0.995): there the 32-phase average still moves by up to 0.45 % of the coefficient
+/// scale on the way to 128 (`coefficient_reference_diagnosis`), as much as the issue's bound;
+/// two 128-phase averages (from a grid line and from the state's attitude) differ by ≤ 0.12 %
+/// (`wall_error_decomposition`).
+const WALL_BAND: usize = 7;
+
 /// `per_band` states in each band of [`BANDS`] (`whip_state`, seed 0x57D1) with their direct
-/// references: the same states for the study and for the whole-domain test.
+/// references (force: 32 grid phases; coefficients: 32, 128 from [`WALL_BAND`] on): the same
+/// states for the study and for the whole-domain test.
 fn banded_states(per_band: usize) -> Vec<Referenced> {
     let geometry = seed_bearing(0.5);
     let grid = FilmGrid::new(60, 10).unwrap();
@@ -415,7 +432,13 @@ fn banded_states(per_band: usize) -> Vec<Referenced> {
         for _ in 0..per_band {
             let (kin, _) = whip_state(&mut rng, c, range);
             let f = force_reference_32(&mut direct, &kin, grid.n_theta);
-            out.push((b, kin, f, finer_phase_average(&mut direct, &kin)));
+            let sub = if b >= WALL_BAND { 16 } else { 4 };
+            out.push((
+                b,
+                kin,
+                f,
+                analytic_reference(&mut direct, &kin, grid.n_theta, sub),
+            ));
         }
     }
     out
@@ -650,7 +673,8 @@ fn difference_reference(
 /// table against A (32 phases of the perturbation coefficients), A128 (128 phases), D(h)
 /// (central differences of the 32-phase force, steps h c and h c ω); then at the band's
 /// worst states the same against the grid-refined film (120 × 20, 240 × 40, 8 phases of its
-/// own grid, perturbation coefficients and differences of the force).
+/// own grid, perturbation coefficients and differences of the force). (In band 7,
+/// [`WALL_BAND`], A averages 128 phases since session 12.)
 #[test]
 #[ignore]
 fn coefficient_reference_diagnosis() {
@@ -708,5 +732,86 @@ fn coefficient_reference_diagnosis() {
                 );
             }
         }
+    }
+}
+
+/// The direct perturbation coefficients averaged over 8 × `sub` grid phases starting on a grid
+/// line, α_k = kΔθ/(8 sub), with the state turned to the attitude φ = 0 and the coefficients
+/// turned back: what a table node averaging 8 × `sub` phases holds (`row` in
+/// src/film/table/mod.rs), without its interpolation.
+fn grid_aligned_reference(
+    direct: &mut FiniteFilm,
+    kin: &JournalKinematics,
+    nt: usize,
+    sub: usize,
+) -> rotor_twin::film::FilmCoefficients {
+    let phi = kin.position_m[1].atan2(kin.position_m[0]);
+    let (ca, sa) = (phi.cos(), phi.sin());
+    // turn by −φ
+    let turn = |v: [f64; 2]| [ca * v[0] + sa * v[1], -sa * v[0] + ca * v[1]];
+    let aligned = JournalKinematics {
+        position_m: turn(kin.position_m),
+        velocity_m_s: turn(kin.velocity_m_s),
+        speed_rad_s: kin.speed_rad_s,
+    };
+    let l = analytic_reference(direct, &aligned, nt, sub);
+    let r = nalgebra::Matrix2::new(ca, sa, -sa, ca);
+    rotor_twin::film::FilmCoefficients {
+        stiffness_n_per_m: r.transpose() * l.stiffness_n_per_m * r,
+        damping_n_s_per_m: r.transpose() * l.damping_n_s_per_m * r,
+        ..l
+    }
+}
+
+/// The wall band's coefficient error split into its parts (a diagnosis, run by hand:
+/// `-- --ignored --nocapture wall_error_decomposition`, bands from `ROTOR_TWIN_DIAG_BANDS`,
+/// default 6,7): per state of the study, the table T against I_m, the direct coefficients
+/// averaged over m grid phases from a grid line (what a node of m phases holds: T–I8 is the
+/// interpolation error alone), and I_m, T, A (32 phases at the state's attitude) against
+/// A128 (128 phases at the state's attitude, the reference least dependent on the phase).
+#[test]
+#[ignore]
+fn wall_error_decomposition() {
+    let (mut table, mut direct, _, nt) = models();
+    let states = banded_states(STATES_PER_BAND);
+    let bands: Vec<usize> = std::env::var("ROTOR_TWIN_DIAG_BANDS")
+        .ok()
+        .map(|v| v.split(',').map(|b| b.parse().expect("band")).collect())
+        .unwrap_or_else(|| vec![6, 7]);
+    let w = OMEGA_9000_RPM;
+    let e = |x: &rotor_twin::film::FilmCoefficients, y: &rotor_twin::film::FilmCoefficients| {
+        100.0 * common::coefficient_error(x, y, w)
+    };
+    for &band in &bands {
+        let mut worst = [0.0_f64; 9];
+        for (_, kin, _, a32) in states.iter().filter(|s| s.0 == band) {
+            let (_, t) = table.solve_with_coefficients(kin).unwrap();
+            let a128 = analytic_reference(&mut direct, kin, nt, 16);
+            let i: Vec<_> = [1, 2, 4, 16]
+                .iter()
+                .map(|&sub| grid_aligned_reference(&mut direct, kin, nt, sub))
+                .collect();
+            let eps =
+                kin.position_m[0].hypot(kin.position_m[1]) / seed_bearing(0.5).radial_clearance_m;
+            let row = [
+                e(a32, &t),
+                e(&a128, &t),
+                e(&i[0], &t),
+                e(&a128, &i[0]),
+                e(&a128, &i[1]),
+                e(&a128, &i[2]),
+                e(&a128, &i[3]),
+                e(&a128, a32),
+                e(&i[2], &t),
+            ];
+            for (w, r) in worst.iter_mut().zip(row) {
+                *w = w.max(r);
+            }
+            println!(
+                "band {band} ε {eps:.5}: T–Aref {:.3} T–A128 {:.3} T–I8 {:.3} | vs A128: I8 {:.3} I16 {:.3} I32 {:.3} I128 {:.3} Aref {:.3} | T–I32 {:.3}",
+                row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8]
+            );
+        }
+        println!("band {band} worst: {worst:.3?}");
     }
 }
