@@ -35,6 +35,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 /// Allocations (and reallocations) made by the process so far.
+#[allow(dead_code)]
 pub fn allocations() -> usize {
     ALLOCATIONS.load(Ordering::SeqCst)
 }
