@@ -301,8 +301,7 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     for n in report.notes.iter().skip(bag.notes.len()) {
         eprintln!("warning: {}: {n}", args.bag.display());
     }
-    let json = serde_json::to_string_pretty(&report)?;
-    std::fs::write(out_dir.join("report.json"), &json)?;
+    write_report_json(&out_dir.join("report.json"), &report)?;
     for c in comparisons.iter().filter(|c| c.samples > 0) {
         let locus: Vec<crate::plot::CenterlinePoint> = report
             .stations
@@ -326,7 +325,8 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
     }
     // a closed standard output (e.g. piped into `head`) is not an error of the replay
     if args.json {
-        super::print_out(&format!("{json}\n"))
+        super::print_out(&serde_json::to_string_pretty(&report)?)?;
+        super::print_out("\n")
     } else {
         super::print_out(&format!(
             "{}output: {}\n",
@@ -334,6 +334,19 @@ pub fn run(args: &ReplayArgs) -> anyhow::Result<()> {
             out_dir.display()
         ))
     }
+}
+
+/// Writes `report` to `path` as pretty JSON, streamed (not first built as one string: with
+/// every block of a long bag it was the replay's largest allocation, issue 17).
+fn write_report_json(path: &Path, report: &crate::replay::ReplayReport) -> anyhow::Result<()> {
+    use std::io::Write;
+    let file = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))?;
+    let mut w = std::io::BufWriter::new(file);
+    serde_json::to_writer_pretty(&mut w, report)?;
+    w.flush()
+        .map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))?;
+    Ok(())
 }
 
 /// Why the twin never started in the replay that gave `report`, if it did not: a replay that

@@ -25,6 +25,15 @@ use serde::Serialize;
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
 
+/// Keeps items 0, 2, 4, … of `v` (in place, its capacity kept).
+fn keep_every_other<T>(v: &mut Vec<T>) {
+    let mut k = 0;
+    v.retain(|_| {
+        k += 1;
+        k % 2 == 1
+    });
+}
+
 /// Revolutions per block of the amplitude–speed series and of the onset detector.
 pub const BLOCK_REVS: usize = 8;
 /// Revolutions of the summary window at the end of the bag.
@@ -32,6 +41,15 @@ pub const SUMMARY_REVS: usize = 32;
 /// Consecutive blocks over which a sub-synchronous component must persist or grow to be an
 /// onset (24 revolutions: 0.16 s at 9,000 rpm).
 pub const ONSET_BLOCKS: usize = 3;
+/// Most blocks a station keeps for the report and plots (issue 17: memory bounded whatever the
+/// bag's length). Beyond it every other kept block is dropped and only every `stride`-th block
+/// is kept from then on (stride 2, 4, 8, …): at 9,000 rpm (18.75 blocks a second) the first
+/// 54.6 s are kept whole, a 10-minute bag keeps every 16th block (704). The onset, transients
+/// and the plant's whip are detected on every block as they come ([`OnsetDetector`]).
+pub const MAX_KEPT_BLOCKS: usize = 1024;
+/// Most transients kept per station and per orbit (measured, predicted); later ones are
+/// counted in [`StationComparison::transients_dropped`].
+pub const MAX_TRANSIENTS: usize = 64;
 
 /// A run of blocks whose sub-synchronous component counted but decayed: a transient.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -44,12 +62,95 @@ pub struct TransientSpan {
     pub largest_subsync_m: f64,
 }
 
-/// Consecutive counting blocks `first ..= last`.
-#[derive(Debug, Clone, Copy)]
+/// The onset rule of [`StationComparison::onset`] over blocks as they come, holding only the
+/// current run of counting blocks' last [`ONSET_BLOCKS`] (issue 17: the blocks themselves are
+/// decimated). The first window of [`ONSET_BLOCKS`] consecutive counting blocks of one run,
+/// each ≥ `least_ratio` × the one before, is the onset (its first block's end time and speed);
+/// the counting blocks before it in its run, and every earlier run, are transients.
+#[derive(Debug, Clone, Default)]
+struct OnsetDetector {
+    onset: Option<(f64, f64)>,
+    transients: Vec<TransientSpan>,
+    dropped: usize,
+    run: Option<CountingRun>,
+}
+
+/// The counting run under way: its start, the blocks that left the window (their last end and
+/// largest amplitude), and its last blocks `(amplitude m, end s, speed rpm)`.
+#[derive(Debug, Clone)]
 struct CountingRun {
-    first: usize,
-    last: usize,
-    persistent: bool,
+    start_s: f64,
+    before: Option<(f64, f64)>,
+    window: VecDeque<(f64, f64, f64)>,
+}
+
+impl CountingRun {
+    /// The run as a transient, whole.
+    fn span(&self) -> Option<TransientSpan> {
+        let last = self.window.back()?;
+        let largest = self.window.iter().map(|w| w.0).fold(0.0, f64::max);
+        Some(TransientSpan {
+            start_s: self.start_s,
+            end_s: last.1,
+            largest_subsync_m: self.before.map_or(largest, |b| b.1.max(largest)),
+        })
+    }
+}
+
+impl OnsetDetector {
+    /// One block (start, end s; speed rpm), its sub-synchronous amplitude when it counts.
+    fn push(&mut self, start_s: f64, end_s: f64, speed_rpm: f64, amp: Option<f64>, least: f64) {
+        if self.onset.is_some() {
+            return;
+        }
+        let Some(a) = amp else {
+            if let Some(span) = self.run.take().and_then(|r| r.span()) {
+                self.note_transient(span);
+            }
+            return;
+        };
+        let run = self.run.get_or_insert_with(|| CountingRun {
+            start_s,
+            before: None,
+            window: VecDeque::with_capacity(ONSET_BLOCKS),
+        });
+        if run.window.len() == ONSET_BLOCKS {
+            if let Some((a0, e0, _)) = run.window.pop_front() {
+                run.before = Some((e0, run.before.map_or(a0, |b| b.1.max(a0))));
+            }
+        }
+        run.window.push_back((a, end_s, speed_rpm));
+        let w = &run.window;
+        if w.len() == ONSET_BLOCKS && (1..w.len()).all(|j| w[j].0 >= least * w[j - 1].0) {
+            self.onset = Some((w[0].1, w[0].2));
+            let prefix = run.before.map(|(end_s, largest)| TransientSpan {
+                start_s: run.start_s,
+                end_s,
+                largest_subsync_m: largest,
+            });
+            self.run = None;
+            if let Some(span) = prefix {
+                self.note_transient(span);
+            }
+        }
+    }
+
+    fn note_transient(&mut self, span: TransientSpan) {
+        if self.transients.len() < MAX_TRANSIENTS {
+            self.transients.push(span);
+        } else {
+            self.dropped += 1;
+        }
+    }
+
+    /// The transients so far, with the run under way (it has not persisted yet).
+    fn transients(&self) -> Vec<TransientSpan> {
+        let mut t = self.transients.clone();
+        if self.onset.is_none() && t.len() < MAX_TRANSIENTS {
+            t.extend(self.run.as_ref().and_then(|r| r.span()));
+        }
+        t
+    }
 }
 
 /// One probe sample with the prediction at the same instant.
@@ -181,11 +282,22 @@ pub struct StationComparison {
     /// the keyphasor events at the end of the bag (for the summary window)
     final_events: Option<Box<KeyphasorEvents>>,
     recent: VecDeque<Sample>,
-    /// Completed blocks.
+    /// Completed blocks, every `block_stride`-th (at most [`MAX_KEPT_BLOCKS`]).
     pub blocks: Vec<WindowComparison>,
-    /// Each block's order spectra, semi-major axes (m) at orders k/8, k = 1 … 16: measured,
+    /// Each kept block's order spectra, semi-major axes (m) at orders k/8, k = 1 … 16: measured,
     /// predicted (for the waterfall plot).
     pub block_spectra: Vec<BlockSpectra>,
+    /// Blocks completed (kept or not).
+    pub blocks_seen: usize,
+    /// One block in this many is kept (1, 2, 4, …).
+    pub block_stride: usize,
+    /// the onset rule on the predicted and the measured orbit, over every block
+    onset_predicted: OnsetDetector,
+    onset_measured: OnsetDetector,
+    /// the plant's whip ([`crate::replay::observed_whip_s`]): consecutive blocks at or above the
+    /// level and the first's start, then the first such run's start
+    whip_run: (usize, f64),
+    observed_whip_start_s: Option<f64>,
     /// Samples compared.
     pub samples: usize,
     /// Why the measured mean position is not the plant's (None: it is, e.g. DC-coupled probes
@@ -207,6 +319,12 @@ impl StationComparison {
             recent: VecDeque::new(),
             blocks: Vec::new(),
             block_spectra: Vec::new(),
+            blocks_seen: 0,
+            block_stride: 1,
+            onset_predicted: OnsetDetector::default(),
+            onset_measured: OnsetDetector::default(),
+            whip_run: (0, 0.0),
+            observed_whip_start_s: None,
             samples: 0,
             mean_not_measured: None,
         }
@@ -270,8 +388,8 @@ impl StationComparison {
         match self.compare(&self.waiting, BLOCK_REVS, events, give_up) {
             Err(()) => return,
             Ok(Some(w)) => {
-                self.block_spectra.push(block_spectra(&self.waiting, &w));
-                self.blocks.push(w);
+                let spectra = block_spectra(&self.waiting, &w);
+                self.note_block(w, spectra);
             }
             Ok(None) => {}
         }
@@ -297,92 +415,81 @@ impl StationComparison {
             .flatten()
     }
 
+    /// A finished block through the onset and whip rules, and kept (with its spectra) if it is
+    /// one of every `block_stride`; at [`MAX_KEPT_BLOCKS`] every other kept block is dropped
+    /// and the stride doubles.
+    fn note_block(&mut self, w: WindowComparison, spectra: BlockSpectra) {
+        let least = (-self.settings.growth_threshold_per_rev * BLOCK_REVS as f64).exp();
+        let counting = |f: &OrbitFeatures| f.subsync_ratio.map(|_| f.subsync_amplitude_m);
+        let (p, m) = (counting(&w.predicted), counting(&w.measured));
+        self.onset_predicted
+            .push(w.start_s, w.end_s, w.speed_rpm, p, least);
+        self.onset_measured
+            .push(w.start_s, w.end_s, w.speed_rpm, m, least);
+        let level = self.settings.whip_eccentricity_ratio * self.clearance_m;
+        if w.measured.subsync_amplitude_m >= level {
+            if self.whip_run.0 == 0 {
+                self.whip_run.1 = w.start_s;
+            }
+            self.whip_run.0 += 1;
+            if self.whip_run.0 >= ONSET_BLOCKS && self.observed_whip_start_s.is_none() {
+                self.observed_whip_start_s = Some(self.whip_run.1);
+            }
+        } else {
+            self.whip_run.0 = 0;
+        }
+        let k = self.blocks_seen;
+        self.blocks_seen += 1;
+        if k % self.block_stride != 0 {
+            return;
+        }
+        if self.blocks.len() == MAX_KEPT_BLOCKS {
+            keep_every_other(&mut self.blocks);
+            keep_every_other(&mut self.block_spectra);
+            self.block_stride *= 2;
+            if k % self.block_stride != 0 {
+                return;
+            }
+        }
+        self.blocks.push(w);
+        self.block_spectra.push(spectra);
+    }
+
     /// The onset (measured, or predicted with `predicted`): the first block of a run of
     /// [`ONSET_BLOCKS`] consecutive blocks whose sub-synchronous component counts (the monitor's
     /// rule) and persists or grows: over the run it decays by less than the classifier's growth
     /// threshold allows (e^{−0.002/rev · 8 revolutions} a block). Its end time (s) and speed
-    /// (rpm). A decaying start-up transient is no onset (see [`Self::transients`]).
+    /// (rpm). A decaying start-up transient is no onset (see [`Self::transients`]). Read over
+    /// every block, kept or not.
     pub fn onset(&self, predicted: bool) -> Option<(f64, f64)> {
-        let runs = self.counting_runs(predicted);
-        runs.iter()
-            .find(|r| r.persistent)
-            .map(|r| (self.blocks[r.first].end_s, self.blocks[r.first].speed_rpm))
+        self.detector(predicted).onset
     }
 
     /// The runs of consecutive counting blocks before the onset that do not persist: decaying
-    /// transients (e.g. the free vibration after a sudden unbalance), reported as such.
+    /// transients (e.g. the free vibration after a sudden unbalance), reported as such (the
+    /// first [`MAX_TRANSIENTS`]).
     pub fn transients(&self, predicted: bool) -> Vec<TransientSpan> {
-        let pick = |b: &WindowComparison| {
-            if predicted {
-                b.predicted
-            } else {
-                b.measured
-            }
-        };
-        self.counting_runs(predicted)
-            .iter()
-            .take_while(|r| !r.persistent)
-            .map(|r| {
-                let blocks = &self.blocks[r.first..=r.last];
-                TransientSpan {
-                    start_s: blocks[0].start_s,
-                    end_s: blocks[blocks.len() - 1].end_s,
-                    largest_subsync_m: blocks
-                        .iter()
-                        .map(|b| pick(b).subsync_amplitude_m)
-                        .fold(0.0, f64::max),
-                }
-            })
-            .collect()
+        self.detector(predicted).transients()
     }
 
-    /// The runs of consecutive blocks whose sub-synchronous component counts, each marked
-    /// persistent if some [`ONSET_BLOCKS`] consecutive blocks of it persist or grow (then the
-    /// run starts at the first of those).
-    fn counting_runs(&self, predicted: bool) -> Vec<CountingRun> {
-        let amp = |b: &WindowComparison| {
-            let f = if predicted { b.predicted } else { b.measured };
-            f.subsync_ratio.map(|_| f.subsync_amplitude_m)
-        };
-        let least_ratio = (-self.settings.growth_threshold_per_rev * BLOCK_REVS as f64).exp();
-        let mut runs = Vec::new();
-        let mut i = 0;
-        while i < self.blocks.len() {
-            if amp(&self.blocks[i]).is_none() {
-                i += 1;
-                continue;
-            }
-            let mut end = i;
-            while end + 1 < self.blocks.len() && amp(&self.blocks[end + 1]).is_some() {
-                end += 1;
-            }
-            let a: Vec<f64> = self.blocks[i..=end].iter().filter_map(amp).collect();
-            let start = (0..a.len().saturating_sub(ONSET_BLOCKS - 1))
-                .find(|&k| (k..k + ONSET_BLOCKS - 1).all(|j| a[j + 1] >= least_ratio * a[j]));
-            match start {
-                Some(k) => {
-                    if k > 0 {
-                        runs.push(CountingRun {
-                            first: i,
-                            last: i + k - 1,
-                            persistent: false,
-                        });
-                    }
-                    runs.push(CountingRun {
-                        first: i + k,
-                        last: end,
-                        persistent: true,
-                    });
-                }
-                None => runs.push(CountingRun {
-                    first: i,
-                    last: end,
-                    persistent: false,
-                }),
-            }
-            i = end + 1;
+    /// Transients beyond the first [`MAX_TRANSIENTS`], not reported (predicted, measured).
+    pub fn transients_dropped(&self) -> (usize, usize) {
+        (self.onset_predicted.dropped, self.onset_measured.dropped)
+    }
+
+    /// The start of the first [`ONSET_BLOCKS`] consecutive blocks whose measured
+    /// sub-synchronous semi-major axis is at or above the monitor's whip eccentricity times the
+    /// clearance (bag time, s), over every block.
+    pub fn observed_whip_start_s(&self) -> Option<f64> {
+        self.observed_whip_start_s
+    }
+
+    fn detector(&self, predicted: bool) -> &OnsetDetector {
+        if predicted {
+            &self.onset_predicted
+        } else {
+            &self.onset_measured
         }
-        runs
     }
 
     /// The order spectra (measured, predicted) of the summary window, orders 1/R … 2.

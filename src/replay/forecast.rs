@@ -1,7 +1,7 @@
 //! `replay --forecast`: the forecast ([`crate::forecast`]) run offline at bag time, every
 //! period, from a checkpoint of the replay's twin, and scored against the plant's observed onset.
 
-use super::compare::{StationComparison, ONSET_BLOCKS};
+use super::compare::StationComparison;
 use super::ReplayError;
 use crate::driver::Driver;
 use crate::forecast::schedule::{start_of, Schedule};
@@ -108,20 +108,13 @@ impl Forecasting {
 
 /// The plant's whip as its probes show it: the start of the first 8-revolution block from
 /// which the measured sub-synchronous semi-major axis stays at or above the monitor's whip
-/// eccentricity (0.75) times the clearance over [`ONSET_BLOCKS`] consecutive blocks, at any
+/// eccentricity (0.75) times the clearance over [`ONSET_BLOCKS`](super::compare::ONSET_BLOCKS) consecutive blocks, at any
 /// station (bag time, s). The probes stand for the journals: a 0.5X whip is a near-rigid
 /// conical or cylindrical whirl whose amplitude at the probes is of the journals' size (on the
 /// sample bag 39.6 µm at both stations in a 40 µm clearance).
 pub fn observed_whip_s(comparisons: &[StationComparison]) -> Option<f64> {
-    let whip = crate::monitor::ClassifierSettings::default().whip_eccentricity_ratio;
     comparisons
         .iter()
-        .filter_map(|c| {
-            let level = whip * c.clearance_m();
-            c.blocks
-                .windows(ONSET_BLOCKS)
-                .find(|w| w.iter().all(|b| b.measured.subsync_amplitude_m >= level))
-                .map(|w| w[0].start_s)
-        })
+        .filter_map(StationComparison::observed_whip_start_s)
         .min_by(f64::total_cmp)
 }

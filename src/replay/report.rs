@@ -295,6 +295,8 @@ impl ReplayReport {
             .filter(|c| c.samples > 0)
             .map(station_report)
             .collect();
+        self.notes
+            .extend(comparisons.iter().filter_map(decimation_note));
     }
 
     /// A few lines for the terminal.
@@ -499,6 +501,30 @@ fn station_report(c: &StationComparison) -> StationReport {
         mean_position_null_reason: c.mean_not_measured.clone(),
         centerline_static_predicted: Vec::new(),
     }
+}
+
+/// What the memory bound left out at station `c` (issue 17): blocks decimated in the report
+/// and plots, transients beyond the first ones; None when nothing was.
+fn decimation_note(c: &StationComparison) -> Option<String> {
+    let (p, m) = c.transients_dropped();
+    if c.block_stride == 1 && p + m == 0 {
+        return None;
+    }
+    Some(format!(
+        "{}: {} blocks of {} revolutions; the report and plots keep every {}{} ({} kept, at most {}); the onset, transients and whip are read over every block{}",
+        c.station,
+        c.blocks_seen,
+        super::compare::BLOCK_REVS,
+        c.block_stride,
+        match c.block_stride { 1 => "", 2 => "nd", _ => "th" },
+        c.blocks.len(),
+        super::compare::MAX_KEPT_BLOCKS,
+        if p + m > 0 {
+            format!("; transients beyond the first {} not listed: {p} predicted, {m} measured", super::compare::MAX_TRANSIENTS)
+        } else {
+            String::new()
+        }
+    ))
 }
 
 /// Speeds of the static-equilibrium locus of the centerline plot over a bag's speed range.
