@@ -88,7 +88,11 @@ fn the_default_grids_threshold_is_within_half_a_percent_of_the_converged_one() {
     };
     let threshold = |grid: &str| {
         let yaml = DEFAULT_MACHINE_YAML.replace("grid: 60x10", &format!("grid: {grid}"));
-        assert_eq!(yaml.matches(&format!("grid: {grid}")).count(), 2, "two bearings");
+        assert_eq!(
+            yaml.matches(&format!("grid: {grid}")).count(),
+            2,
+            "two bearings"
+        );
         let rotor = Rotor::from_description(&MachineDescription::from_yaml(&yaml, grid).unwrap());
         let st = static_solution(&rotor).unwrap();
         stability_threshold(&rotor, &st, 8000.0, 9000.0, 500.0)
