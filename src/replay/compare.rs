@@ -440,14 +440,14 @@ impl StationComparison {
         }
         let k = self.blocks_seen;
         self.blocks_seen += 1;
-        if k % self.block_stride != 0 {
+        if !k.is_multiple_of(self.block_stride) {
             return;
         }
         if self.blocks.len() == MAX_KEPT_BLOCKS {
             keep_every_other(&mut self.blocks);
             keep_every_other(&mut self.block_spectra);
             self.block_stride *= 2;
-            if k % self.block_stride != 0 {
+            if !k.is_multiple_of(self.block_stride) {
                 return;
             }
         }
