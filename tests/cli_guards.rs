@@ -418,6 +418,33 @@ fn replay_and_calibrate_reuse_their_output_directory() {
     std::fs::remove_dir_all(&out).ok();
 }
 
+/// An empty `--out` directory (as a failed run leaves one) is used as it is; a directory with
+/// a file of the user's and no earlier replay's output is refused, and the file is kept.
+#[test]
+fn an_empty_output_directory_is_used_and_a_foreign_one_refused() {
+    let out = scratch("empty-out");
+    std::fs::create_dir_all(&out).unwrap();
+    let out_s = out.to_str().unwrap();
+    let (ok, _, err) = run_cli(&["replay", "--out", out_s, "--duration", "0.05"]);
+    assert!(ok, "{err}");
+    assert!(listing(&out).contains(&"report.json".into()));
+    let foreign = scratch("foreign-out");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "the user's").unwrap();
+    let (ok, _, err) = run_cli(&[
+        "replay",
+        "--out",
+        foreign.to_str().unwrap(),
+        "--duration",
+        "0.05",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("is not a previous replay's output"), "{err}");
+    assert_eq!(listing(&foreign), ["notes.txt"]);
+    std::fs::remove_dir_all(&out).ok();
+    std::fs::remove_dir_all(&foreign).ok();
+}
+
 /// A bag of `speeds_rpm` as /rotor_twin/speed, 10 ms apart (an empty list: the topic without a
 /// message).
 fn speed_bag(name: &str, speeds_rpm: &[f64]) -> PathBuf {

@@ -566,12 +566,17 @@ const PLOT_PREFIXES: [&str; 8] = [
 ];
 
 /// Creates `dir`, or clears a previous replay's output in it (its bag, report or calibration and
-/// plots, so that no file of an earlier run is left beside the new ones; a directory holding
-/// neither `report.json` nor `calibration.json` is refused, so nothing of the user's is
-/// overwritten).
+/// plots, so that no file of an earlier run is left beside the new ones; an empty directory, such
+/// as a failed run leaves, is used as it is; any other directory holding neither `report.json`
+/// nor `calibration.json` is refused, so nothing of the user's is overwritten).
 fn prepare_out_dir(dir: &Path) -> anyhow::Result<()> {
     if !dir.exists() {
         return std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()));
+    }
+    let mut listing =
+        std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
+    if listing.next().is_none() {
+        return Ok(());
     }
     anyhow::ensure!(
         OUTPUT_FILES.iter().any(|f| dir.join(f).exists()),
