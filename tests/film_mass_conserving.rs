@@ -147,14 +147,7 @@ fn a_whirling_journal_conserves_the_fluid_step_by_step() {
         Cavitation::MassConserving,
     );
     let w = OMEGA_9000_RPM;
-    let orbit = |t: f64| {
-        let (s, c) = (0.5 * w * t).sin_cos();
-        JournalKinematics {
-            position_m: [C * (0.5 + 0.3 * c), C * 0.3 * s],
-            velocity_m_s: [-C * 0.3 * 0.5 * w * s, C * 0.3 * 0.5 * w * c],
-            speed_rad_s: w,
-        }
-    };
+    let orbit = |t: f64| half_speed_whirl(C, w, t);
     mc.solve(&orbit(0.0)).unwrap();
     let dt = 2.0 * PI / w / 100.0;
     mc.set_time_step(Some(dt)).unwrap();

@@ -35,14 +35,7 @@ fn whirl(per_rev: usize) -> (f64, f64, f64) {
         .unwrap()
         .with_cavitation(Cavitation::MassConserving);
     let w = OMEGA_9000_RPM;
-    let orbit = |t: f64| {
-        let (s, c) = (0.5 * w * t).sin_cos();
-        JournalKinematics {
-            position_m: [C * (0.5 + 0.3 * c), C * 0.3 * s],
-            velocity_m_s: [-C * 0.3 * 0.5 * w * s, C * 0.3 * 0.5 * w * c],
-            speed_rad_s: w,
-        }
-    };
+    let orbit = |t: f64| half_speed_whirl(C, w, t);
     mc.solve(&orbit(0.0)).unwrap();
     let dt = 2.0 * PI / w / per_rev as f64;
     let v0 = mc.fluid_volume_m3();

@@ -276,3 +276,15 @@ pub const ECC_BANDS: [(f64, f64); 8] = [
     (0.95, 0.98),
     (0.98, 0.995),
 ];
+
+/// A journal whirling forward at half the shaft speed `w` (rad/s) on a circle of 0.3 c about
+/// ε 0.5 (c = `clearance_m`), at time `t_s`: the mass-conserving film tests' orbit.
+pub fn half_speed_whirl(clearance_m: f64, w: f64, t_s: f64) -> JournalKinematics {
+    let c = clearance_m;
+    let (s, k) = (0.5 * w * t_s).sin_cos();
+    JournalKinematics {
+        position_m: [c * (0.5 + 0.3 * k), c * 0.3 * s],
+        velocity_m_s: [-c * 0.3 * 0.5 * w * s, c * 0.3 * 0.5 * w * k],
+        speed_rad_s: w,
+    }
+}
