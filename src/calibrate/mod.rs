@@ -29,7 +29,7 @@ pub use unbalance::{
 };
 pub use viscosity::{
     estimate_viscosity, estimate_viscosity_under_orbits, static_probe_positions, JournalOrbits,
-    ViscosityEstimate, ORBIT_POINTS,
+    ViscosityEstimate, ORBIT_POINTS, VISCOSITY_MODEL_FLOOR,
 };
 
 use serde::Serialize;

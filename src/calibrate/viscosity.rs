@@ -3,8 +3,11 @@
 //! the eccentricity and attitude where the film carries the static load, and at fixed geometry
 //! that position depends on µΩ only (the Sommerfeld number, seed eq. 2 isoviscous), so the
 //! positions over a speed range fix µ. The scale s = µ / µ_reference is fitted by Gauss–Newton
-//! in ln s; its standard uncertainty is σ_r / |∂d/∂s| from the residual σ_r and the slope
-//! (the usual linearised least-squares covariance). The probe's zero is taken to be the
+//! in ln s. Its standard uncertainty combines the fit's own, σ_r / |∂d/∂s| from the residual
+//! σ_r and the slope (the usual linearised least-squares covariance, which shrinks as 1/√N
+//! with the number of mean positions whatever their common model error), with a stated model
+//! floor [`VISCOSITY_MODEL_FLOOR`] in quadrature (GUM's root sum of squares of independent
+//! components). The probe's zero is taken to be the
 //! bearing centre's axis (probes referenced to the bearing; the synthetic plant's are).
 //!
 //! Under a 1X orbit the mean journal position is not the static equilibrium: the film force is
@@ -27,6 +30,16 @@ use crate::rotor::{static_solution, BearingModel, Rotor, StaticSolution};
 use faer::c64;
 use serde::Serialize;
 
+/// The model's own relative standard uncertainty of the viscosity scale (a Type B component,
+/// GUM 4.3): 0.5 %. What the data's residual cannot show because every mean position shares it:
+/// the films' grid (the plant's static equilibrium on 72 × 12, 90 × 15 and 120 × 20 films fitted
+/// by the twin on 60 × 10: +0.08, +0.15 and +0.21 %, README "Why the live viscosity fit was
+/// 2.4 % high") and the orbit-averaged model (the linear model's orbits of the fitted
+/// unbalance; the fit on the plant of tests/live_calibration.rs reads +0.38 %, of which the grid
+/// +0.08 %). Before, the reported ± was the fit's alone: × 1.0514 ± 0.0002 for a plant's 1.05
+/// (7σ off), × 1.1042 ± 0.0016 for 1.10 (2.6σ off).
+pub const VISCOSITY_MODEL_FLOOR: f64 = 0.005;
+
 /// Points per orbit of the orbit-averaged equilibrium: 16 (the mean force of a 1X orbit of
 /// 0.5 c at ε 0.55 changes by under 1e-6 of the load from 16 to 32 points, the integrand being
 /// smooth and periodic).
@@ -47,8 +60,12 @@ pub struct JournalOrbits {
 pub struct ViscosityEstimate {
     /// µ / µ_reference (the machine file's viscosity_pa_s).
     pub scale: f64,
-    /// Its standard uncertainty (1σ).
+    /// Its standard uncertainty (1σ): the fit's own ([`Self::fit_std`]) and the model floor
+    /// [`VISCOSITY_MODEL_FLOOR`] × scale in quadrature.
     pub scale_std: f64,
+    /// The fit's own standard uncertainty (1σ, from the residual and the slope): noise and the
+    /// part of the model error that differs from one mean position to the next.
+    pub fit_std: f64,
     /// The effective viscosity µ (Pa·s) of the first film bearing.
     pub viscosity_pa_s: f64,
     /// The oil temperature the law gives for it (°C), if the machine file has a law and the
@@ -278,13 +295,15 @@ pub fn estimate_viscosity_under_orbits(
     let dof = (2 * measured.len()).saturating_sub(1).max(1) as f64;
     let sigma_r = (rss / dof).sqrt();
     // d(model)/d(ln s) = s d(model)/ds: σ_s = s σ_ln s
-    let scale_std = scale * sigma_r / slope.sqrt().max(f64::MIN_POSITIVE);
+    let fit_std = scale * sigma_r / slope.sqrt().max(f64::MIN_POSITIVE);
+    let scale_std = fit_std.hypot(VISCOSITY_MODEL_FLOOR * scale);
     let mu = reference.lubricant.viscosity_pa_s * scale;
     let (temperature_c, temperature_std_k, temperature_offset_k) =
         temperature_of(reference, mu, scale_std / scale);
     Ok(ViscosityEstimate {
         scale,
         scale_std,
+        fit_std,
         viscosity_pa_s: mu,
         temperature_c,
         temperature_std_k,
