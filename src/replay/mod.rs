@@ -13,7 +13,9 @@ mod report;
 
 pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
 
-pub use report::{CenterlineStatic, OnsetReport, ReplayReport, StateChange, StationReport};
+pub use report::{
+    CenterlineStatic, OilReport, OnsetReport, ReplayReport, StateChange, StationReport,
+};
 
 use crate::bag::{Bag, BagMessage};
 use crate::driver::{settings, Driver, DriverSettings, Fed, Input, SpeedUnit};
@@ -339,6 +341,12 @@ impl Replaying {
         }
         report.finish(&comparisons, wall.elapsed().as_secs_f64());
         report.heat_balance = driver.heat_balance_report();
+        report.oil = driver.oil_temperature_k().map(|t| report::OilReport {
+            supply_temperature_c: t - crate::film::ZERO_CELSIUS_K,
+            viscosity_scales: (driver.film_oil().into_iter())
+                .map(|f| (f.name, f.viscosity_scale))
+                .collect(),
+        });
         report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
         if let Some(out) = out {
             report.messages_out = out.finish()?;

@@ -183,6 +183,19 @@ pub struct ReplayReport {
     /// last good viscosity in force.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub heat_balance: Option<crate::driver::HeatBalanceReport>,
+    /// The oil in force at the end (issue 12; absent when no oil supply temperature was
+    /// accepted): the last supply temperature and each film bearing's viscosity scale.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub oil: Option<OilReport>,
+}
+
+/// The oil in force at the end of a replay (issue 12).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct OilReport {
+    /// The last oil supply temperature accepted (°C).
+    pub supply_temperature_c: f64,
+    /// Per film bearing: its name and viscosity scale in force (µ / µ of the machine file).
+    pub viscosity_scales: Vec<(String, f64)>,
 }
 
 impl ReplayReport {
@@ -202,6 +215,7 @@ impl ReplayReport {
             states: Vec::new(),
             forecast: None,
             heat_balance: None,
+            oil: None,
         }
     }
 
@@ -325,6 +339,13 @@ impl ReplayReport {
                 h.balances,
                 h.last_failure.as_deref().unwrap_or("")
             );
+        }
+        if let Some(oil) = &self.oil {
+            s += &format!("oil supply {:.2} degC: viscosity", oil.supply_temperature_c);
+            for (name, k) in &oil.viscosity_scales {
+                s += &format!(" x{k:.5} ({name})");
+            }
+            s += "\n";
         }
         for st in &self.stations {
             s += &station_lines(st);
