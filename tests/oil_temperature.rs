@@ -3,6 +3,8 @@
 //! viscosity through the machine file's law; bad temperatures are refused and reported, the last
 //! good value kept.
 
+mod common;
+
 use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind};
 use rotor_twin::dynamics::FilmEvaluation;
 use rotor_twin::film::{
@@ -281,4 +283,95 @@ fn a_calibrated_viscosity_follows_later_oil_temperatures() {
     assert!((d.viscosity_scale() / expected - 1.0).abs() < 1e-9);
     d.revert_calibration().unwrap();
     assert!((twin(&d) / s_law(60.0) - 1.0).abs() < 1e-9);
+}
+
+/// Issue 12 (referee's gap 2): a bag written by PyPI rosbags (tests/interop/write_signal_bag.py,
+/// not our writer) in standard types only — std_msgs/Header keyphasor, std_msgs/Float64 raw
+/// probes (µm, AC), sensor_msgs/Temperature at 55 °C ten times a second, then one NaN — replayed
+/// with remaps (/plant/keyphasor and /plant/oil_temperature onto the twin's topics, the probes
+/// by `probe_signals`). The report's oil is 55 °C and each film's scale the one the driver sets
+/// for 55 °C offline (to 1e-12: the same law, the same arithmetic); the NaN is refused (one
+/// rejection on the oil topic) and the 55 °C kept. The scale moves off 1 by more than 10 %, so
+/// a temperature not read would fail.
+#[test]
+fn a_rosbags_bag_carries_the_oil_temperature_into_the_replay() {
+    use rotor_twin::bag::Bag;
+    use rotor_twin::dynamics::Coupling;
+    use rotor_twin::replay::{replay, ReplayOptions};
+    use rotor_twin::rotor::DEFAULT_MACHINE_YAML;
+    let dir = std::env::temp_dir().join(format!("rotor-twin-oil-bag-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    common::interop_script(
+        "write_signal_bag.py",
+        [
+            dir.as_os_str(),
+            "0.4".as_ref(),
+            "8000".as_ref(),
+            "--oil-temperature-c".as_ref(),
+            "55".as_ref(),
+        ],
+    );
+    let mut yaml = format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n");
+    for station in ["probe_pulley_end", "probe_outboard"] {
+        for (suffix, angle) in [("x", 45.0), ("y", 135.0)] {
+            yaml += &format!(
+                "  - {{name: {station}_{suffix}, station: {station}, angle_deg: {angle}, unit: um, coupling: ac}}\n"
+            );
+        }
+    }
+    let rotor = Rotor::from_description(&MachineDescription::from_yaml(&yaml, "raw.yaml").unwrap());
+    let mut options = ReplayOptions {
+        coupling: Coupling::Nonlinear,
+        film: FilmEvaluation::Direct,
+        remaps: vec![
+            ("/plant/keyphasor".into(), "/rotor_twin/keyphasor".into()),
+            (
+                "/plant/oil_temperature".into(),
+                "/rotor_twin/oil_temperature".into(),
+            ),
+        ],
+        ..ReplayOptions::default()
+    };
+    for station in ["probe_pulley_end", "probe_outboard"] {
+        for suffix in ["x", "y"] {
+            let name = format!("{station}_{suffix}");
+            options.probe_signals.push((format!("/plant/{name}"), name));
+        }
+    }
+    let bag = Bag::read(&dir).unwrap();
+    let report = replay(&bag, &rotor, &options, &mut |_| {}).unwrap().0;
+    std::fs::remove_dir_all(&dir).ok();
+    println!("{}", report.summary());
+    let oil = report
+        .oil
+        .as_ref()
+        .expect("the replay read no oil temperature");
+    let mut d = Driver::new(
+        rotor.clone(),
+        DriverSettings::new(
+            ModelKind::Linear,
+            FilmEvaluation::Direct,
+            rotor.rated_speed_rad_s,
+        ),
+    );
+    assert_eq!(d.feed(0, temperature(55.0), &mut |_| {}), Fed::Taken);
+    let offline = d.film_oil();
+    println!(
+        "replay: oil {:.2} °C, scales {:?}; offline driver {:?}",
+        oil.supply_temperature_c, oil.viscosity_scales, offline
+    );
+    assert!((oil.supply_temperature_c - 55.0).abs() < 1e-9);
+    assert_eq!(oil.viscosity_scales.len(), offline.len());
+    for ((name, s), f) in oil.viscosity_scales.iter().zip(&offline) {
+        assert_eq!(name, &f.name);
+        assert!((s - f.viscosity_scale).abs() < 1e-12, "{name}: {s}");
+        assert!((s - 1.0).abs() > 0.1, "{name}: × {s} at 55 °C");
+    }
+    let refused: Vec<_> = report
+        .rejected
+        .iter()
+        .filter(|r| r.topic == "/plant/oil_temperature")
+        .collect();
+    assert_eq!(refused.len(), 1, "{:?}", report.rejected);
+    assert_eq!(refused[0].count, 1, "{:?}", refused[0]);
 }

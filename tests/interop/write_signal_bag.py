@@ -6,7 +6,10 @@ speed topic. The shaft whirls on a forward 1X circle of 2 µm radius lagging the
 BETA = 50°, so the probe at angle α (45° and 135°) reads a displacement 2 µm·cos(ψ − (BETA + α)):
 its phase lag is BETA + α. The gap is 1000 µm minus that displacement.
 
-Usage: write_signal_bag.py OUT_DIR SECONDS SPEED_RPM
+With --oil-temperature-c C also sensor_msgs/Temperature (°C) on /plant/oil_temperature, 10 a
+second at C, then one NaN 1 ms after the last (a bad sample the replay must refuse, keeping C).
+
+Usage: write_signal_bag.py OUT_DIR SECONDS SPEED_RPM [--oil-temperature-c C]
 Prints the message counts per topic as JSON.
 """
 import json
@@ -22,6 +25,9 @@ out, seconds, rpm = Path(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])
 store = get_typestore(Stores.ROS2_JAZZY)
 Float64 = store.types["std_msgs/msg/Float64"]
 Header = store.types["std_msgs/msg/Header"]
+Temperature = store.types["sensor_msgs/msg/Temperature"]
+oil_c = float(sys.argv[sys.argv.index("--oil-temperature-c") + 1]) \
+    if "--oil-temperature-c" in sys.argv else None
 Time = store.types["builtin_interfaces/msg/Time"]
 
 t0 = 1_767_225_600_000_000_000  # 2026-01-01T00:00:00Z, ns
@@ -47,6 +53,18 @@ while k * dt <= seconds:
         d_um = 2.0 * math.cos(psi - lag)
         events.append((ns, topic, Float64(data=1000.0 - d_um), "std_msgs/msg/Float64"))
     k += 1
+if oil_c is not None:
+    k, values = 0, []
+    while k * 0.1 <= seconds:
+        values.append((t0 + round(k * 0.1e9), oil_c))
+        k += 1
+    values.append((values[-1][0] + 1_000_000, float("nan")))
+    for ns, c in values:
+        stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+        events.append((ns, "/plant/oil_temperature",
+                       Temperature(header=Header(stamp=stamp, frame_id="oil_supply"),
+                                   temperature=c, variance=0.0),
+                       "sensor_msgs/msg/Temperature"))
 events.sort(key=lambda e: e[0])
 
 counts = {}
@@ -54,6 +72,9 @@ with Writer(out, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
     conns = {"/plant/keyphasor": writer.add_connection("/plant/keyphasor", "std_msgs/msg/Header", typestore=store)}
     for topic, _ in probes:
         conns[topic] = writer.add_connection(topic, "std_msgs/msg/Float64", typestore=store)
+    if oil_c is not None:
+        conns["/plant/oil_temperature"] = writer.add_connection(
+            "/plant/oil_temperature", "sensor_msgs/msg/Temperature", typestore=store)
     for ns, topic, msg, msgtype in events:
         writer.write(conns[topic], ns, store.serialize_cdr(msg, msgtype))
         counts[topic] = counts.get(topic, 0) + 1
