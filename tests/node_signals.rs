@@ -10,12 +10,18 @@ use rotor_twin::rotor::DEFAULT_MACHINE_YAML;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
-/// The built-in machine with AC-coupled raw probes in µm at 45° and 135° at probe_outboard.
-fn machine(out: &Path) -> PathBuf {
+/// The built-in machine with raw probes in µm at 45° and 135° at probe_outboard, AC-coupled, or
+/// DC-coupled about a 1,000 µm gap with `dc`.
+fn machine(out: &Path, dc: bool) -> PathBuf {
+    let coupling = if dc {
+        "dc, reference_gap: 1000.0"
+    } else {
+        "ac"
+    };
     let mut yaml = format!("{DEFAULT_MACHINE_YAML}\nproximity_probes:\n");
     for (suffix, angle) in [("x", 45.0), ("y", 135.0)] {
         yaml += &format!(
-            "  - {{name: probe_outboard_{suffix}, station: probe_outboard, angle_deg: {angle}, unit: um, coupling: ac}}\n"
+            "  - {{name: probe_outboard_{suffix}, station: probe_outboard, angle_deg: {angle}, unit: um, coupling: {coupling}}}\n"
         );
     }
     let path = out.join("machine.yaml");
@@ -24,9 +30,15 @@ fn machine(out: &Path) -> PathBuf {
 }
 
 /// Runs tests/interop/signal_scenario.sh (SECONDS RPM STOP_KEYPHASOR_AFTER LOSS_PER_MILLE
-/// UNAPPLY_AFTER) and
+/// UNAPPLY_AFTER OIL) and
 /// returns (peer.json, recorded.json, the node's log).
-fn scenario(name: &str, args: [&str; 5]) -> (Value, Value, String) {
+fn scenario(name: &str, args: [&str; 6]) -> (Value, Value, String) {
+    scenario_with(name, args, None)
+}
+
+/// [`scenario`] with DC-coupled probes and the peer's plant (signal_peer.py `--plant`) when
+/// `plant` (its JSON) is given.
+fn scenario_with(name: &str, args: [&str; 6], plant: Option<Value>) -> (Value, Value, String) {
     // one scenario at a time: two nodes and two peers side by side starve the pairing of
     // unstamped Float64 readings on two cores
     static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
@@ -34,8 +46,13 @@ fn scenario(name: &str, args: [&str; 5]) -> (Value, Value, String) {
     let py = common::python();
     let run = Scenario::new(name);
     let mut all = vec![py.into_os_string(), run.out.clone().into_os_string()];
-    all.push(machine(&run.out).into_os_string());
+    all.push(machine(&run.out, plant.is_some()).into_os_string());
     all.extend(args.map(Into::into));
+    if let Some(p) = plant {
+        let path = run.out.join("plant.json");
+        std::fs::write(&path, p.to_string()).unwrap();
+        all.push(path.into_os_string());
+    }
     run.run("signal_scenario.sh", all);
     let read = |file: &str| run.json(file, &["node.err", "peer.err"]);
     let got = (
@@ -67,7 +84,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// warns "keyphasor stopped"; the amplitudes go on.
 #[test]
 fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
-    let (peer, rec, log) = scenario("signals", ["6", "1500", "4", "0", "4.5"]);
+    let (peer, rec, log) = scenario("signals", ["6", "1500", "4", "0", "4.5", "0"]);
     let blocks = peer["one_x"].as_array().unwrap();
     let stop = peer["keyphasor_stopped_at_s"].as_f64().unwrap();
     let (mut gaps, mut amps, mut null) = ([Vec::new(), Vec::new()], Vec::new(), 0);
@@ -166,7 +183,7 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
 /// Before, such losses were invisible (`dropped_messages 0`).
 #[test]
 fn every_sample_lost_on_a_best_effort_link_is_counted() {
-    let (peer, rec, _) = scenario("signal-loss", ["6", "1500", "100", "50", "0"]);
+    let (peer, rec, _) = scenario("signal-loss", ["6", "1500", "100", "50", "0", "0"]);
     let d = &rec["diagnostics"];
     println!("{d}");
     let mut lost_all = 0;
@@ -194,4 +211,149 @@ fn every_sample_lost_on_a_best_effort_link_is_counted() {
         lost_all += lost;
     }
     assert_eq!(d["lost_samples"].as_str().unwrap(), lost_all.to_string());
+}
+
+/// The viscosity scale the driver sets for an oil supply temperature (°C) on the node's machine
+/// (the built-in law, config/orc_microturbine_100kw.yaml), fed offline as tests/oil_temperature.rs
+/// feeds it: the reference for the node's /diagnostics.
+fn offline_scale(celsius: f64) -> f64 {
+    use rotor_twin::driver::{Driver, DriverSettings, Fed, Input, ModelKind};
+    use rotor_twin::messages::{Header, Temperature, Time};
+    let rotor = rotor_twin::rotor::Rotor::from_description(
+        &rotor_twin::rotor::MachineDescription::builtin_default(),
+    );
+    let settings = DriverSettings::new(
+        ModelKind::Linear,
+        rotor_twin::dynamics::FilmEvaluation::Direct,
+        rotor.rated_speed_rad_s,
+    );
+    let mut d = Driver::new(rotor, settings);
+    let t = Input::from(&Temperature {
+        header: Header {
+            stamp: Time::from_nanos(0),
+            frame_id: String::new(),
+        },
+        temperature: celsius,
+        variance: 0.0,
+    });
+    assert_eq!(d.feed(0, t, &mut |_| {}), Fed::Taken);
+    d.viscosity_scale()
+}
+
+/// Issue 12 (referee's gap 2): sensor_msgs/Temperature (°C) through DDS from the independent
+/// Cyclone peer, best effort, on /plant/oil_temperature (the node's rotor_twin/oil_temperature
+/// remapped): 60 °C for the first 3 s, then 50 °C, then one NaN and one 1,000 °C and nothing
+/// more. The node's viscosity in force, as its /diagnostics (status `<node>: model`) reports it
+/// per film bearing, moves to the driver's scale for 60 °C (× 0.8114 on the built-in law) and
+/// then 50 °C, each equal to the offline driver's to the 5 decimals printed; the NaN and the
+/// absurd value are refused, counted (`refused_inputs` ≥ 2) and warned about (`bad_input`
+/// naming the temperature), and the last good 50 °C stays in force; every Temperature sent is
+/// recorded as received.
+#[test]
+fn a_best_effort_temperature_on_the_bus_sets_the_viscosity_and_bad_ones_are_refused() {
+    let (peer, rec, _) = scenario("signal-oil", ["6", "1500", "100", "0", "0", "1"]);
+    let oil = rec["oil"].as_array().unwrap();
+    println!("oil in force over the run: {oil:?}");
+    println!(
+        "inputs: {}; warnings: {}",
+        rec["diagnostics"], peer["warnings"]
+    );
+    let key = "viscosity_scale bearing_pulley_end";
+    let scale = |v: &Value| v[key].as_str().unwrap().parse::<f64>().unwrap();
+    let (hot, warm) = (offline_scale(60.0), offline_scale(50.0));
+    println!("offline driver: × {hot:.5} at 60 °C, × {warm:.5} at 50 °C");
+    let seen = |c: &str, s: f64| {
+        oil.iter().any(|v| {
+            v["oil_supply_temperature_c"].as_str() == Some(c) && (scale(v) - s).abs() < 1e-5
+        })
+    };
+    assert!(seen("60.00", hot), "60 °C never in force: {oil:?}");
+    assert!(seen("50.00", warm), "50 °C never in force: {oil:?}");
+    let last = oil.last().unwrap();
+    assert_eq!(last["oil_supply_temperature_c"], "50.00", "{oil:?}");
+    assert!((scale(last) - warm).abs() < 1e-5, "{last}");
+    assert!(
+        (hot - 1.0).abs() > 0.1,
+        "60 °C must move the viscosity: × {hot}"
+    );
+    let refused: u64 = rec["diagnostics"]["refused_inputs"]
+        .as_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(refused >= 2, "{refused} refused");
+    let bad = peer["warnings"]["bad_input"].to_string();
+    assert!(bad.contains("temperature"), "{bad}");
+    // recorded under the node's topic name (the remap's target), as the keyphasor is
+    assert_eq!(
+        rec["counts"]["/rotor_twin/oil_temperature"],
+        peer["sent"]["/plant/oil_temperature"]
+    );
+}
+
+/// Issue 12 (referee's gap 1), what a short run through the bus reaches: the live viscosity
+/// calibration from DC-coupled raw probes published BEST EFFORT by the independent Cyclone peer
+/// (std_msgs/Float64, µm, about a 1,000 µm gap at 45° and 135° at probe_outboard). The plant is
+/// the one of tests/live_calibration.rs statically (oil × 1.10, films on 72 × 12 instead of the
+/// twin's 60 × 10): its journal's mean position at 1,500, 2,500 and 3,500 rpm
+/// (`calibrate::static_probe_positions` of the plant's machine), 2.5 s each, is the probes' DC
+/// part; a forward 1X circle of 2 µm (the peer's) rides on it, and the keyphasor marks each
+/// revolution. The node (`calibration_period_s:=2`) publishes its estimate on
+/// /rotor_twin/calibration (recorded): the viscosity × 1.10 within 3 % (the issue's), from at least
+/// 3 mean positions. Not asserted: the unbalance (the peer's 1X circle is not the plant's
+/// unbalance response: a Float64 is timed by its receive time, so the plant's own 1X at its
+/// 5,000–8,000 rpm would need stamped samples, and its nonlinear transient a minute of solving
+/// per speed; tests/live_calibration.rs checks it through the driver); the speeds are low for the
+/// same reason (16 samples a revolution from Python: 930 Hz at 3,500 rpm).
+#[test]
+fn the_node_calibrates_the_viscosity_from_best_effort_dc_probes_of_an_independent_peer() {
+    use common::calibration::{plant_rotor, twin_rotor};
+    let plant = plant_rotor(&twin_rotor());
+    let station = plant
+        .probes
+        .iter()
+        .position(|p| p.name == "probe_outboard")
+        .unwrap();
+    let mut segments = Vec::new();
+    for (k, rpm) in [1500.0f64, 2500.0, 3500.0].into_iter().enumerate() {
+        let w = rpm * std::f64::consts::PI / 30.0;
+        let xy = rotor_twin::calibrate::static_probe_positions(&plant, 1.0, w).unwrap()[station];
+        let along = |deg: f64| {
+            let a = deg.to_radians();
+            1e6 * (xy[0] * a.cos() + xy[1] * a.sin())
+        };
+        println!(
+            "plant at {rpm} rpm: mean position {:.3} / {:.3} µm along the probes",
+            along(45.0),
+            along(135.0)
+        );
+        segments.push(serde_json::json!({
+            "t_s": 2.5 * k as f64, "rpm": rpm, "dc_um": [along(45.0), along(135.0)]
+        }));
+    }
+    let plant_json = serde_json::json!({ "segments": segments });
+    let (peer, rec, log) = scenario_with(
+        "signal-calib",
+        ["8", "1500", "100", "0", "0", "0"],
+        Some(plant_json),
+    );
+    let cal = &rec["calibration"];
+    println!("calibration: {cal}; inputs {}", rec["diagnostics"]);
+    println!(
+        "{} 1X blocks received by the peer",
+        peer["one_x"].as_array().unwrap().len()
+    );
+    assert_eq!(cal["viscosity_valid"], true, "{cal}\n{log}");
+    let (s, sigma) = (
+        cal["viscosity_scale"].as_f64().unwrap(),
+        cal["viscosity_scale_std"].as_f64().unwrap(),
+    );
+    println!(
+        "viscosity × {s:.4} ± {sigma:.4} for the plant's × 1.10 ({:+.2} %, {:+.2} σ), from {} mean positions",
+        100.0 * (s / 1.10 - 1.0),
+        (s - 1.10) / sigma,
+        cal["positions"]
+    );
+    assert!(cal["positions"].as_u64().unwrap() >= 3, "{cal}");
+    assert!((s / 1.10 - 1.0).abs() < 0.03, "{cal}");
 }
