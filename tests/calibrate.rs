@@ -90,6 +90,8 @@ fn viscosity_then_unbalance_are_recovered_from_a_plant_that_differs() {
         v.scale
     );
     assert!(v.scale_std > 0.0 && v.scale_std < 0.03, "σ {}", v.scale_std);
+    // covered at 1.3σ, by the fit's own σ: 6 mean positions whose residual carries the orbit
+    // bias (the replay test below, 21 positions, shows the static fit uncovered)
     assert_covers("static fit, plant × 1.10", &v, 1.10);
     // the built-in law: 10 % more viscous is a cooler oil, about 9 K below the 40 °C design
     let offset = v.temperature_offset_k.unwrap();
@@ -323,7 +325,13 @@ fn replay_calibrate_fits_the_viscosity_under_the_orbits() {
     );
     assert!(vectors.len() >= 8, "{} 1X vectors", vectors.len());
     assert!((v.scale / 1.10 - 1.0).abs() < 0.03, "{v:?}");
-    assert_covers("replay, static fit, plant × 1.10", &before, 1.10);
+    // the static fit alone (no orbit model; no longer what `--calibrate` reports) is not
+    // covered here: its orbit bias, +2.6 %, is beyond the model floor (printed, not asserted)
+    let e = before.scale - 1.10;
+    println!(
+        "replay, static fit: error {e:+.4} = {:+.2} σ (not covered: the orbit bias)",
+        e / before.scale_std
+    );
     assert_covers("replay, orbit-averaged fit, plant × 1.10", v, 1.10);
     assert!(
         (v.scale - 1.10).abs() < (before.scale - 1.10).abs(),
