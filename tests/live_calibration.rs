@@ -514,8 +514,15 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// replay's rule (`StationComparison::onset`, the earlier station) from the measured (the plant,
 /// direct film) and the predicted signals. The reference: the twin of the plant's own machine,
 /// through the same driver, tabulated film and keyphasor lock, predicts the plant's onset within
-/// the 30 rpm (measured 0 rpm). The calibrated twin does not (measured −616 rpm; on its
-/// 60 × 10 films even the plant's exact oil and unbalance give −458 rpm): printed, see README.
+/// the 30 rpm (measured +21 rpm). The calibrated twin takes the estimate over
+/// `CALIBRATION_BLEND_S` (1 s): measured −107 rpm (before calibration −128), asserted within
+/// 150 rpm (the −107 and the spread of the onset with the seed: 48 against 100 revolutions of
+/// blend move it 83 rpm, `tests/onset_scratch.rs`). Taken at once, as before session 13, the
+/// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
+/// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
+/// is not met by the run-up onset (README, "The onset after a live calibration": it moves
+/// ~80 rpm per e-fold of the whirl's seed, ~+250 rpm per doubling of the run-up rate); the
+/// linear threshold the node publishes is (+4 rpm, `predicted_onset_after_calibration`).
 #[test]
 fn nonlinear_onset_after_live_calibration() {
     let twin = twin_rotor();
@@ -554,6 +561,7 @@ fn nonlinear_onset_after_live_calibration() {
     // one start each: the twins ran the plant's whole history
     assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 1));
     assert!((own - plant).abs() < 30.0);
+    assert!((after - plant).abs() < 150.0);
 }
 
 /// The twin's films on `n_theta × n_z`.
