@@ -214,7 +214,12 @@ fn onset_switch() {
     let hi = 9400.0;
     let mut config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, hi * PI / 30.0, 64);
     config.film = FilmEvaluation::Table;
-    let mut twin = Twin::new(&twin_r, config, w8).unwrap();
+    let w0 = if std::env::var("ONSET_PRE").is_ok() {
+        num("ONSET_PRE", 8000.0) * PI / 30.0
+    } else {
+        w8
+    };
+    let mut twin = Twin::new(&twin_r, config, w0).unwrap();
     // the values at fraction f of the way from the machine file's to the estimate's
     let set = |twin: &mut Twin, f: f64| {
         if unb {
@@ -231,7 +236,11 @@ fn onset_switch() {
     let mut monitor = Monitor::new(&twin, 128, ClassifierSettings::default());
     let cls = ClassifierSettings::default();
     let c = twin.bearing_clearances_m()[0];
-    let t_hold = hold_revs * 60.0 / 8000.0;
+    // ONSET_PRE: first 24.5 revolutions at that speed, then 8,000 rpm at once (the speed steps
+    // of tests/live_calibration.rs's plant)
+    let pre = num("ONSET_PRE", 0.0);
+    let t_pre = if pre > 0.0 { 24.5 * 60.0 / pre } else { 0.0 };
+    let t_hold = t_pre + hold_revs * 60.0 / 8000.0;
     let t_blend = blend_revs * 60.0 / 8000.0;
     let t_end = t_hold + (hi - 8000.0) / rate;
     let h = twin.config().time_step_s;
@@ -243,7 +252,9 @@ fn onset_switch() {
             "blend" if t >= t_hold => set(&mut twin, ((t - t_hold) / t_blend).min(1.0)),
             _ => {}
         }
-        let rpm = if t < t_hold {
+        let rpm = if t < t_pre {
+            pre
+        } else if t < t_hold {
             8000.0
         } else {
             8000.0 + rate * (t + 0.5 * h - t_hold)
@@ -268,7 +279,7 @@ fn onset_switch() {
         }
     }
     let label = format!(
-        "switch {apply} unb {unb} visc {vis} rate {rate} hold {hold_revs} blend {blend_revs}"
+        "switch {apply} unb {unb} visc {vis} rate {rate} hold {hold_revs} blend {blend_revs} pre {pre}"
     );
     for k in (0..per_rev.len()).step_by(16) {
         println!(
