@@ -5,7 +5,9 @@
 //! ONSET_ROTOR = plant | calibrated | machine; ONSET_GRID = 60x10; ONSET_FILM = table | direct;
 //! ONSET_MODE = ramp | const | updown; ONSET_RATE (rpm/s); ONSET_FROM, ONSET_TO (rpm);
 //! ONSET_RPM (const speed); ONSET_VISC (a further viscosity factor); ONSET_KICK (N·s in x and y
-//! at the stage-7 node at ONSET_KICK_T s, 0 = none); ONSET_REVS (revolutions after the ramp).
+//! at the stage-7 node at ONSET_KICK_T s, 0 = none); ONSET_REVS (revolutions after the ramp);
+//! ONSET_SPR (time steps a revolution at ONSET_TO, 64). `onset_switch` (the calibration applied
+//! mid-run): ONSET_APPLY, ONSET_BLEND, ONSET_HOLD, ONSET_PRE, ONSET_STAIR_MS, ONSET_LOCK (its doc).
 //! The film tables go to the disk cache (`ROTOR_TWIN_CACHE_DIR`).
 
 mod common;
@@ -95,7 +97,7 @@ fn onset_scratch() {
         speed_rpm: num("ONSET_RPM", lo),
         revolutions: num("ONSET_REVS", 8.0) as usize,
         coupling: Coupling::Nonlinear,
-        steps_per_rev: 64,
+        steps_per_rev: num("ONSET_SPR", 64.0) as usize,
         grid: Some(grid),
         film,
     };
@@ -126,10 +128,11 @@ fn onset_scratch() {
     let onset = (0..per_rev.len())
         .find(|&k| k + 24 <= per_rev.len() && per_rev[k..k + 24].iter().all(|p| p.2));
     let label = format!(
-        "{} {g} {:?} {mode} rate {rate} rpm {} kick {kick}",
+        "{} {g} {:?} {mode} rate {rate} rpm {} kick {kick} spr {}",
         env("ONSET_ROTOR", "plant"),
         film,
-        spec.speed_rpm
+        spec.speed_rpm,
+        spec.steps_per_rev
     );
     // the growth per revolution over 16-revolution windows (ln A slope) while A is above the
     // floor and below 20 % c
@@ -184,8 +187,11 @@ fn onset_scratch() {
 /// The twin (machine file, 60 × 10 table) at 8,000 rpm for ONSET_HOLD revolutions, then the
 /// live estimate (275.4 g·mm at 118.6° at stage 7, none at stage 4, viscosity × 1.1042) applied
 /// as ONSET_APPLY = step | start (from t = 0) | blend (linearly over ONSET_BLEND revolutions,
-/// from the hold's end on), then the run-up at ONSET_RATE to 9,400 rpm. ONSET_UNB_ONLY /
-/// ONSET_VISC_ONLY apply one of the two.
+/// from the hold's end on) | none, then the run-up at ONSET_RATE to 9,400 rpm. ONSET_UNB_ONLY /
+/// ONSET_VISC_ONLY apply one of the two; ONSET_PRE (rpm): 24.5 revolutions there first, then
+/// 8,000 rpm at once; ONSET_STAIR_MS: the speed held between updates (the driver's input);
+/// ONSET_LOCK: the twin's angle shifted onto the continuous ramp's once a revolution (the
+/// keyphasor lock).
 #[test]
 #[ignore]
 fn onset_switch() {
@@ -239,6 +245,9 @@ fn onset_switch() {
     // ONSET_PRE: first 24.5 revolutions at that speed, then 8,000 rpm at once (the speed steps
     // of tests/live_calibration.rs's plant)
     let pre = num("ONSET_PRE", 0.0);
+    let stair = num("ONSET_STAIR_MS", 0.0) * 1e-3;
+    let lock = std::env::var("ONSET_LOCK").is_ok();
+    let (mut plant_angle, mut plant_revs, mut largest_shift) = (0.0f64, 0.0f64, 0.0f64);
     let t_pre = if pre > 0.0 { 24.5 * 60.0 / pre } else { 0.0 };
     let t_hold = t_pre + hold_revs * 60.0 / 8000.0;
     let t_blend = blend_revs * 60.0 / 8000.0;
@@ -260,11 +269,35 @@ fn onset_switch() {
             8000.0 + rate * (t + 0.5 * h - t_hold)
         };
         let accel = if t < t_hold { 0.0 } else { rate * PI / 30.0 };
+        // ONSET_STAIR_MS: the speed held between updates every that many ms (the driver's
+        // speed input), the rate given with it
+        let rpm = if stair > 0.0 && t >= t_hold {
+            let tu = t_hold + ((t - t_hold) / stair).floor() * stair;
+            8000.0 + rate * (tu - t_hold)
+        } else {
+            rpm
+        };
         twin.step(&StepInput {
             speed_rad_s: rpm * PI / 30.0,
             accel_rad_s2: accel,
         })
         .unwrap();
+        // ONSET_LOCK: the plant's angle (the continuous ramp) kept alongside, and at each of its
+        // revolutions the twin's angle shifted onto it, as the keyphasor lock does
+        let rpm_true = if t < t_pre {
+            pre
+        } else if t < t_hold {
+            8000.0
+        } else {
+            8000.0 + rate * (t + 0.5 * h - t_hold)
+        };
+        plant_angle += h * rpm_true * PI / 30.0;
+        if lock && (plant_angle / std::f64::consts::TAU).floor() > plant_revs {
+            plant_revs = (plant_angle / std::f64::consts::TAU).floor();
+            let d = plant_angle - twin.output().angle_rad;
+            twin.shift_angle(d);
+            largest_shift = largest_shift.max(d.abs());
+        }
         if let Some(r) = monitor.record(&twin) {
             let a = r
                 .bearings
@@ -279,7 +312,7 @@ fn onset_switch() {
         }
     }
     let label = format!(
-        "switch {apply} unb {unb} visc {vis} rate {rate} hold {hold_revs} blend {blend_revs} pre {pre}"
+        "switch {apply} unb {unb} visc {vis} rate {rate} hold {hold_revs} blend {blend_revs} pre {pre} stair {stair} lock {lock}"
     );
     for k in (0..per_rev.len()).step_by(16) {
         println!(
@@ -291,6 +324,7 @@ fn onset_switch() {
     }
     let onset = (0..per_rev.len())
         .find(|&k| k + 24 <= per_rev.len() && per_rev[k..k + 24].iter().all(|p| p.2));
+    println!("largest angle correction {largest_shift:.2e} rad");
     println!(
         "RESULT {label}: onset {:?} rpm, by the replay's rule {:?}",
         onset.map(|k| per_rev[k].0.round()),
