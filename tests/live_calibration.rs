@@ -521,8 +521,9 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
 /// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
 /// is not met by the run-up onset (README, "The onset after a live calibration": it moves
-/// ~80 rpm per e-fold of the whirl's seed, ~+250 rpm per doubling of the run-up rate); the
-/// linear threshold the node publishes is (+4 rpm, `predicted_onset_after_calibration`).
+/// 60–80 rpm per e-fold of the whirl's seed, +231 and +345 rpm per doubling of the run-up
+/// rate); the linear threshold the node publishes meets it (+4 rpm,
+/// `predicted_onset_after_calibration`).
 #[test]
 fn nonlinear_onset_after_live_calibration() {
     let twin = twin_rotor();

@@ -266,7 +266,7 @@ impl super::Driver {
     /// for the log.
     ///
     /// A nonlinear twin that is running takes the new values over [`CALIBRATION_BLEND_S`]
-    /// ([`Blend`]), not at once: a step of the viscosity or the unbalance is a kick to the
+    /// (a `Blend`), not at once: a step of the viscosity or the unbalance is a kick to the
     /// rotor, whose free whirl near the stability threshold decays slowly and seeds the whip
     /// in a later run-up hundreds of rpm early (README, "The onset after a live calibration").
     pub fn apply_calibration(&mut self, applied: Applied) -> Result<String, String> {
