@@ -623,3 +623,41 @@ fn onset_against_the_film_grid() {
         );
     }
 }
+
+/// Study (README, "The onset after a live calibration", the grid study's 212 rpm): the machine
+/// file's plant (60 × 10, direct film, a plain twin) against twins of the same machine through
+/// the driver: tabulated, direct, and direct with the plant's own time step; from 8,000 rpm (16
+/// revolutions), the 400 rpm/s run-up. Ignored; asserts only that each finds an onset.
+#[test]
+#[ignore]
+fn onset_through_the_driver_against_a_plain_twin() {
+    let machine = twin_rotor();
+    let w8 = 8000.0 * PI / 30.0;
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w8, 64);
+    let driver = |film: FilmEvaluation, same_step: bool| {
+        let mut settings =
+            DriverSettings::new(ModelKind::Nonlinear, film, machine.rated_speed_rad_s);
+        if same_step {
+            settings.twin.time_step_s = config.time_step_s;
+        }
+        Driver::new(machine.clone(), settings)
+    };
+    let drivers = vec![
+        driver(FilmEvaluation::Table, false),
+        driver(FilmEvaluation::Direct, false),
+        driver(FilmEvaluation::Direct, true),
+    ];
+    let plant = Twin::new(&machine, config, w8).unwrap();
+    let mut rig = Rig::new(plant, drivers, 0.0, PlantProbes::Pairs);
+    rig.run(8000.0, 16.0, true);
+    rig.ramp(8000.0, 9400.0, 3.5, true);
+    rig.finish_comparisons();
+    let onset = |i: usize, predicted: bool| rig.onset_rpm(i, predicted);
+    println!(
+        "plant (plain twin, direct): {:.0} rpm; through the driver: table {:.0}, direct {:.0}, direct at the plant's step {:.0}",
+        onset(0, false),
+        onset(0, true),
+        onset(1, true),
+        onset(2, true)
+    );
+}
