@@ -525,8 +525,16 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// replay's rule (`StationComparison::onset`, the earlier station) from the measured (the plant,
 /// direct film) and the predicted signals. The reference: the twin of the plant's own machine,
 /// through the same driver, tabulated film and keyphasor lock, predicts the plant's onset within
-/// the 30 rpm (measured 0 rpm). The calibrated twin does not (measured −616 rpm; on its
-/// 60 × 10 films even the plant's exact oil and unbalance give −458 rpm): printed, see README.
+/// the 30 rpm (measured +21 rpm). The calibrated twin takes the estimate over
+/// `CALIBRATION_BLEND_S` (1 s): measured −107 rpm (before calibration −128), asserted within
+/// 150 rpm (the −107 and the spread of the onset with the seed: 48 against 100 revolutions of
+/// blend move it 83 rpm, `tests/onset_scratch.rs`). Taken at once, as before session 13, the
+/// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
+/// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
+/// is not met by the run-up onset (README, "The onset after a live calibration": it moves
+/// 60–80 rpm per e-fold of the whirl's seed, +231 and +345 rpm per doubling of the run-up
+/// rate); the linear threshold the node publishes meets it (+4 rpm,
+/// `predicted_onset_after_calibration`).
 #[test]
 fn nonlinear_onset_after_live_calibration() {
     let twin = twin_rotor();
@@ -565,6 +573,7 @@ fn nonlinear_onset_after_live_calibration() {
     // one start each: the twins ran the plant's whole history
     assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 1));
     assert!((own - plant).abs() < 30.0);
+    assert!((after - plant).abs() < 150.0);
 }
 
 /// The twin's films on `n_theta × n_z`.
@@ -624,4 +633,42 @@ fn onset_against_the_film_grid() {
             onset(i, true)
         );
     }
+}
+
+/// Study (README, "The onset after a live calibration", the grid study's 212 rpm): the machine
+/// file's plant (60 × 10, direct film, a plain twin) against twins of the same machine through
+/// the driver: tabulated, direct, and direct with the plant's own time step; from 8,000 rpm (16
+/// revolutions), the 400 rpm/s run-up. Ignored; asserts only that each finds an onset.
+#[test]
+#[ignore]
+fn onset_through_the_driver_against_a_plain_twin() {
+    let machine = twin_rotor();
+    let w8 = 8000.0 * PI / 30.0;
+    let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w8, 64);
+    let driver = |film: FilmEvaluation, same_step: bool| {
+        let mut settings =
+            DriverSettings::new(ModelKind::Nonlinear, film, machine.rated_speed_rad_s);
+        if same_step {
+            settings.twin.time_step_s = config.time_step_s;
+        }
+        Driver::new(machine.clone(), settings)
+    };
+    let drivers = vec![
+        driver(FilmEvaluation::Table, false),
+        driver(FilmEvaluation::Direct, false),
+        driver(FilmEvaluation::Direct, true),
+    ];
+    let plant = Twin::new(&machine, config, w8).unwrap();
+    let mut rig = Rig::new(plant, drivers, 0.0, PlantProbes::Pairs);
+    rig.run(8000.0, 16.0, true);
+    rig.ramp(8000.0, 9400.0, 3.5, true);
+    rig.finish_comparisons();
+    let onset = |i: usize, predicted: bool| rig.onset_rpm(i, predicted);
+    println!(
+        "plant (plain twin, direct): {:.0} rpm; through the driver: table {:.0}, direct {:.0}, direct at the plant's step {:.0}",
+        onset(0, false),
+        onset(0, true),
+        onset(1, true),
+        onset(2, true)
+    );
 }

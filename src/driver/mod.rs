@@ -160,6 +160,8 @@ pub struct Driver {
     viscosity_correction: Option<f64>,
     /// each film bearing's oil: law and heated scales, effective temperatures (issue 12)
     oil: oil::OilState,
+    /// an applied calibration on its way into the running nonlinear twin
+    blend: Option<calibration::Blend>,
 }
 
 impl Driver {
@@ -191,6 +193,7 @@ impl Driver {
             oil_scale: None,
             viscosity_correction: None,
             oil,
+            blend: None,
         }
     }
 
@@ -335,31 +338,43 @@ impl Driver {
         self.check_keyphasor_stop(now_ns, emit);
         self.warn_refusals(now_ns, emit);
         let mut taken = 0;
-        if let (Some(s), Some(speed)) = (self.session.as_mut(), self.speed) {
-            let (w, a) = (speed.speed_rad_s, speed.accel_rad_s2);
-            let input = StepInput {
-                speed_rad_s: w,
-                accel_rad_s2: a,
-            };
-            while taken < max_steps && s.stamp_ns() < now_ns {
-                if let Err(e) = s.step(&input, emit) {
-                    emit(warning(
-                        s.stamp_ns(),
-                        InstabilityWarning::ERROR,
-                        WarningKind::ModelFailure,
-                        "",
-                        format!("step failed: {e}; the twin restarts at the next speed"),
-                    ));
-                    self.session = None;
-                    self.counts.step_failures += 1;
-                    break;
-                }
-                taken += 1;
+        self.blend_targets();
+        while taken < max_steps && self.session.as_ref().is_some_and(|s| s.stamp_ns() < now_ns) {
+            // an applied calibration moves the twin's values on before each step
+            self.blend_step();
+            match self.step_once(emit) {
+                0 => break,
+                n => taken += n,
             }
         }
         self.counts.steps += taken as u64;
         self.emit_margin(now_ns, emit);
         taken
+    }
+
+    /// One step of the running twin at the speed in force (1), or none (0: no twin or speed,
+    /// or the step failed: warned, the twin stops).
+    fn step_once(&mut self, emit: &mut impl FnMut(Outgoing)) -> usize {
+        let (Some(s), Some(speed)) = (self.session.as_mut(), self.speed) else {
+            return 0;
+        };
+        let input = StepInput {
+            speed_rad_s: speed.speed_rad_s,
+            accel_rad_s2: speed.accel_rad_s2,
+        };
+        if let Err(e) = s.step(&input, emit) {
+            emit(warning(
+                s.stamp_ns(),
+                InstabilityWarning::ERROR,
+                WarningKind::ModelFailure,
+                "",
+                format!("step failed: {e}; the twin restarts at the next speed"),
+            ));
+            self.session = None;
+            self.counts.step_failures += 1;
+            return 0;
+        }
+        1
     }
 
     fn take_speed(
@@ -433,6 +448,7 @@ impl Driver {
             }
         }
         self.session = Some(s);
+        self.blend = None;
         self.signals.keyphasor.unlock();
         self.counts.starts += 1;
         Fed::Started { speed_rad_s: w }
