@@ -528,7 +528,7 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// the 30 rpm (measured +21 rpm). The calibrated twin takes the estimate over
 /// `CALIBRATION_BLEND_S` (1 s): measured −107 rpm (before calibration −128), asserted within
 /// 150 rpm (the −107 and the spread of the onset with the seed: 48 against 100 revolutions of
-/// blend move it 83 rpm, `tests/onset_scratch.rs`). Taken at once, as before session 13, the
+/// blend move it 83 rpm, `tests/onset_study.rs`). Taken at once, as before session 13, the
 /// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
 /// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
 /// is not met by the run-up onset (README, "The onset after a live calibration": it moves

@@ -426,7 +426,7 @@ impl super::Driver {
 }
 
 /// How long a running nonlinear twin takes to move to an applied calibration (s): 1 s, some
-/// 130 revolutions at 8,000 rpm. Measured (`tests/onset_scratch.rs` `onset_switch`: the
+/// 130 revolutions at 8,000 rpm. Measured (`tests/onset_study.rs` `onset_switch`: the
 /// machine file's twin on 60 × 10 at 8,000 rpm taking the live estimate of
 /// `tests/live_calibration.rs`, then the 400 rpm/s run-up): the run-up onset at once 8,442 rpm,
 /// blended over 8, 24, 48 and 100 revolutions 9,057, 9,099, 9,183 and 9,266 rpm, with the

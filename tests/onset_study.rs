@@ -1,7 +1,7 @@
 //! Studies of the nonlinear run-up onset (issue 12, session 13; README, "The onset after a live
 //! calibration"): not checks, every one ignored, printing `TRACE` and `RESULT` lines. Each run is
 //! set by environment variables so that one build serves all of them (`cargo test --release
-//! --test onset_scratch -- --ignored --nocapture --exact onset_scratch`):
+//! --test onset_study -- --ignored --nocapture --exact onset_study`):
 //! ONSET_ROTOR = plant | calibrated | machine; ONSET_GRID = 60x10; ONSET_FILM = table | direct;
 //! ONSET_MODE = ramp | const | updown; ONSET_RATE (rpm/s); ONSET_FROM, ONSET_TO (rpm);
 //! ONSET_RPM (const speed); ONSET_VISC (a further viscosity factor); ONSET_KICK (N·s in x and y
@@ -28,7 +28,7 @@ fn num(name: &str, default: f64) -> f64 {
 
 #[test]
 #[ignore]
-fn onset_scratch() {
+fn onset_study() {
     if let Some(dir) = TableCache::default_dir() {
         set_disk_cache(Some(TableCache::new(dir)));
     }
