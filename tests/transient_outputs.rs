@@ -157,21 +157,23 @@ fn extents(orbit: &[[f64; 2]]) -> [f64; 2] {
 }
 
 /// The monitor fed a synthetic orbit of known content (`Monitor::record_orbit`, 128 samples a
-/// revolution at half-sample angles, 40 revolutions at 9,000 rpm, bearings of the built-in
+/// revolution at half-sample angles, 39 revolutions at 9,000 rpm, bearings of the built-in
 /// machine, c = 40 µm): a forward half-speed whirl of radius A = 20 µm plus a forward 1X of
 /// radius B = 8 µm, x = A cos(ψ/2) + B cos ψ, y = A sin(ψ/2) + B sin ψ (ψ the rotor angle).
 /// Its extents in closed form, with u = ψ/2: x = 2B cos²u + A cos u − B, largest A + B at
 /// cos u = 1, smallest −A²/(8B) − B at cos u = −A/(4B) (A ≤ 4B), so p-p_x = A + 2B + A²/(8B) =
-/// 42.25 µm; y = sin u (A + 2B cos u) is odd in u, p-p_y = 2 max, at cos u = (√(A² + 32B²) − A)/(8B)
-/// (48.59 µm). Asserted: span 2 revolutions, both p-p within 0.1 % of these (the samples miss
-/// the extremes by at most (π/256)²/2 (A + 4B) ≈ 0.004 µm), the sub-synchronous semi-major axis
-/// A at order 0.5 and the 1X semi-major axis B within 0.5 % (both orders on the 1/16 bins of the
-/// 16-revolution window), and the amplitude half the larger p-p. Over one revolution (the old
-/// span) u covers only half the whirl: y stays on one side of zero and reads half, 24.29 µm
-/// (within 1 %: the revolution's last sample lies a quarter step of u past u = π) — asserted
-/// on the last revolution's samples, so this test fails with the span of
-/// one revolution (checked: with `whirl_span` returning 1, p-p_y read 24.29 against 48.59 µm).
-/// A pure forward whirl at 7/16 X (radius A) spans ⌈16/7⌉ = 3 revolutions, p-p 2A both ways.
+/// 42.25 µm; y = sin u (A + 2B cos u) is odd in u, p-p_y = 2 max, at cos u = (√(A² + 32B²) −
+/// A)/(8B): 48.587 µm. Asserted: span 2 revolutions, both p-p within 0.1 % of these (measured
+/// 42.246 × 48.587 µm; the samples miss the extremes by at most (π/256)²/2 (A + 4B) ≈ 0.004 µm),
+/// the sub-synchronous semi-major axis A at order 0.5 and the 1X semi-major axis B within 0.5 %
+/// (measured 20.000 and 8.000 µm: both orders on the 1/16 bins of the 16-revolution window), and
+/// the amplitude half the larger p-p. Over one revolution (the old span) u covers only half the
+/// whirl: y stays on one side of zero and reads half, 24.343 µm (0.2 % above 24.294: the
+/// revolution's last sample lies a quarter step of u past u = π), asserted within 1 % on the
+/// report's last revolution. This test failed with the old span: run with `whirl_span`
+/// returning 1 (a temporary change, reverted), the report read 42.215 × 24.343 µm over 1
+/// revolution. A pure forward whirl at 7/16 X (radius A) spans ⌈16/7⌉ = 3 revolutions, p-p 2A
+/// both ways (measured 40.000 × 40.000 µm).
 #[test]
 fn peak_to_peak_of_a_synthetic_whirl_is_its_closed_form_extent() {
     let rotor = orc();
@@ -187,7 +189,8 @@ fn peak_to_peak_of_a_synthetic_whirl_is_its_closed_form_extent() {
     let run = |order: f64, b: f64| {
         let mut monitor = Monitor::new(&twin, 128, ClassifierSettings::default());
         let dpsi = TAU / 128.0;
-        for k in 0..40 * 128 {
+        // up to the sample that completes the 39th revolution: the report's window is the last
+        for k in 0..=39 * 128 {
             let psi = (k as f64 + 0.5) * dpsi;
             let p = [
                 a * (order * psi).cos() + b * psi.cos(),
@@ -232,7 +235,10 @@ fn peak_to_peak_of_a_synthetic_whirl_is_its_closed_form_extent() {
         assert!((r.one_x_amplitude_m / b - 1.0).abs() < 5e-3, "{r:?}");
         // what one revolution reads: y on one side of zero, half the whole extent (to the one
         // sample past the revolution mark, (π/256)(A − 2B) ≈ 0.05 µm)
-        assert!((one_rev[1] / (0.5 * pp_y) - 1.0).abs() < 0.01, "{one_rev:?}");
+        assert!(
+            (one_rev[1] / (0.5 * pp_y) - 1.0).abs() < 0.01,
+            "{one_rev:?}"
+        );
         assert!((r.max_eccentricity_ratio * clearances[i] - (a + b)).abs() < 1e-3 * (a + b));
     }
     let monitor = run(7.0 / 16.0, 0.0);

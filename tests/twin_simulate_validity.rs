@@ -80,12 +80,13 @@ fn linear_orbit_beyond_the_clearance_is_flagged() {
 /// (`run_driven`), (b) the twin's per-step flag summed over the same steps taken by hand, and
 /// (c) independently of that flag, the steps of one substep that took more than
 /// `max_newton_iterations` iterations (measured 38, 38, 38). A JSON that dropped the field or
-/// reported 0, as the old `simulate` did, fails here (the old test only asked for the key).
+/// reported 0 fails here (the old test only asked for the key): run with the JSON's count
+/// forced to 0 (a temporary change, reverted) it failed, JSON 0 against the library's 38.
 #[test]
 fn prehistory_fallbacks_in_the_json_count_the_runs_fallbacks() {
     use rotor_twin::dynamics::{Coupling, FilmEvaluation};
-    use rotor_twin::rotor::{MachineDescription, Rotor};
     use rotor_twin::dynamics::{StepInput, Twin, TwinConfig};
+    use rotor_twin::rotor::{MachineDescription, Rotor};
     use rotor_twin::transient::{apply_kicks, run_driven, Drive, Kick, TransientSpec};
     use rotor_twin::units::rpm_to_rad_s;
     let (speed, revs, steps, delta) = (8000.0, 6, 64, 0.5);
@@ -109,7 +110,9 @@ fn prehistory_fallbacks_in_the_json_count_the_runs_fallbacks() {
     ]);
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let json = v["prehistory_fallbacks"].as_u64().expect("the count in the JSON");
+    let json = v["prehistory_fallbacks"]
+        .as_u64()
+        .expect("the count in the JSON");
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let spec = TransientSpec {
         speed_rpm: speed,

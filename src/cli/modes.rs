@@ -33,6 +33,12 @@ pub struct ModesArgs {
     /// damping (`fluid_inertia: full`).
     #[arg(long, conflicts_with = "fluid_inertia")]
     fluid_inertia_full: bool,
+    /// With --fluid-inertia-full: the stability threshold on the tabulated film with the
+    /// convective inertia's slopes taken with the pressure zone and κ following the journal,
+    /// as the nonlinear transient has them (its own threshold; the Campbell diagram keeps the
+    /// held slopes).
+    #[arg(long, requires = "fluid_inertia_full")]
+    zone_following: bool,
     /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the
     /// lowest --modes modes (at most 6 drawn).
     #[arg(long)]
@@ -201,8 +207,17 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
-    let threshold =
-        stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
+    let threshold = if args.zone_following {
+        crate::rotor::stability_threshold_zone_following(
+            &rotor,
+            &statics,
+            [from, to, step],
+            crate::rotor::ZONE_FOLLOWING_STEP,
+        )
+    } else {
+        stability_threshold(&rotor, &statics, from, to, step)
+    }
+    .context("stability threshold")?;
     let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) =
         critical_speeds(&rotor, &statics, &points)
             .context("critical speeds")?
