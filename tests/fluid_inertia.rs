@@ -361,64 +361,11 @@ fn without_rotation_only_the_quadratic_squeeze_term_remains() {
     }
 }
 
-/// The convective inertia's slopes as the transient sees them at bearing `f`'s equilibrium `eq`
-/// (speed `w`) on the film `solver`: central differences (steps `step` × c in position, × cω in
-/// velocity) of eq. I1's force with the film solved at the displaced and moving journal, so that
-/// its pressure zone ζ1, ζ2 and κ follow the state (they are held in `convective_coefficients`),
-/// minus the held slopes: [ΔK, ΔC] to add.
-fn following_minus_held(
-    f: &rotor_twin::rotor::FilmBearing,
-    solver: &mut dyn rotor_twin::film::FilmModel,
-    eq: &rotor_twin::film::Equilibrium,
-    (w, step): (f64, f64),
-) -> [nalgebra::Matrix2<f64>; 2] {
-    use rotor_twin::film::JournalKinematics;
-    let inertia = f.inertia.unwrap();
-    let mu = f.viscosity_pa_s();
-    let mut force = |d: [f64; 2], v: [f64; 2]| {
-        let kin = JournalKinematics {
-            position_m: d,
-            velocity_m_s: v,
-            speed_rad_s: w,
-        };
-        let (r, c) = solver.solve_with_coefficients(&kin).unwrap();
-        let kappa = inertia.length_factor(d, &r, &c.damping_n_s_per_m, mu);
-        inertia.transient_force(d, v, &r, w, kappa).force_n
-    };
-    let clearance = f.geometry.radial_clearance_m;
-    let (dx, dv, d0) = (step * clearance, step * clearance * w, eq.position_m);
-    let mut out = [nalgebra::Matrix2::zeros(); 2];
-    for j in 0..2 {
-        let (mut dp, mut dm, mut vp, mut vm) = (d0, d0, [0.0; 2], [0.0; 2]);
-        dp[j] += dx;
-        dm[j] -= dx;
-        vp[j] += dv;
-        vm[j] -= dv;
-        let (fdp, fdm, fvp, fvm) = (
-            force(dp, [0.0; 2]),
-            force(dm, [0.0; 2]),
-            force(d0, vp),
-            force(d0, vm),
-        );
-        for i in 0..2 {
-            out[0][(i, j)] = -(fdp[i] - fdm[i]) / (2.0 * dx);
-            out[1][(i, j)] = -(fvp[i] - fvm[i]) / (2.0 * dv);
-        }
-    }
-    let damping = &eq.coefficients.damping_n_s_per_m;
-    let kappa = inertia.length_factor(d0, &eq.film, damping, mu);
-    let held = inertia.convective_coefficients(d0, &eq.film, w, kappa);
-    [
-        out[0] - held.stiffness_n_per_m,
-        out[1] - held.damping_n_s_per_m,
-    ]
-}
-
 /// The least-damped sub-synchronous mode's growth per revolution at `rpm` on the TABULATED film
 /// (the transient's film below: equilibria and coefficients from the table's interpolant, whose
 /// ζ1, ζ2 are interpolated and smooth in the state), with the film's inertia of `rotor`; with
 /// `follow` (a step as a share of the clearance) the convective slopes are taken with the zone
-/// and κ following the state ([`following_minus_held`]), else held as `modes` holds them.
+/// and κ following the state (`rotor::following_minus_held`), else held as `modes` holds them.
 fn table_eigen_growth(rotor: &Rotor, rpm: f64, follow: Option<f64>) -> f64 {
     let w = rpm * PI / 30.0;
     let statics = static_solution(rotor).unwrap();
@@ -435,7 +382,8 @@ fn table_eigen_growth(rotor: &Rotor, rpm: f64, follow: Option<f64>) -> f64 {
         if let Some(inertia) = f.inertia {
             c = inertia.add_to(c, eq.position_m, &eq.film, f.viscosity_pa_s(), w);
             if let Some(step) = follow {
-                let [dk, dc] = following_minus_held(f, &mut *solver, &eq, (w, step));
+                let [dk, dc] =
+                    rotor_twin::rotor::following_minus_held(f, &mut *solver, &eq, w, step).unwrap();
                 c.stiffness_n_per_m += dk;
                 c.damping_n_s_per_m += dc;
             }
