@@ -146,6 +146,120 @@ fn half_speed_whirl_peak_to_peak_spans_its_whole_period() {
     }
 }
 
+/// Extents (m) in x and y of the samples `orbit`.
+fn extents(orbit: &[[f64; 2]]) -> [f64; 2] {
+    [0, 1].map(|k| {
+        let (lo, hi) = orbit
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[k]), h.max(p[k])));
+        hi - lo
+    })
+}
+
+/// The monitor fed a synthetic orbit of known content (`Monitor::record_orbit`, 128 samples a
+/// revolution at half-sample angles, 39 revolutions at 9,000 rpm, bearings of the built-in
+/// machine, c = 40 µm): a forward half-speed whirl of radius A = 20 µm plus a forward 1X of
+/// radius B = 8 µm, x = A cos(ψ/2) + B cos ψ, y = A sin(ψ/2) + B sin ψ (ψ the rotor angle).
+/// Its extents in closed form, with u = ψ/2: x = 2B cos²u + A cos u − B, largest A + B at
+/// cos u = 1, smallest −A²/(8B) − B at cos u = −A/(4B) (A ≤ 4B), so p-p_x = A + 2B + A²/(8B) =
+/// 42.25 µm; y = sin u (A + 2B cos u) is odd in u, p-p_y = 2 max, at cos u = (√(A² + 32B²) −
+/// A)/(8B): 48.587 µm. Asserted: span 2 revolutions, both p-p within 0.1 % of these (measured
+/// 42.246 × 48.587 µm; the samples miss the extremes by at most (π/256)²/2 (A + 4B) ≈ 0.004 µm),
+/// the sub-synchronous semi-major axis A at order 0.5 and the 1X semi-major axis B within 0.5 %
+/// (measured 20.000 and 8.000 µm: both orders on the 1/16 bins of the 16-revolution window), and
+/// the amplitude half the larger p-p. Over one revolution (the old span) u covers only half the
+/// whirl: y stays on one side of zero and reads half, 24.343 µm (0.2 % above 24.294: the
+/// revolution's last sample lies a quarter step of u past u = π), asserted within 1 % on the
+/// report's last revolution. This test failed with the old span: run with `whirl_span`
+/// returning 1 (a temporary change, reverted), the report read 42.215 × 24.343 µm over 1
+/// revolution. A pure forward whirl at 7/16 X (radius A) spans ⌈16/7⌉ = 3 revolutions, p-p 2A
+/// both ways (measured 40.000 × 40.000 µm).
+#[test]
+fn peak_to_peak_of_a_synthetic_whirl_is_its_closed_form_extent() {
+    let rotor = orc();
+    let omega = rpm_to_rad_s(9000.0);
+    let twin = Twin::new(
+        &rotor,
+        TwinConfig::with_steps_per_rev(Coupling::Linear, omega, 128),
+        omega,
+    )
+    .unwrap();
+    let clearances = twin.bearing_clearances_m();
+    let (a, b) = (20e-6, 8e-6);
+    let run = |order: f64, b: f64| {
+        let mut monitor = Monitor::new(&twin, 128, ClassifierSettings::default());
+        let dpsi = TAU / 128.0;
+        // up to the sample that completes the 39th revolution: the report's window is the last
+        for k in 0..=39 * 128 {
+            let psi = (k as f64 + 0.5) * dpsi;
+            let p = [
+                a * (order * psi).cos() + b * psi.cos(),
+                a * (order * psi).sin() + b * psi.sin(),
+            ];
+            let at = vec![p; clearances.len()];
+            monitor.record_orbit(psi / omega, omega, psi, &at);
+        }
+        monitor
+    };
+    let monitor = run(0.5, b);
+    let report = monitor.report();
+    assert_eq!(report.revolution, 39, "revolutions completed");
+    let pp_x = a + 2.0 * b + a * a / (8.0 * b);
+    let cu = ((a * a + 32.0 * b * b).sqrt() - a) / (8.0 * b);
+    let pp_y = 2.0 * (1.0 - cu * cu).sqrt() * (a + 2.0 * b * cu);
+    for (i, r) in report.bearings.iter().enumerate() {
+        let one_rev = extents(&monitor.recent_orbit(i, 1));
+        println!(
+            "synthetic 0.5X {:.1} + 1X {:.1} µm: p-p {:.3} × {:.3} µm over {} revolutions against \
+             {:.3} × {:.3} closed form; one revolution {:.3} × {:.3}; sub-synchronous {:.3} µm at \
+             {:.3}X, 1X {:.3} µm",
+            a * 1e6,
+            b * 1e6,
+            r.orbit_pp_x_m * 1e6,
+            r.orbit_pp_y_m * 1e6,
+            r.span_revolutions,
+            pp_x * 1e6,
+            pp_y * 1e6,
+            one_rev[0] * 1e6,
+            one_rev[1] * 1e6,
+            r.subsync_amplitude_m * 1e6,
+            r.subsync_ratio,
+            r.one_x_amplitude_m * 1e6
+        );
+        assert_eq!(r.span_revolutions, 2);
+        assert!((r.orbit_pp_x_m / pp_x - 1.0).abs() < 1e-3, "{r:?}");
+        assert!((r.orbit_pp_y_m / pp_y - 1.0).abs() < 1e-3, "{r:?}");
+        assert!((r.amplitude_m / (0.5 * pp_y) - 1.0).abs() < 1e-3);
+        assert!((r.subsync_ratio - 0.5).abs() < 1e-3, "{r:?}");
+        assert!((r.subsync_amplitude_m / a - 1.0).abs() < 5e-3, "{r:?}");
+        assert!((r.one_x_amplitude_m / b - 1.0).abs() < 5e-3, "{r:?}");
+        // what one revolution reads: y on one side of zero, half the whole extent (to the one
+        // sample past the revolution mark, (π/256)(A − 2B) ≈ 0.05 µm)
+        assert!(
+            (one_rev[1] / (0.5 * pp_y) - 1.0).abs() < 0.01,
+            "{one_rev:?}"
+        );
+        assert!((r.max_eccentricity_ratio * clearances[i] - (a + b)).abs() < 1e-3 * (a + b));
+    }
+    let monitor = run(7.0 / 16.0, 0.0);
+    for r in &monitor.report().bearings {
+        println!(
+            "synthetic 7/16 X {:.1} µm: p-p {:.3} × {:.3} µm over {} revolutions; sub-synchronous \
+             {:.3} µm at {:.4}X",
+            a * 1e6,
+            r.orbit_pp_x_m * 1e6,
+            r.orbit_pp_y_m * 1e6,
+            r.span_revolutions,
+            r.subsync_amplitude_m * 1e6,
+            r.subsync_ratio
+        );
+        assert_eq!(r.span_revolutions, 3);
+        assert!((r.orbit_pp_x_m / (2.0 * a) - 1.0).abs() < 1e-3, "{r:?}");
+        assert!((r.orbit_pp_y_m / (2.0 * a) - 1.0).abs() < 1e-3, "{r:?}");
+        assert!((r.subsync_amplitude_m / a - 1.0).abs() < 5e-3, "{r:?}");
+    }
+}
+
 /// A kick on the gyroscopic Jeffcott rotor (config/textbook_disc_midspan.yaml, massless shaft,
 /// rigid supports, no damping, no unbalance): an impulse J on the disc gives the free vibration
 /// x(t) = J/(m ω_n) sin ω_n (t − t₀), ω_n = √(k/m) = 2π · 31.44 Hz (the file's closed form).

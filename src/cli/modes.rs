@@ -33,6 +33,12 @@ pub struct ModesArgs {
     /// damping (`fluid_inertia: full`).
     #[arg(long, conflicts_with = "fluid_inertia")]
     fluid_inertia_full: bool,
+    /// With --fluid-inertia-full: the stability threshold on the tabulated film with the
+    /// convective inertia's slopes taken with the pressure zone and κ following the journal,
+    /// as the nonlinear transient has them (its own threshold; the Campbell diagram keeps the
+    /// held slopes).
+    #[arg(long, requires = "fluid_inertia_full")]
+    zone_following: bool,
     /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the
     /// lowest --modes modes (at most 6 drawn).
     #[arg(long)]
@@ -201,8 +207,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
-    let threshold =
-        stability_threshold(&rotor, &statics, from, to, step).context("stability threshold")?;
+    let threshold = threshold(args, &rotor, &statics, [from, to, step])?;
     let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) =
         critical_speeds(&rotor, &statics, &points)
             .context("critical speeds")?
@@ -255,6 +260,27 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         print_effective_temperatures(&report.effective_temperatures);
     }
     Ok(())
+}
+
+/// The stability threshold over `[from, to, step]` (rpm): the held linearisation, or with
+/// `--zone-following` the tabulated film's with the zone-following slopes.
+fn threshold(
+    args: &ModesArgs,
+    rotor: &Rotor,
+    statics: &crate::rotor::StaticSolution,
+    [from, to, step]: [f64; 3],
+) -> anyhow::Result<Option<crate::rotor::Threshold>> {
+    if args.zone_following {
+        crate::rotor::stability_threshold_zone_following(
+            rotor,
+            statics,
+            [from, to, step],
+            crate::rotor::ZONE_FOLLOWING_STEP,
+        )
+    } else {
+        stability_threshold(rotor, statics, from, to, step)
+    }
+    .context("stability threshold")
 }
 
 /// The `--plot` Campbell diagram.

@@ -369,11 +369,7 @@ impl Monitor {
     pub fn record(&mut self, twin: &Twin) -> Option<&RevolutionReport> {
         let out: &StepOutput = twin.output();
         let slot = self.head;
-        let previous_angle = if self.len > 0 {
-            self.angle[self.idx(0)]
-        } else {
-            out.angle_rad
-        };
+        let previous_angle = self.previous_angle(out.angle_rad);
         self.angle[slot] = out.angle_rad;
         for (k, (h, b)) in self.bearings.iter_mut().zip(&out.bearings).enumerate() {
             h.x[slot] = b.position_m[0];
@@ -386,6 +382,54 @@ impl Monitor {
             h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS]
                 .copy_from_slice(&self.profile);
         }
+        self.close_sample(previous_angle, out.angle_rad, out.time_s, out.speed_rad_s)
+    }
+
+    /// Records a sample of given journal positions `positions_m` (m, one `[x, y]` a bearing, as
+    /// the twin's `position_m`) at rotor angle `angle_rad`, with no film pressure, no wall
+    /// contact and the eccentricity ratio |position|/c: an orbit of known content (a synthetic
+    /// whirl) through the same analysis as [`record`](Self::record). Returns the new report when
+    /// a revolution was completed. Bearings beyond `positions_m` keep their old samples.
+    pub fn record_orbit(
+        &mut self,
+        time_s: f64,
+        speed_rad_s: f64,
+        angle_rad: f64,
+        positions_m: &[[f64; 2]],
+    ) -> Option<&RevolutionReport> {
+        let slot = self.head;
+        let previous_angle = self.previous_angle(angle_rad);
+        self.angle[slot] = angle_rad;
+        for (h, p) in self.bearings.iter_mut().zip(positions_m) {
+            h.x[slot] = p[0];
+            h.y[slot] = p[1];
+            h.ecc[slot] = p[0].hypot(p[1]) / h.clearance_m;
+            h.p_max[slot] = 0.0;
+            h.contact[slot] = false;
+            h.rub_power[slot] = 0.0;
+            h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS].fill(0.0);
+        }
+        self.close_sample(previous_angle, angle_rad, time_s, speed_rad_s)
+    }
+
+    /// The newest stored sample's rotor angle (rad), or `angle_rad` when none is stored.
+    fn previous_angle(&self, angle_rad: f64) -> f64 {
+        if self.len > 0 {
+            self.angle[self.idx(0)]
+        } else {
+            angle_rad
+        }
+    }
+
+    /// Advances the ring past the sample just written at `head` (rotor angle `angle_rad`, the
+    /// previous sample's `previous_angle`) and analyses the revolution if one was completed.
+    fn close_sample(
+        &mut self,
+        previous_angle: f64,
+        angle_rad: f64,
+        time_s: f64,
+        speed_rad_s: f64,
+    ) -> Option<&RevolutionReport> {
         self.head = if self.head + 1 == self.capacity {
             0
         } else {
@@ -393,7 +437,7 @@ impl Monitor {
         };
         self.len = (self.len + 1).min(self.capacity);
         self.current_rev_len += 1;
-        let completed = (out.angle_rad / TAU).floor() > (previous_angle / TAU).floor();
+        let completed = (angle_rad / TAU).floor() > (previous_angle / TAU).floor();
         if !completed || self.len < 2 {
             return None;
         }
@@ -403,7 +447,7 @@ impl Monitor {
         self.rev_lengths.push(self.current_rev_len);
         self.current_rev_len = 0;
         self.revolutions += 1;
-        self.analyse(out.time_s, out.speed_rad_s);
+        self.analyse(time_s, speed_rad_s);
         Some(&self.report)
     }
 

@@ -15,6 +15,7 @@ pub mod mode_tracking;
 mod oil_heating;
 mod statics;
 mod unbalance_response;
+mod zone_following;
 
 pub use critical_speeds::{critical_speeds, CriticalSpeed, API_684_MIN_AMPLIFICATION_FACTOR};
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
@@ -32,8 +33,9 @@ pub use machine::{
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
     campbell, damped_mode_shapes, damped_modes, natural_frequencies, stability_threshold,
-    stability_threshold_tabulated, undamped_frequencies_hz, BearingCoefficientSet, CampbellPoint,
-    Constraint, Mode, ModeShape, NaturalFrequencies, Threshold, WhirlDirection,
+    stability_threshold_tabulated, stability_threshold_zone_following, undamped_frequencies_hz,
+    BearingCoefficientSet, CampbellPoint, Constraint, Mode, ModeShape, NaturalFrequencies,
+    Threshold, WhirlDirection,
 };
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};
@@ -42,6 +44,7 @@ pub use unbalance_response::{
     response_stations, unbalance_response, ResponsePeak, Station, StationResponse,
     UnbalanceResponse,
 };
+pub use zone_following::{following_minus_held, ZONE_FOLLOWING_STEP};
 
 use crate::film::{
     BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FiniteFilm, Lubricant, ShortFilm,

@@ -493,7 +493,9 @@ pub struct CampbellPoint {
 }
 
 /// The film solvers of a rotor's bearings, reused from speed to speed (warm starts).
-pub(crate) struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>);
+/// With a step (share of the clearance), the convective inertia's slopes are taken with the
+/// pressure zone following the state ([`super::zone_following`]).
+pub(crate) struct BearingSolvers(Vec<Option<Box<dyn FilmModel + Send>>>, Option<f64>);
 
 impl BearingSolvers {
     pub(crate) fn new(rotor: &Rotor) -> Self {
@@ -506,7 +508,14 @@ impl BearingSolvers {
                     _ => None,
                 })
                 .collect(),
+            None,
         )
+    }
+
+    /// These solvers, the convective inertia's slopes taken with the zone following the state
+    /// (central differences, steps `step` × c and × c ω).
+    pub(crate) fn following_zone(self, step: f64) -> Self {
+        Self(self.0, Some(step))
     }
 
     /// The tabulated film of every film bearing (plain bearings on the finite model; others an
@@ -524,7 +533,7 @@ impl BearingSolvers {
             }
             _ => Ok(None),
         });
-        Ok(Self(solvers.collect::<Result<_, _>>()?))
+        Ok(Self(solvers.collect::<Result<_, _>>()?, None))
     }
 
     /// Coefficients and eccentricity ratios of every bearing at its static equilibrium under
@@ -537,6 +546,7 @@ impl BearingSolvers {
     ) -> Result<(BearingCoefficientSet, Vec<f64>), RotorError> {
         let mut coefs = Vec::new();
         let mut eps = Vec::new();
+        let follow = self.1;
         for ((b, solver), load) in rotor.bearings.iter().zip(&mut self.0).zip(loads) {
             let (coef, e) = match (&b.model, solver) {
                 (BearingModel::Film(f), Some(s)) => {
@@ -558,15 +568,25 @@ impl BearingSolvers {
                         let eq = f
                             .equilibrium(s.as_mut(), *load, speed_rad_s)
                             .map_err(fail)?;
-                        (
-                            f.with_added_mass(
-                                eq.coefficients,
-                                eq.position_m,
-                                &eq.film,
+                        let mut c = f.with_added_mass(
+                            eq.coefficients,
+                            eq.position_m,
+                            &eq.film,
+                            speed_rad_s,
+                        );
+                        if let Some(step) = follow {
+                            let [dk, dc] = super::zone_following::following_minus_held(
+                                f,
+                                s.as_mut(),
+                                &eq,
                                 speed_rad_s,
-                            ),
-                            eq.eccentricity_ratio,
-                        )
+                                step,
+                            )
+                            .map_err(fail)?;
+                            c.stiffness_n_per_m += dk;
+                            c.damping_n_s_per_m += dc;
+                        }
+                        (c, eq.eccentricity_ratio)
                     }
                 }
                 (BearingModel::Linear(c), _) => (*c, 0.0),
@@ -667,6 +687,29 @@ pub fn stability_threshold_tabulated(
         statics,
         speeds_rpm,
         BearingSolvers::tabulated(rotor)?,
+    )
+}
+
+/// [`stability_threshold_tabulated`] with the convective inertia's slopes of `fluid_inertia:
+/// full` taken with the pressure zone and κ following the state, as the transient has them
+/// ([`super::zone_following`], steps `step` × c and × c ω; [`ZONE_FOLLOWING_STEP`] in the
+/// plateau): the linearisation of the transient, whose threshold the held slopes of
+/// [`stability_threshold`] miss by 180 rpm on the seed machine (README "The transient's own
+/// threshold with `full`"). Without the convective inertia the same as
+/// [`stability_threshold_tabulated`].
+///
+/// [`ZONE_FOLLOWING_STEP`]: super::ZONE_FOLLOWING_STEP
+pub fn stability_threshold_zone_following(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: [f64; 3],
+    step: f64,
+) -> Result<Option<Threshold>, RotorError> {
+    threshold_with(
+        rotor,
+        statics,
+        speeds_rpm,
+        BearingSolvers::tabulated(rotor)?.following_zone(step),
     )
 }
 
