@@ -203,12 +203,7 @@ fn bag_at_8000_rpm(
     rotor_twin::bag::Bag,
     rotor_twin::messages::Unbalance,
 ) {
-    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_{tag}_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
     let mut args = vec![
-        "synth-bag",
-        "--out",
-        dir.to_str().unwrap(),
         "--from-rpm",
         "8000",
         "--to-rpm",
@@ -219,6 +214,27 @@ fn bag_at_8000_rpm(
         "0.01",
         "--hold-end",
         "0.01",
+    ];
+    args.extend_from_slice(extra);
+    synth_bag(tag, &args)
+}
+
+/// `synth-bag --keyphasor-deg 123` with `args` (the profile among them) in a scratch directory
+/// named by `tag`, read back, with the unbalance it publishes (the plant's, phase from the mark).
+fn synth_bag(
+    tag: &str,
+    extra: &[&str],
+) -> (
+    std::path::PathBuf,
+    rotor_twin::bag::Bag,
+    rotor_twin::messages::Unbalance,
+) {
+    let dir = std::env::temp_dir().join(format!("rotor_twin_cal_{tag}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut args = vec![
+        "synth-bag",
+        "--out",
+        dir.to_str().unwrap(),
         "--keyphasor-deg",
         "123",
     ];
@@ -418,9 +434,11 @@ fn replay_calibrate_with_ac_coupled_probes_fits_the_unbalance_alone() {
 /// so the test fails without the measurement; calibration.json says which runout was used.
 #[test]
 fn replay_calibrate_measures_the_runout_at_slow_roll() {
-    let (dir, bag, published) = bag_at_8000_rpm(
+    let (dir, bag, published) = synth_bag(
         "slowroll",
         &[
+            "--to-rpm",
+            "8000",
             "--raw-probes",
             "--runout-um",
             "5",
@@ -470,6 +488,21 @@ fn replay_calibrate_measures_the_runout_at_slow_roll() {
     assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
     let dphi = angle_gap(p.phase_deg, published.phase.to_degrees());
     assert!(dphi.abs() < 10.0, "{p:?}");
+    // the same bag and machine without slow_roll_speed_rpm: nothing measures the runout, the
+    // fit reads it as unbalance and misses
+    let blind = raw_machine("dc, reference_gap: 7.87", None);
+    let (cal0, _) =
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &blind, &[], &[], [0.9, 1.5]).unwrap();
+    let q = cal0.unbalance.planes[0];
+    println!(
+        "runout left in: {:.1} g·mm at {:.1}° ({})",
+        q.magnitude_g_mm, q.phase_deg, cal0.runouts[0].source
+    );
+    assert!(
+        (q.magnitude_g_mm / 140.0 - 1.0).abs() > 0.10
+            || angle_gap(q.phase_deg, published.phase.to_degrees()).abs() > 10.0,
+        "{q:?}"
+    );
     std::fs::remove_dir_all(dir).ok();
 }
 
