@@ -725,6 +725,7 @@ fn calibration_summary(cal: &crate::replay::calibration::BagCalibration) -> Stri
 /// The before/after comparison, as text.
 fn comparison_summary(c: &crate::replay::calibration::CalibrationComparison) -> String {
     let pct = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:.1} %", 100.0 * e));
+    let signed = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:+.1} %", 100.0 * e));
     let deg =
         |x: Option<[f64; 2]>| x.map_or("null".into(), |[a, b]| format!("{a:+.1}/{b:+.1} deg"));
     let mut s = String::new();
@@ -739,9 +740,9 @@ fn comparison_summary(c: &crate::replay::calibration::CalibrationComparison) -> 
             deg(st.phase_lag_error_window_deg[1]),
         );
         s += &format!(
-            "    over the bag's last 32 revolutions: amplitude before {}, after {}; phase lag before {}, after {}{}\n",
-            pct(st.amplitude_error_last[0]),
-            pct(st.amplitude_error_last[1]),
+            "    over the bag's last 32 revolutions (predicted - measured): amplitude before {}, after {}; phase lag before {}, after {}{}\n",
+            signed(st.amplitude_error_last[0]),
+            signed(st.amplitude_error_last[1]),
             deg(st.phase_lag_error_last_deg[0]),
             deg(st.phase_lag_error_last_deg[1]),
             st.phase_null_reason
