@@ -726,7 +726,8 @@ fn calibration_summary(cal: &crate::replay::calibration::BagCalibration) -> Stri
 fn comparison_summary(c: &crate::replay::calibration::CalibrationComparison) -> String {
     let pct = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:.1} %", 100.0 * e));
     let signed = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:+.1} %", 100.0 * e));
-    let deg =
+    let deg = |x: Option<[f64; 2]>| x.map_or("null".into(), |[a, b]| format!("{a:.1}/{b:.1} deg"));
+    let sdeg =
         |x: Option<[f64; 2]>| x.map_or("null".into(), |[a, b]| format!("{a:+.1}/{b:+.1} deg"));
     let mut s = String::new();
     for st in &c.stations {
@@ -743,8 +744,8 @@ fn comparison_summary(c: &crate::replay::calibration::CalibrationComparison) -> 
             "    over the bag's last 32 revolutions (predicted - measured): amplitude before {}, after {}; phase lag before {}, after {}{}\n",
             signed(st.amplitude_error_last[0]),
             signed(st.amplitude_error_last[1]),
-            deg(st.phase_lag_error_last_deg[0]),
-            deg(st.phase_lag_error_last_deg[1]),
+            sdeg(st.phase_lag_error_last_deg[0]),
+            sdeg(st.phase_lag_error_last_deg[1]),
             st.phase_null_reason
                 .as_ref()
                 .map_or(String::new(), |w| format!(" (phases null: {w})"))
