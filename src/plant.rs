@@ -111,7 +111,18 @@ pub struct PlantSignals {
     /// whose high spot is [`RUNOUT_HIGH_SPOT_DEG`] from the mark, so the probe at angle α reads
     /// it with the lag α − 30°.
     pub runout_m: f64,
+    /// Write no speed topic (a rig with only the keyphasor: the speed is the keyphasor's).
+    pub no_speed_topic: bool,
+    /// The raw probes are AC-coupled: their readings carry no DC gap (the reference gap and
+    /// the journal's static position taken out by a high pass, [`RAW_AC_TIME_CONSTANT_S`]),
+    /// only the motion about it.
+    pub ac_coupled: bool,
 }
+
+/// Time constant of the plant's AC coupling (s): 0.1, a first-order high pass (an exponential
+/// mean of the displacement, taken out) with its corner at 1.6 Hz; at 1X of 8,000 rpm (133 Hz)
+/// it leads the phase by 0.7° and leaves the amplitude within 0.01 %.
+pub const RAW_AC_TIME_CONSTANT_S: f64 = 0.1;
 
 /// Sensitivity of the plant's raw probes (V/m): 7.87 V/mm.
 pub const RAW_SENSITIVITY_V_PER_M: f64 = 7870.0;
@@ -237,6 +248,7 @@ pub fn write_bag(
         truth: TruthSamples {
             stations: vec![Vec::new(); plant.probes.len()],
         },
+        ac_mean: vec![[None; 2]; plant.probes.len()],
     };
     let mut last_progress = std::time::Instant::now();
     let profile = spec.profile;
@@ -276,6 +288,8 @@ struct Sampler {
     next_probe: f64,
     truth_from_s: f64,
     truth: TruthSamples,
+    /// AC coupling: per raw probe, the exponential mean of its displacement and its time (m, s)
+    ac_mean: Vec<[Option<(f64, f64)>; 2]>,
 }
 
 impl Sampler {
@@ -340,17 +354,34 @@ impl Sampler {
                 psi,
             );
             let d = clean[j] + runout + self.noise.sample(&mut self.rng);
-            let volts = RAW_SENSITIVITY_V_PER_M * (RAW_REFERENCE_GAP_M - d);
+            let volts = match sig.ac_coupled {
+                false => RAW_SENSITIVITY_V_PER_M * (RAW_REFERENCE_GAP_M - d),
+                true => -RAW_SENSITIVITY_V_PER_M * (d - self.ac_mean(k, j, t, d)),
+            };
             bag.write_probe_signal(t, &format!("{}_{suffix}", station.name), volts)?;
         }
         Ok(())
     }
 }
 
+impl Sampler {
+    /// The AC coupling's mean of raw probe `j` of station `k` after displacement `d` (m) at
+    /// `t` (s): a first-order high pass ([`RAW_AC_TIME_CONSTANT_S`]) started at the first one.
+    fn ac_mean(&mut self, k: usize, j: usize, t: f64, d: f64) -> f64 {
+        let slot = &mut self.ac_mean[k][j];
+        let mean = slot.map_or(d, |(m, t0)| {
+            m + (d - m) * (1.0 - (-(t - t0) / RAW_AC_TIME_CONSTANT_S).exp())
+        });
+        *slot = Some((mean, t));
+        mean
+    }
+}
+
 /// The bag being written: the recorder and its topics.
 struct PlantBag {
     rec: Recorder,
-    speed: usize,
+    /// the speed topic (absent when the rig has only the keyphasor)
+    speed: Option<usize>,
     unbalance: usize,
     /// probe pairs (absent with raw probes)
     probe: Option<usize>,
@@ -400,10 +431,13 @@ impl PlantBag {
         rec.set_custom_data(
             "plant_signals",
             &format!(
-                "keyphasor {}; probes {}",
+                "keyphasor {}; speed topic {}; probes {}",
                 sig.keyphasor_angle_deg
                     .map_or("none".into(), |a| format!("at plant shaft angle {a}° (unbalance phases published from the mark)")),
-                if sig.raw_probes {
+                if sig.no_speed_topic { "none (the speed is the keyphasor's)" } else { "/rotor_twin/speed" },
+                if sig.raw_probes && sig.ac_coupled {
+                    format!("raw (ProbeSignal in V, {RAW_SENSITIVITY_V_PER_M} V/m, AC: high pass of {RAW_AC_TIME_CONSTANT_S} s; runout {:.2} µm, high spot {RUNOUT_HIGH_SPOT_DEG}° from the mark)", sig.runout_m * 1e6)
+                } else if sig.raw_probes {
                     format!("raw (ProbeSignal in V, {RAW_SENSITIVITY_V_PER_M} V/m, DC, gap {} mm at the centre; runout {:.2} µm, high spot {RUNOUT_HIGH_SPOT_DEG}° from the mark)", RAW_REFERENCE_GAP_M * 1e3, sig.runout_m * 1e6)
                 } else {
                     "pairs (ProbeDisplacement, m)".into()
@@ -414,7 +448,12 @@ impl PlantBag {
         // best effort
         let sensor = TopicQos::sensor(1000);
         Ok(Self {
-            speed: rec.add_topic::<messages::RotorSpeed>(SPEED, TopicQos::reliable(100))?,
+            speed: match sig.no_speed_topic {
+                false => {
+                    Some(rec.add_topic::<messages::RotorSpeed>(SPEED, TopicQos::reliable(100))?)
+                }
+                true => None,
+            },
             unbalance: rec.add_topic::<messages::Unbalance>(UNBALANCE, TopicQos::reliable(10))?,
             probe: match sig.raw_probes {
                 false => Some(rec.add_topic::<messages::ProbeDisplacement>(PROBE, sensor)?),
@@ -490,13 +529,16 @@ impl PlantBag {
     }
 
     fn write_speed(&mut self, t: f64, profile: &SpeedProfile) -> Result<(), RecordError> {
+        let Some(h) = self.speed else {
+            return Ok(());
+        };
         let ns = stamp(t);
         let m = messages::RotorSpeed {
             header: header(ns, "rotor"),
             speed: profile.speed_rad_s(t),
             acceleration: profile.accel_rad_s2(t),
         };
-        self.rec.write(self.speed, &m, ns as u64, ns as u64)
+        self.rec.write(h, &m, ns as u64, ns as u64)
     }
 
     fn write_probe(&mut self, t: f64, station: &str, xy: [f64; 2]) -> Result<(), RecordError> {

@@ -119,6 +119,7 @@ fn a_plant_keyphasor_anywhere_and_raw_probes_with_runout_give_the_true_phase_lag
         keyphasor_angle_deg: Some(123.0),
         raw_probes: true,
         runout_m: 5e-6,
+        ..PlantSignals::default()
     };
     let (dir, truth) = plant_bag("raw", 0.35, signals);
     let report = replay_of(&dir, &machine_with_raw_probes(Some(5e-6)));

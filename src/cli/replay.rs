@@ -639,73 +639,69 @@ fn run_calibrated(
         ),
     );
     let (after, _) = replay(bag, &calibrated, &after_options, &mut |_| {})?;
-    let json = serde_json::json!({ "calibration": cal, "before": before, "after": after });
+    let comparison = crate::replay::calibration::compare_before_after(&before, &after, window);
+    let json = serde_json::json!({
+        "calibration": cal,
+        "comparison": comparison,
+        "before": before,
+        "after": after
+    });
     let text = serde_json::to_string_pretty(&json)?;
     std::fs::write(out_dir.join("calibration.json"), &text)?;
     if args.json {
         return super::print_out(&format!("{text}\n"));
     }
     super::print_out(&format!(
-        "{}output: {}\n",
-        calibration_summary(&cal, &before, &after),
+        "{}{}output: {}\n",
+        calibration_summary(&cal),
+        comparison_summary(&comparison),
         out_dir.display()
     ))
 }
 
-/// The mean relative 1X amplitude error, |predicted − measured| / measured, over the blocks of
-/// station report `r` that lie within `window_s` (bag time, s), and how many there are.
-fn window_one_x_error(
-    r: &crate::replay::StationReport,
-    window_s: [f64; 2],
-) -> Option<(f64, usize)> {
-    let errors: Vec<f64> = r
-        .blocks
-        .iter()
-        .filter(|b| b.start_s >= window_s[0] && b.end_s <= window_s[1])
-        .filter(|b| b.measured.one_x_amplitude_m > 0.0)
-        .map(|b| {
-            (b.predicted.one_x_amplitude_m - b.measured.one_x_amplitude_m).abs()
-                / b.measured.one_x_amplitude_m
-        })
-        .collect();
-    (!errors.is_empty()).then(|| {
-        (
-            errors.iter().sum::<f64>() / errors.len() as f64,
-            errors.len(),
-        )
-    })
-}
-
-/// The estimates and the before/after comparison, as text.
-fn calibration_summary(
-    cal: &crate::replay::calibration::BagCalibration,
-    before: &crate::replay::ReplayReport,
-    after: &crate::replay::ReplayReport,
-) -> String {
-    let v = &cal.viscosity;
+/// The estimates, as text.
+fn calibration_summary(cal: &crate::replay::calibration::BagCalibration) -> String {
     let mut s = format!(
-        "calibration on bag time {:.2}-{:.2} s ({} windows of {} revolutions, {} left out)\n  viscosity x{:.4} +- {:.4} of the machine file's",
+        "calibration on bag time {:.2}-{:.2} s ({} windows of {} revolutions, {} left out){}\n",
         cal.window_s[0],
         cal.window_s[1],
         cal.windows_used,
         crate::replay::calibration::CALIBRATION_WINDOW_REVS,
         cal.windows_skipped,
-        v.scale,
-        v.scale_std
+        if cal.speed_from_keyphasor {
+            "; speed from the keyphasor (no speed topic)"
+        } else {
+            ""
+        }
     );
-    if let (Some(t), Some(dt), Some(off)) =
-        (v.temperature_c, v.temperature_std_k, v.temperature_offset_k)
-    {
-        s += &format!(" (oil {t:.1} +- {dt:.1} degC, {off:+.1} K from the design point)");
+    match (&cal.viscosity, &cal.viscosity_not_fitted) {
+        (Some(v), _) => {
+            s += &format!(
+                "  viscosity x{:.4} +- {:.4} of the machine file's",
+                v.scale, v.scale_std
+            );
+            if let (Some(t), Some(dt), Some(off)) =
+                (v.temperature_c, v.temperature_std_k, v.temperature_offset_k)
+            {
+                s += &format!(" (oil {t:.1} +- {dt:.1} degC, {off:+.1} K from the design point)");
+            }
+            s += "\n";
+        }
+        (None, why) => s += &format!("  viscosity {}\n", why.as_deref().unwrap_or("not fitted")),
     }
-    s += "\n";
     let u = &cal.unbalance;
     for p in &u.planes {
-        s += &format!(
-            "  unbalance at node {}: {:.1} g.mm at {:.1} deg; correction {:.3} g at {:.0} mm, {:.1} deg\n",
-            p.node, p.magnitude_g_mm, p.phase_deg, p.correction.mass_g,
-            p.correction.radius_m * 1e3, p.correction.angle_deg
-        );
+        s += &match &cal.phase_null_reason {
+            None => format!(
+                "  unbalance at node {}: {:.1} g.mm at {:.1} deg; correction {:.3} g at {:.0} mm, {:.1} deg\n",
+                p.node, p.magnitude_g_mm, p.phase_deg, p.correction.mass_g,
+                p.correction.radius_m * 1e3, p.correction.angle_deg
+            ),
+            Some(why) => format!(
+                "  unbalance at node {}: {:.1} g.mm, phase null ({why}); correction {:.3} g at {:.0} mm\n",
+                p.node, p.magnitude_g_mm, p.correction.mass_g, p.correction.radius_m * 1e3
+            ),
+        };
     }
     s += &format!(
         "  1X residual {:.3} um RMS ({:.1} %), condition number {:.2}\n",
@@ -713,32 +709,54 @@ fn calibration_summary(
         100.0 * u.relative_residual,
         u.condition_number
     );
-    for (b, a) in before.stations.iter().zip(&after.stations) {
-        let pct = |r: &crate::replay::StationReport| {
-            r.one_x_amplitude_error_m
-                .zip(r.one_x_amplitude_measured_m)
-                .map_or("-".into(), |(e, m)| format!("{:+.1} %", 100.0 * e / m))
-        };
-        let in_window = |r: &crate::replay::StationReport| {
-            window_one_x_error(r, cal.window_s).map_or("-".into(), |(e, n)| {
-                format!("{:.1} % ({n} blocks)", 100.0 * e)
-            })
-        };
+    for r in &cal.runouts {
+        let v = r.vector.map_or(String::new(), |v| {
+            format!(
+                ": {:.2} um at {:.1} deg",
+                v.amplitude_m * 1e6,
+                v.phase_lag_deg
+            )
+        });
+        s += &format!("  runout of {}: {}{v}\n", r.probe, r.source);
+    }
+    s
+}
+
+/// The before/after comparison, as text.
+fn comparison_summary(c: &crate::replay::calibration::CalibrationComparison) -> String {
+    let pct = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:.1} %", 100.0 * e));
+    let signed = |x: Option<f64>| x.map_or("-".into(), |e| format!("{:+.1} %", 100.0 * e));
+    let deg = |x: Option<[f64; 2]>| x.map_or("null".into(), |[a, b]| format!("{a:.1}/{b:.1} deg"));
+    let sdeg =
+        |x: Option<[f64; 2]>| x.map_or("null".into(), |[a, b]| format!("{a:+.1}/{b:+.1} deg"));
+    let mut s = String::new();
+    for st in &c.stations {
         s += &format!(
-            "  {}: 1X amplitude error over the fitted window (mean |predicted - measured| / measured, blocks of 8 revolutions) before {}, after {}; over the bag's last 32 revolutions before {}, after {}\n",
-            b.station,
-            in_window(b),
-            in_window(a),
-            pct(b),
-            pct(a)
+            "  {}: over the fitted window ({} blocks of 8 revolutions, mean |predicted - measured|) 1X amplitude error before {}, after {}; phase lag error (probe axes) before {}, after {}\n",
+            st.station,
+            st.blocks_in_window,
+            pct(st.amplitude_error_window[0]),
+            pct(st.amplitude_error_window[1]),
+            deg(st.phase_lag_error_window_deg[0]),
+            deg(st.phase_lag_error_window_deg[1]),
+        );
+        s += &format!(
+            "    over the bag's last 32 revolutions (predicted - measured): amplitude before {}, after {}; phase lag before {}, after {}{}\n",
+            signed(st.amplitude_error_last[0]),
+            signed(st.amplitude_error_last[1]),
+            sdeg(st.phase_lag_error_last_deg[0]),
+            sdeg(st.phase_lag_error_last_deg[1]),
+            st.phase_null_reason
+                .as_ref()
+                .map_or(String::new(), |w| format!(" (phases null: {w})"))
         );
     }
     let rpm = |x: Option<f64>| x.map_or("-".into(), |v| format!("{v:.0} rpm"));
     s += &format!(
         "  onset: observed {}, predicted before {}, after {}\n",
-        rpm(before.onset.observed_speed_rpm),
-        rpm(before.onset.predicted_speed_rpm),
-        rpm(after.onset.predicted_speed_rpm)
+        rpm(c.onset_observed_rpm),
+        rpm(c.onset_predicted_rpm[0]),
+        rpm(c.onset_predicted_rpm[1])
     );
     s
 }

@@ -65,6 +65,14 @@ pub struct SynthArgs {
     /// Runout of each raw probe (µm, zero to peak; high spot 30° from the keyphasor mark).
     #[arg(long, default_value_t = 0.0)]
     pub runout_um: f64,
+    /// Write no speed topic: a rig with only the once-per-revolution keyphasor (the replay and
+    /// `--calibrate` take the speed from its intervals). Needs the keyphasor.
+    #[arg(long, conflicts_with = "no_keyphasor")]
+    pub no_speed: bool,
+    /// Raw probes AC-coupled: readings without the DC gap (a 0.1 s high pass takes the gap and
+    /// the journal's static position out), so no mean position. Needs --raw-probes.
+    #[arg(long, requires = "raw_probes")]
+    pub ac_coupled: bool,
 }
 
 /// Runs `rotor-twin synth-bag`: checks the arguments, writes the bag, prints what it holds.
@@ -110,6 +118,8 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
             keyphasor_angle_deg: (!args.no_keyphasor).then_some(args.keyphasor_deg),
             raw_probes: args.raw_probes,
             runout_m: args.runout_um * 1e-6,
+            no_speed_topic: args.no_speed,
+            ac_coupled: args.ac_coupled,
         },
     };
     anyhow::ensure!(
