@@ -146,6 +146,9 @@ pub struct FiniteFilm {
     journal_velocity: [f64; 2],
     /// ω of the last film shape (rad/s).
     speed_now: f64,
+    /// Mass-conserving mode: fall back to projected Gauss–Seidel when the active set cycles
+    /// (`finite/mass_conserving.rs`, eq. M5); off only to compare with the bare active set.
+    sweep_fallback: bool,
 }
 
 impl FiniteFilm {
@@ -216,6 +219,7 @@ impl FiniteFilm {
             feed_column: None,
             journal_velocity: [0.0; 2],
             speed_now: 0.0,
+            sweep_fallback: true,
             geometry,
             lubricant,
             grid,

@@ -55,6 +55,9 @@ use crate::film::error::FilmError;
 use crate::film::{FilmResult, JournalKinematics};
 use serde::{Deserialize, Serialize};
 
+#[path = "mass_conserving_sweep.rs"]
+mod sweep;
+
 /// How the film cavitates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
@@ -89,8 +92,12 @@ struct MixedRow {
     constant: f64,
 }
 
-/// Most set-update passes allowed for one mass-conserving solve.
+/// Most set-update passes allowed for one mass-conserving solve without the fallback (M5).
 const MAX_PASSES: usize = 200;
+
+/// Active-set passes before the fallback (M5) takes over (the fast path: 3–7 passes from a
+/// cold start, 1–2 warm).
+const FAST_PASSES: usize = 40;
 
 /// The complementarity tolerance of pass `pass`: 1e-12 (round-off) for the first 40 passes,
 /// then 1e-8, 1e-6 and from pass 120 on 1e-4 — a set iteration that cycles between nodes whose
@@ -204,6 +211,43 @@ impl FiniteFilm {
         }
     }
 
+    /// Replaces the committed fluid fraction φ⁰ (the twin's form, node `i·n_z + j`, `i` around,
+    /// `j` from the mid-plane): to reproduce a recorded film state. Errors if the film is not in
+    /// the twin's form or the length is not `n_theta·n_z`.
+    pub fn set_committed_fraction(&mut self, phi0: &[f64]) -> Result<(), FilmError> {
+        if !self.twin_form || phi0.len() != self.content_old.len() {
+            return Err(FilmError::InvalidParameter {
+                name: "committed fluid fraction (nodes)",
+                value: phi0.len() as f64,
+                rule: "the twin's transient form, one value per node (n_theta·n_z)",
+            });
+        }
+        self.content_old.copy_from_slice(phi0);
+        Ok(())
+    }
+
+    /// The full (true) and ruptured nodes the next mass-conserving solve starts its active set
+    /// from (node `i·n_z + j`): to reproduce a recorded film state.
+    pub fn set_full_nodes(&mut self, full: &[bool]) -> Result<(), FilmError> {
+        if full.len() != self.free.len() {
+            return Err(FilmError::InvalidParameter {
+                name: "full nodes (count)",
+                value: full.len() as f64,
+                rule: "one per node (n_theta·n_z)",
+            });
+        }
+        self.free.copy_from_slice(full);
+        self.warm = true;
+        Ok(())
+    }
+
+    /// This film with (default) or without the fallback (M5) of the mass-conserving solve:
+    /// without it, a cycling active set runs to 200 passes and fails (for comparison).
+    pub fn with_sweep_fallback(mut self, on: bool) -> Self {
+        self.sweep_fallback = on;
+        self
+    }
+
     /// Π of a node whose pressure is imposed (a groove, or the feed line of a plain bearing in
     /// the mass-conserving mode), else `None`.
     #[inline]
@@ -248,16 +292,31 @@ impl FiniteFilm {
                 self.free[i * nz..(i + 1) * nz].fill(full);
             }
         }
-        for pass in 1..=MAX_PASSES {
+        for pass in 1..=FAST_PASSES {
             self.solve_mixed_system()?;
             if !self.update_mixed_sets(set_tolerance(pass)) {
-                self.last_passes = pass;
-                self.warm = true;
-                return Ok(self.outputs(kin.speed_rad_s));
+                return Ok(self.settled(pass, kin));
+            }
+        }
+        if self.sweep_fallback {
+            // the active set cycles: (M5)
+            return self.solve_by_sweeps(kin);
+        }
+        for pass in FAST_PASSES + 1..=MAX_PASSES {
+            self.solve_mixed_system()?;
+            if !self.update_mixed_sets(set_tolerance(pass)) {
+                return Ok(self.settled(pass, kin));
             }
         }
         self.warm = false;
         Err(self.not_converged(kin, MAX_PASSES))
+    }
+
+    /// A solve that settled after `passes` passes: its sets start the next solve.
+    fn settled(&mut self, passes: usize, kin: &JournalKinematics) -> FilmResult {
+        self.last_passes = passes;
+        self.warm = true;
+        self.outputs(kin.speed_rad_s)
     }
 
     /// Orders the unknown nodes column by column from just after a fed column (every mixed
