@@ -146,9 +146,9 @@ pub struct FiniteFilm {
     journal_velocity: [f64; 2],
     /// ω of the last film shape (rad/s).
     speed_now: f64,
-    /// Mass-conserving mode: fall back to projected Gauss–Seidel when the active set cycles
-    /// (`finite/mass_conserving.rs`, eq. M5); off only to compare with the bare active set.
-    sweep_fallback: bool,
+    /// Mass-conserving mode: active-set passes before the projected Gauss–Seidel fallback (M5)
+    /// of `finite/mass_conserving_sweep.rs` takes over.
+    fast_passes: usize,
 }
 
 impl FiniteFilm {
@@ -219,7 +219,7 @@ impl FiniteFilm {
             feed_column: None,
             journal_velocity: [0.0; 2],
             speed_now: 0.0,
-            sweep_fallback: true,
+            fast_passes: mass_conserving::FAST_PASSES,
             geometry,
             lubricant,
             grid,

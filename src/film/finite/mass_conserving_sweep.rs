@@ -24,7 +24,6 @@
 //! sets (the flow balance to round-off).
 
 use super::super::FiniteFilm;
-use super::FAST_PASSES;
 use crate::film::error::FilmError;
 use crate::film::{FilmResult, JournalKinematics};
 
@@ -53,12 +52,12 @@ impl FiniteFilm {
             self.solve_mixed_system()?;
             let tol = if pass <= 2 { 1e-12 } else { 1e-9 };
             if !self.update_mixed_sets(tol) {
-                return Ok(self.settled(FAST_PASSES + pass, kin));
+                return Ok(self.settled(self.fast_passes + pass, kin));
             }
         }
         // the linear solves keep switching nodes on the rupture boundary: the swept solution
         self.sweep_until_settled(n, kin)?;
-        Ok(self.settled(FAST_PASSES + POLISH_PASSES, kin))
+        Ok(self.settled(self.fast_passes + POLISH_PASSES, kin))
     }
 
     /// Sweeps (M5) over the `n` unknown nodes until settled; the number of sweeps.
@@ -74,7 +73,7 @@ impl FiniteFilm {
             }
         }
         self.warm = false;
-        Err(self.not_converged(kin, FAST_PASSES + MAX_SWEEPS))
+        Err(self.not_converged(kin, self.fast_passes + MAX_SWEEPS))
     }
 
     /// One Gauss–Seidel sweep of (M5) in the order of the unknowns (downstream from the feed
