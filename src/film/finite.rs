@@ -134,7 +134,7 @@ pub struct FiniteFilm {
     content_old: Vec<f64>,
     /// `content_old` saved before a twin step that may be retried.
     content_saved: Vec<f64>,
-    /// The twin's transient form of (M3): φḢ + H(φ − φ⁰)/Δt.
+    /// The twin's transient form of (M3): φ⁰Ḣ + H(φ − φ⁰)/Δt (M4).
     twin_form: bool,
     /// 1/Δt of the mass-conserving transient (1/s), 0 when steady.
     inverse_step: f64,
