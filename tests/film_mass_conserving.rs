@@ -306,8 +306,9 @@ fn recorded_state(file: &str, passes: usize) -> RecordedState {
     let (nt, nz) = (field("n_theta")[0] as usize, field("n_z")[0] as usize);
     let c = field("clearance_m")[0];
     let g = BearingGeometry::plain(2.0 * field("radius_m")[0], field("length_m")[0], c).unwrap();
-    let oil = rotor_twin::film::Lubricant::new(field("density_kg_m3")[0], field("viscosity_pa_s")[0])
-        .unwrap();
+    let oil =
+        rotor_twin::film::Lubricant::new(field("density_kg_m3")[0], field("viscosity_pa_s")[0])
+            .unwrap();
     let mut film = FiniteFilm::new(g, oil, FilmGrid::new(nt, nz).unwrap())
         .unwrap()
         .with_cavitation(Cavitation::MassConserving)
@@ -317,7 +318,8 @@ fn recorded_state(file: &str, passes: usize) -> RecordedState {
     // − Y sin θ), then the twin's transient form keeps it
     let feed = field("feed_column")[0] * 2.0 * PI / nt as f64;
     let away = [-0.5 * c * feed.cos(), -0.5 * c * feed.sin()];
-    film.solve(&JournalKinematics::at_position(away, speed)).unwrap();
+    film.solve(&JournalKinematics::at_position(away, speed))
+        .unwrap();
     FilmModel::begin_step(&mut film, 1.0 / field("inverse_step_1_s")[0]);
     film.set_committed_fraction(&field("phi0")).unwrap();
     let full: Vec<bool> = field("full").iter().map(|&f| f > 0.5).collect();
@@ -378,5 +380,9 @@ fn the_near_wall_whip_state_converges() {
     );
     assert!(gap(&s) < 1e-9 * load(&r), "sweeps differ by {} N", gap(&s));
     assert!(s_imbalance < 1e-9, "sweeps' imbalance {s_imbalance}");
-    assert!(gap(&cold) < 1e-9 * load(&r), "cold start differs by {} N", gap(&cold));
+    assert!(
+        gap(&cold) < 1e-9 * load(&r),
+        "cold start differs by {} N",
+        gap(&cold)
+    );
 }

@@ -156,8 +156,10 @@ impl FiniteFilm {
             self.feed_column.map_or(-1, |f| f as i64),
         );
         let list = |v: Vec<String>| v.join(" ") + "\n";
-        out += &("phi0 ".to_string() + &list(self.content_old.iter().map(|v| format!("{v:?}")).collect()));
-        out += &("full ".to_string() + &list(self.free.iter().map(|&f| u8::from(f).to_string()).collect()));
+        out += &("phi0 ".to_string()
+            + &list(self.content_old.iter().map(|v| format!("{v:?}")).collect()));
+        out += &("full ".to_string()
+            + &list(self.free.iter().map(|&f| u8::from(f).to_string()).collect()));
         let speed = self.speed_now;
         let worst_b = (0..nt * nz)
             .filter(|&k| self.fixed_pi(k / nz).is_none())
@@ -176,7 +178,14 @@ impl FiniteFilm {
             self.update_mixed_sets(1e-12);
             let flips: Vec<String> = (0..nt * nz)
                 .filter(|&k| before[k] != self.free[k])
-                .map(|k| format!("{}:{}{}", k / nz, k % nz, if self.free[k] { "+" } else { "-" }))
+                .map(|k| {
+                    format!(
+                        "{}:{}{}",
+                        k / nz,
+                        k % nz,
+                        if self.free[k] { "+" } else { "-" }
+                    )
+                })
                 .collect();
             out += &format!(
                 "pass {pass} max_pi {pmax:?} least_pi {neg:?} most_phi_over_1 {over:?} flips {}",
