@@ -134,7 +134,7 @@ pub struct FiniteFilm {
     content_old: Vec<f64>,
     /// `content_old` saved before a twin step that may be retried.
     content_saved: Vec<f64>,
-    /// The twin's transient form of (M3): φḢ + H(φ − φ⁰)/Δt.
+    /// The twin's transient form of (M3): φ⁰Ḣ + H(φ − φ⁰)/Δt (M4).
     twin_form: bool,
     /// 1/Δt of the mass-conserving transient (1/s), 0 when steady.
     inverse_step: f64,
@@ -146,6 +146,9 @@ pub struct FiniteFilm {
     journal_velocity: [f64; 2],
     /// ω of the last film shape (rad/s).
     speed_now: f64,
+    /// Mass-conserving mode: active-set passes before the projected Gauss–Seidel fallback (M5)
+    /// of `finite/mass_conserving_sweep.rs` takes over.
+    fast_passes: usize,
 }
 
 impl FiniteFilm {
@@ -216,6 +219,7 @@ impl FiniteFilm {
             feed_column: None,
             journal_velocity: [0.0; 2],
             speed_now: 0.0,
+            fast_passes: mass_conserving::FAST_PASSES,
             geometry,
             lubricant,
             grid,

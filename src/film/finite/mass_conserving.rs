@@ -28,20 +28,26 @@
 //! as the Reynolds film does, and only the fluid fraction from the last committed step:
 //!
 //! ```text
-//!   (M4)  D_k = φ_k Ḣ_i + H_i (φ_k − φ⁰_k) / Δt      (twin's form: `FilmModel::begin_step`)
+//!   (M4)  D_k = φ⁰_k Ḣ_i + H_i (φ_k − φ⁰_k) / Δt     (twin's form: `FilmModel::begin_step`)
 //! ```
 //!
-//! (M4) is ∂(φH)/∂t = φ ∂H/∂t + H ∂φ/∂t with ∂φ/∂t backward Euler: where the film is whole
-//! (φ = φ⁰ = 1) it is the Reynolds film's squeeze term exactly, so a stable orbit fed at its
-//! widest gap matches the Reynolds twin; the fluid volume it conserves is that of the
-//! continuous rate (the flow balance holds to round-off at each solve, the volume over a step to
-//! O(Δt²)).
+//! (M4) is backward Euler of ∂(φH)/∂t, (φH − φ⁰H⁰)/Δt, with the step's starting gap taken as
+//! H⁰ = H − ḢΔt: where the film is whole (φ = φ⁰ = 1) it is the Reynolds film's squeeze term
+//! exactly, so a stable orbit fed at its widest gap matches the Reynolds twin; the fluid
+//! volume it conserves is that of the continuous rate (the flow balance holds to round-off at
+//! each solve, the volume over a step to O(Δt²)). φ's own coefficient is H/Δt > 0 whatever the
+//! squeeze. (Session 12 took φ_k Ḣ_i: φ's coefficient 2V(Ḣ + H/Δt) + w_jωH_{i+½} turns
+//! negative where the gap closes fast, Ḣ < −H/Δt − ωH_{i+½}/2Δθ — the minimum gap of the seed case's whip
+//! at ε 0.94–0.97, the journal running into the wall at 47–80 mm/s — and the mixed problem
+//! loses its M-matrix pieces: the active set flipped the minimum-gap column full ↔ ruptured
+//! each pass and no solution was found.)
 //!
 //! A as in `finite.rs`. The complementarity (M2) is solved by an active-set iteration on the
 //! mixed unknowns: each node is either full (unknown Π, φ = 1) or ruptured (unknown φ, Π = 0);
 //! one pass solves the linear system (M3) of the current sets (not symmetric: band LU), then a
 //! full node with Π < 0 ruptures and a ruptured node with φ > 1 fills. The sets of the previous
-//! solve are the next one's first guess.
+//! solve are the next one's first guess. If the sets still change after 40 passes, projected
+//! Gauss–Seidel (M5, `mass_conserving_sweep.rs`) finds the solution and its sets.
 //!
 //! Feeding: the grooves of the geometry hold Π at their supply pressure and φ = 1. A plain
 //! bearing (no groove) is fed at ambient pressure (Π = 0, φ = 1) at the column of the widest gap
@@ -54,6 +60,9 @@ use crate::film::coefficients::FilmCoefficients;
 use crate::film::error::FilmError;
 use crate::film::{FilmResult, JournalKinematics};
 use serde::{Deserialize, Serialize};
+
+#[path = "mass_conserving_sweep.rs"]
+mod sweep;
 
 /// How the film cavitates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -89,21 +98,9 @@ struct MixedRow {
     constant: f64,
 }
 
-/// Most set-update passes allowed for one mass-conserving solve.
-const MAX_PASSES: usize = 200;
-
-/// The complementarity tolerance of pass `pass`: 1e-12 (round-off) for the first 40 passes,
-/// then 1e-8, 1e-6 and from pass 120 on 1e-4 — a set iteration that cycles between nodes whose
-/// violations are that small (seen in the whip at ε 0.94–0.97, 8,500 and 9,000 rpm) stops with
-/// Π ≥ −1e-4·max Π and φ ≤ 1.0001.
-fn set_tolerance(pass: usize) -> f64 {
-    match pass {
-        0..=40 => 1e-12,
-        41..=80 => 1e-8,
-        81..=120 => 1e-6,
-        _ => 1e-4,
-    }
-}
+/// Active-set passes before the fallback (M5) takes over (the fast path: 3–7 passes from a
+/// cold start, 1–2 warm).
+pub(super) const FAST_PASSES: usize = 40;
 
 impl FiniteFilm {
     /// This solver with the cavitation model `cavitation` (Reynolds by default).
@@ -204,6 +201,43 @@ impl FiniteFilm {
         }
     }
 
+    /// Replaces the committed fluid fraction φ⁰ (the twin's form, node `i·n_z + j`, `i` around,
+    /// `j` from the mid-plane): to reproduce a recorded film state. Errors if the film is not in
+    /// the twin's form or the length is not `n_theta·n_z`.
+    pub fn set_committed_fraction(&mut self, phi0: &[f64]) -> Result<(), FilmError> {
+        if !self.twin_form || phi0.len() != self.content_old.len() {
+            return Err(FilmError::InvalidParameter {
+                name: "committed fluid fraction (nodes)",
+                value: phi0.len() as f64,
+                rule: "the twin's transient form, one value per node (n_theta·n_z)",
+            });
+        }
+        self.content_old.copy_from_slice(phi0);
+        Ok(())
+    }
+
+    /// The full (true) and ruptured nodes the next mass-conserving solve starts its active set
+    /// from (node `i·n_z + j`): to reproduce a recorded film state.
+    pub fn set_full_nodes(&mut self, full: &[bool]) -> Result<(), FilmError> {
+        if full.len() != self.free.len() {
+            return Err(FilmError::InvalidParameter {
+                name: "full nodes (count)",
+                value: full.len() as f64,
+                rule: "one per node (n_theta·n_z)",
+            });
+        }
+        self.free.copy_from_slice(full);
+        self.warm = true;
+        Ok(())
+    }
+
+    /// This film with `passes` active-set passes (default 40) before the fallback (M5) of the
+    /// mass-conserving solve takes over; 0: the projected Gauss–Seidel sweeps alone.
+    pub fn with_active_set_passes(mut self, passes: usize) -> Self {
+        self.fast_passes = passes;
+        self
+    }
+
     /// Π of a node whose pressure is imposed (a groove, or the feed line of a plain bearing in
     /// the mass-conserving mode), else `None`.
     #[inline]
@@ -248,16 +282,21 @@ impl FiniteFilm {
                 self.free[i * nz..(i + 1) * nz].fill(full);
             }
         }
-        for pass in 1..=MAX_PASSES {
+        for pass in 1..=self.fast_passes {
             self.solve_mixed_system()?;
-            if !self.update_mixed_sets(set_tolerance(pass)) {
-                self.last_passes = pass;
-                self.warm = true;
-                return Ok(self.outputs(kin.speed_rad_s));
+            if !self.update_mixed_sets(1e-12) {
+                return Ok(self.settled(pass, kin));
             }
         }
-        self.warm = false;
-        Err(self.not_converged(kin, MAX_PASSES))
+        // the active set cycles (or was given no passes): (M5)
+        self.solve_by_sweeps(kin)
+    }
+
+    /// A solve that settled after `passes` passes: its sets start the next solve.
+    fn settled(&mut self, passes: usize, kin: &JournalKinematics) -> FilmResult {
+        self.last_passes = passes;
+        self.warm = true;
+        self.outputs(kin.speed_rad_s)
     }
 
     /// Orders the unknown nodes column by column from just after a fed column (every mixed
@@ -304,11 +343,12 @@ impl FiniteFilm {
         let (up_east, up_west) = if speed >= 0.0 { (i, west) } else { (east, i) };
         let volume = self.dtheta * rw;
         let (own, constant) = if self.inverse_step > 0.0 && self.twin_form {
-            // (M4): φḢ + H(φ − φ⁰)/Δt, Ḣ from the journal velocity
+            // (M4): φ⁰Ḣ + H(φ − φ⁰)/Δt, Ḣ from the journal velocity; φ's coefficient H/Δt > 0
             let v = self.journal_velocity;
             let squeeze = -v[0] * self.cos_node[i] - v[1] * self.sin_node[i];
             let s = 2.0 * volume * self.inverse_step * self.h_node[i];
-            (2.0 * volume * squeeze + s, -s * self.content_old[k])
+            let old = self.content_old[k];
+            (s, (2.0 * volume * squeeze - s) * old)
         } else if self.inverse_step > 0.0 {
             let s = 2.0 * volume * self.inverse_step;
             (s * self.h_node[i], -s * self.content_old[k])
