@@ -466,7 +466,7 @@ fn banded_errors(model: &mut TabulatedFilm, states: &[Referenced]) -> ([f64; 8],
 #[test]
 #[ignore]
 fn resolution_study() {
-    use rotor_twin::film::{EccentricityMap, ForceFrame, TableResolution};
+    use rotor_twin::film::{EccentricityMap, ForceFrame, TableResolution, WallRows};
     let geometry = seed_bearing(0.5);
     let grid = FilmGrid::new(60, 10).unwrap();
     let per_band: usize = std::env::var("ROTOR_TWIN_TABLE_STUDY_N")
@@ -478,10 +478,15 @@ fn resolution_study() {
         .unwrap_or_else(|_| "atanh-loc:160x192x8,atanh:160x192x8".into());
     for spec in list.split(',') {
         let (map, dims) = spec.split_once(':').expect("map:NxMxP");
-        let d: Vec<usize> = dims
-            .split('x')
-            .map(|v| v.parse().expect("number"))
-            .collect();
+        // `…+950x384x8`: the rows at ε ≥ 0.950 with 384 columns and 8 phases (`WallRows`)
+        let (dims, wall) = dims.split_once('+').unwrap_or((dims, ""));
+        let numbers = |t: &str| -> Vec<usize> {
+            t.split('x')
+                .filter(|v| !v.is_empty())
+                .map(|v| v.parse().expect("number"))
+                .collect()
+        };
+        let (d, w) = (numbers(dims), numbers(wall));
         let res = TableResolution {
             n_ecc: d[0],
             n_psi: d[1],
@@ -497,6 +502,11 @@ fn resolution_study() {
             } else {
                 ForceFrame::Source
             },
+            wall: (w.len() == 3).then(|| WallRows {
+                from_ecc_per_mille: w[0] as u32,
+                n_psi: w[1],
+                grid_phases: w[2],
+            }),
         };
         let t0 = std::time::Instant::now();
         let table = FilmTable::build_with(&geometry, mdm(), grid, res).unwrap();

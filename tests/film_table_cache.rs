@@ -6,8 +6,9 @@
 
 use rotor_twin::film::{
     BearingGeometry, CacheWarning, FilmGrid, FilmModel, FilmTable, JournalKinematics, Lookup,
-    Lubricant, TableCache, TableOrigin, TabulatedFilm,
+    Lubricant, TableCache, TableOrigin, TableResolution, TabulatedFilm,
 };
+use rotor_twin::film::table_key;
 use std::sync::Arc;
 
 fn bearing() -> (BearingGeometry, Lubricant, FilmGrid) {
@@ -161,6 +162,24 @@ fn other_inputs_miss_and_a_file_of_other_inputs_is_refused() {
         Lookup::Rejected(w) => assert!(w.what.contains("key differs"), "{w}"),
         _ => panic!("a table of 40 µm clearance was taken for 41 µm"),
     }
+}
+
+/// The key spells out the default resolution's wall rows (session 13: finer ψ columns on the
+/// rows at ε ≥ 0.95, README "The film table's resolution"), so a file of the earlier uniform
+/// table (the same `nodes 160x192` line, no wall rows) has another name and key: it is never
+/// read, the table is rebuilt. On main (no wall rows) this fails.
+#[test]
+fn the_key_spells_out_the_wall_rows() {
+    let (g, l, grid) = bearing();
+    let key = table_key(&g, l, grid);
+    let res = TableResolution::DEFAULT;
+    let w = res.wall.expect("the default refines the wall rows");
+    let line = format!(
+        "wall rows eps >= {}/1000: {} columns, grid_phases {}\n",
+        w.from_ecc_per_mille, w.n_psi, w.grid_phases
+    );
+    assert!(key.contains(&line), "{key}");
+    assert!(w.n_psi > res.n_psi, "{w:?}");
 }
 
 #[test]
