@@ -64,6 +64,9 @@ pub struct TableResolution {
 /// resolution", session 12), while at the centre finer columns make them worse: so only
 /// these rows are refined. The 4 × 4 stencil interpolates each of its rows in ψ with that
 /// row's own spacing, then across the rows in ε: still Catmull–Rom (C¹) in each direction.
+/// Finer columns need more phases: a node's phase average keeps a jitter along ψ (where
+/// pressure-zone boundaries cross grid nodes), and the ψ-slope of the interpolant divides it
+/// by the spacing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WallRows {
     /// The first ε of the wall rows, in thousandths.
@@ -161,10 +164,13 @@ impl TableResolution {
         grid_phases: 8,
         map: EccentricityMap::Atanh,
         frame: ForceFrame::Source,
+        // 384 columns × 32 phases on the 83 rows at ε ≥ 0.95: coefficients 0.28 / 0.27 % in
+        // ε 0.95–0.98 / 0.98–0.995 (0.46 / 1.17 % uniform); finer columns need more phases
+        // (512 × 8: 0.61 / 1.63 %, 512 × 16: 0.33 / 0.67 %; README, session 13)
         wall: Some(WallRows {
             from_ecc_per_mille: 950,
-            n_psi: 512,
-            grid_phases: 8,
+            n_psi: 384,
+            grid_phases: 32,
         }),
     };
 
