@@ -5,10 +5,9 @@
 //! about a second: the cache does not look at the numbers, only stores them.
 
 use rotor_twin::film::{
-    BearingGeometry, CacheWarning, FilmGrid, FilmModel, FilmTable, JournalKinematics, Lookup,
-    Lubricant, TableCache, TableOrigin, TableResolution, TabulatedFilm,
+    table_key, BearingGeometry, CacheWarning, FilmGrid, FilmModel, FilmTable, JournalKinematics,
+    Lookup, Lubricant, TableCache, TableOrigin, TableResolution, TabulatedFilm,
 };
-use rotor_twin::film::table_key;
 use std::sync::Arc;
 
 fn bearing() -> (BearingGeometry, Lubricant, FilmGrid) {
