@@ -75,6 +75,8 @@ impl std::fmt::Display for TableOrigin {
 }
 
 /// The result of looking a table up on disk.
+// one a table load, never stored or in a hot path: the table unboxed (its nodes are on the heap)
+#[allow(clippy::large_enum_variant)]
 pub enum Lookup {
     /// The file verified: the table.
     Hit(FilmTable),

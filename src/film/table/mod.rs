@@ -334,7 +334,7 @@ pub struct FilmTable {
 impl FilmTable {
     /// The table of a plain bearing (no grooves) on `grid`, shared between all users of the same
     /// bearing in this process: on first use read from the disk cache ([`set_disk_cache`]) or
-    /// built (n_ecc × n_psi × (grid phases + 1) film solves, on all cores) and stored there, then reused.
+    /// built ([`TableResolution::solves`] film solves, on all cores) and stored there, then reused.
     pub fn shared(
         geometry: &BearingGeometry,
         lubricant: Lubricant,
