@@ -5,8 +5,8 @@
 //! about a second: the cache does not look at the numbers, only stores them.
 
 use rotor_twin::film::{
-    BearingGeometry, CacheWarning, FilmGrid, FilmModel, FilmTable, JournalKinematics, Lookup,
-    Lubricant, TableCache, TableOrigin, TabulatedFilm,
+    table_key, BearingGeometry, CacheWarning, FilmGrid, FilmModel, FilmTable, JournalKinematics,
+    Lookup, Lubricant, TableCache, TableOrigin, TableResolution, TabulatedFilm,
 };
 use std::sync::Arc;
 
@@ -76,7 +76,10 @@ fn a_table_read_back_is_the_table_built_bit_for_bit_with_identical_film_forces()
     let Lookup::Hit(loaded) = load(&cache) else {
         panic!("the stored table must load from {}", path.display());
     };
-    assert_eq!(table.values().len(), 160 * 192 * (14 + 12));
+    // 77 rows of 192 columns, then the 83 rows at ε ≥ 0.95 of 384 (`WallRows`), 14 values a
+    // node and the 12-angle profile
+    assert_eq!(TableResolution::DEFAULT.nodes(), 77 * 192 + 83 * 384);
+    assert_eq!(table.values().len(), (77 * 192 + 83 * 384) * (14 + 12));
     assert!(same_bits(&table, &loaded), "a tabulated value differs");
     // what the twin reads: force, zone, friction, flows, the eight coefficients, the profile
     let (mut a, mut b) = (
@@ -161,6 +164,24 @@ fn other_inputs_miss_and_a_file_of_other_inputs_is_refused() {
         Lookup::Rejected(w) => assert!(w.what.contains("key differs"), "{w}"),
         _ => panic!("a table of 40 µm clearance was taken for 41 µm"),
     }
+}
+
+/// The key spells out the default resolution's wall rows (session 13: finer ψ columns on the
+/// rows at ε ≥ 0.95, README "The film table's resolution"), so a file of the earlier uniform
+/// table (the same `nodes 160x192` line, no wall rows) has another name and key: it is never
+/// read, the table is rebuilt. On main (no wall rows) this fails.
+#[test]
+fn the_key_spells_out_the_wall_rows() {
+    let (g, l, grid) = bearing();
+    let key = table_key(&g, l, grid);
+    let res = TableResolution::DEFAULT;
+    let w = res.wall.expect("the default refines the wall rows");
+    let line = format!(
+        "wall rows eps >= {}/1000: {} columns, grid_phases {}\n",
+        w.from_ecc_per_mille, w.n_psi, w.grid_phases
+    );
+    assert!(key.contains(&line), "{key}");
+    assert!(w.n_psi > res.n_psi, "{w:?}");
 }
 
 #[test]

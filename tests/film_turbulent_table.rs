@@ -52,6 +52,7 @@ const COARSE: TableResolution = TableResolution {
     grid_phases: 1,
     map: EccentricityMap::Atanh,
     frame: ForceFrame::Source,
+    wall: None,
 };
 
 /// The worst force and coefficient errors of the Re interpolation of a table with slices

@@ -27,6 +27,7 @@ fn the_turbulent_tables_evaluation_allocates_nothing() {
         grid_phases: 1,
         map: EccentricityMap::Atanh,
         frame: ForceFrame::Source,
+        wall: None,
     };
     let re_per_speed = 900.0 * 0.03 * 40e-6 / 0.0008;
     for regime in [FlowRegime::Turbulent, FlowRegime::Auto] {

@@ -44,7 +44,7 @@ pub use table::{
 };
 pub use table::{
     EccentricityMap, FilmTable, ForceFrame, ReynoldsAxis, ReynoldsTable, ReynoldsTabulatedFilm,
-    SliceFlow, TableResolution, TabulatedFilm,
+    SliceFlow, TableResolution, TabulatedFilm, WallRows,
 };
 pub use thermal::{ThermalFilm, ThermalOil, ThermalState};
 pub use turbulence::{taylor_onset, FlowFactors, FlowRegime};

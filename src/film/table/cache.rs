@@ -75,6 +75,8 @@ impl std::fmt::Display for TableOrigin {
 }
 
 /// The result of looking a table up on disk.
+// one a table load, never stored or in a hot path: the table unboxed (its nodes are on the heap)
+#[allow(clippy::large_enum_variant)]
 pub enum Lookup {
     /// The file verified: the table.
     Hit(FilmTable),
@@ -189,6 +191,7 @@ impl TableCache {
                 profiles,
                 n_theta: grid.n_theta,
                 res,
+                layout: res.layout(),
                 u_max,
                 couette_factor: super::couette_factor(grid),
             }),
@@ -373,7 +376,7 @@ fn key_for(
         .collect();
     format!(
         "rotor-twin film table\nformat {FORMAT_VERSION}\nsolver {SOLVER_VERSION} source {:x}\n\
-         nodes {}x{} map {:?} eps_max {:?} eps_row_cap {:?} grid_phases {}\n\
+         nodes {}x{} map {:?} eps_max {:?} eps_row_cap {:?} grid_phases {}\nwall rows {}\n\
          diameter_m {:?}\nlength_m {:?}\nradial_clearance_m {:?}\ngrooves [{}]\n\
          density_kg_m3 {:?}\nviscosity_pa_s {:?}\ngrid {}x{}\n",
         source_fingerprint(),
@@ -383,6 +386,10 @@ fn key_for(
         MAX_ECCENTRICITY_RATIO,
         ROW_ECC_CAP,
         res.grid_phases,
+        res.wall.map_or("none".into(), |w| format!(
+            "eps >= {}/1000: {} columns, grid_phases {}",
+            w.from_ecc_per_mille, w.n_psi, w.grid_phases
+        )),
         geometry.diameter_m,
         geometry.length_m,
         geometry.radial_clearance_m,
@@ -441,7 +448,7 @@ fn node_from(v: &[f64]) -> Node {
 
 /// Payload bytes of a table of resolution `res` with `n_theta` profile angles.
 fn payload_len(n_theta: usize, res: &TableResolution) -> usize {
-    res.n_ecc * res.n_psi * (NODE_VALUES + n_theta) * 8
+    res.nodes() * (NODE_VALUES + n_theta) * 8
 }
 
 fn encode(table: &FilmTable, key: &str) -> Vec<u8> {
@@ -538,7 +545,7 @@ fn decode(
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {
         return Err(format!("value {i} is not finite"));
     }
-    let (node_part, profiles) = values.split_at(res.n_ecc * res.n_psi * NODE_VALUES);
+    let (node_part, profiles) = values.split_at(res.nodes() * NODE_VALUES);
     let nodes = node_part.chunks_exact(NODE_VALUES).map(node_from).collect();
     Ok((nodes, profiles.to_vec(), u_max))
 }

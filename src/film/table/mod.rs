@@ -54,6 +54,58 @@ pub struct TableResolution {
     pub map: EccentricityMap,
     /// The frame the force is held in.
     pub frame: ForceFrame,
+    /// The rows near the wall with their own (finer) ψ spacing and phases; None: every row as
+    /// above.
+    pub wall: Option<WallRows>,
+}
+
+/// The rows at ε ≥ `from_ecc_per_mille`/1000 with their own column count and grid phases.
+/// ψ-interpolation is what limits the coefficients at the wall (README "The film table's
+/// resolution", session 12), while at the centre finer columns make them worse: so only
+/// these rows are refined. The 4 × 4 stencil interpolates each of its rows in ψ with that
+/// row's own spacing, then across the rows in ε: still Catmull–Rom (C¹) in each direction.
+/// Finer columns need more phases: a node's phase average keeps a jitter along ψ (where
+/// pressure-zone boundaries cross grid nodes), and the ψ-slope of the interpolant divides it
+/// by the spacing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WallRows {
+    /// The first ε of the wall rows, in thousandths.
+    pub from_ecc_per_mille: u32,
+    /// Columns around ψ on those rows (even).
+    pub n_psi: usize,
+    /// Grid phases averaged at their nodes.
+    pub grid_phases: usize,
+}
+
+/// Where each row's nodes are: rows below `wall_row` have `n_psi` columns, the others
+/// `n_psi_wall`, row after row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Layout {
+    n_psi: usize,
+    n_psi_wall: usize,
+    wall_row: usize,
+}
+
+impl Layout {
+    /// The columns of row `i`.
+    #[inline]
+    fn columns(&self, i: usize) -> usize {
+        if i < self.wall_row {
+            self.n_psi
+        } else {
+            self.n_psi_wall
+        }
+    }
+
+    /// The index of row `i`'s first node.
+    #[inline]
+    fn start(&self, i: usize) -> usize {
+        if i < self.wall_row {
+            i * self.n_psi
+        } else {
+            self.wall_row * self.n_psi + (i - self.wall_row) * self.n_psi_wall
+        }
+    }
 }
 
 /// The frame in which the table holds the film force per unit V.
@@ -112,6 +164,14 @@ impl TableResolution {
         grid_phases: 8,
         map: EccentricityMap::Atanh,
         frame: ForceFrame::Source,
+        // 384 columns × 32 phases on the 83 rows at ε ≥ 0.95: coefficients 0.28 / 0.27 % in
+        // ε 0.95–0.98 / 0.98–0.995 (0.46 / 1.17 % uniform); finer columns need more phases
+        // (512 × 8: 0.61 / 1.63 %, 512 × 16: 0.33 / 0.67 %; README, session 13)
+        wall: Some(WallRows {
+            from_ecc_per_mille: 950,
+            n_psi: 384,
+            grid_phases: 32,
+        }),
     };
 
     fn validate(&self) -> Result<(), FilmError> {
@@ -131,12 +191,61 @@ impl TableResolution {
         if self.grid_phases == 0 {
             return bad("table grid_phases", 0, "at least 1");
         }
+        if let Some(w) = self.wall {
+            if w.n_psi < 4 || !w.n_psi.is_multiple_of(2) {
+                return bad("table wall columns n_psi", w.n_psi, "even, at least 4");
+            }
+            if w.grid_phases == 0 {
+                return bad("table wall grid_phases", 0, "at least 1");
+            }
+        }
         Ok(())
+    }
+
+    /// ε of row `i` (the build's and the cache's).
+    fn row_eps(&self, i: usize) -> f64 {
+        let u_max = self.map.u(MAX_ECCENTRICITY_RATIO);
+        self.map.eps(i as f64 * u_max / (self.n_ecc - 1) as f64)
+    }
+
+    /// Where the rows' nodes are.
+    fn layout(&self) -> Layout {
+        let (n_psi_wall, wall_row) = match self.wall {
+            Some(w) => {
+                let from = f64::from(w.from_ecc_per_mille) / 1000.0;
+                let first = (0..self.n_ecc).find(|&i| self.row_eps(i) >= from);
+                (w.n_psi, first.unwrap_or(self.n_ecc))
+            }
+            None => (self.n_psi, self.n_ecc),
+        };
+        Layout {
+            n_psi: self.n_psi,
+            n_psi_wall,
+            wall_row,
+        }
+    }
+
+    /// Columns and grid phases of row `i`.
+    fn row_columns(&self, i: usize) -> (usize, usize) {
+        match self.wall {
+            Some(w) if i >= self.layout().wall_row => (w.n_psi, w.grid_phases),
+            _ => (self.n_psi, self.grid_phases),
+        }
+    }
+
+    /// Nodes of a table on this resolution.
+    pub fn nodes(&self) -> usize {
+        self.layout().start(self.n_ecc)
     }
 
     /// Film solves to build a table on this resolution.
     pub fn solves(&self) -> usize {
-        self.n_ecc * self.n_psi * (self.grid_phases + 1)
+        (0..self.n_ecc)
+            .map(|i| {
+                let (n, m) = self.row_columns(i);
+                n * (m + 1)
+            })
+            .sum()
     }
 }
 
@@ -216,6 +325,7 @@ pub struct FilmTable {
     n_theta: usize,
     /// The resolution it was built on, and u at [`MAX_ECCENTRICITY_RATIO`].
     res: TableResolution,
+    layout: Layout,
     u_max: f64,
     /// κ = sin(Δθ/2)/(Δθ/2) of the grid ([`couette_factor`]).
     couette_factor: f64,
@@ -224,7 +334,7 @@ pub struct FilmTable {
 impl FilmTable {
     /// The table of a plain bearing (no grooves) on `grid`, shared between all users of the same
     /// bearing in this process: on first use read from the disk cache ([`set_disk_cache`]) or
-    /// built (n_ecc × n_psi × (grid phases + 1) film solves, on all cores) and stored there, then reused.
+    /// built ([`TableResolution::solves`] film solves, on all cores) and stored there, then reused.
     pub fn shared(
         geometry: &BearingGeometry,
         lubricant: Lubricant,
@@ -320,7 +430,7 @@ impl FilmTable {
             });
         }
         let u_max = res.map.u(MAX_ECCENTRICITY_RATIO);
-        let (n_ecc, n_psi) = (res.n_ecc, res.n_psi);
+        let n_ecc = res.n_ecc;
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let rows: Vec<usize> = (0..n_ecc).collect();
         let chunks: Vec<&[usize]> = rows.chunks(n_ecc.div_ceil(threads)).collect();
@@ -337,9 +447,10 @@ impl FilmTable {
                         }
                         let mut out = Vec::new();
                         for &i in chunk.iter() {
-                            let eps = res.map.eps(i as f64 * u_max / (n_ecc - 1) as f64);
+                            let eps = res.row_eps(i).min(ROW_ECC_CAP);
+                            let (n_psi, m) = res.row_columns(i);
                             let (nodes, profiles) =
-                                row(&mut film, &geometry, eps.min(ROW_ECC_CAP), &res)?;
+                                row(&mut film, &geometry, eps, [n_psi, m], res.frame)?;
                             out.push((i, nodes, profiles));
                         }
                         Ok(out)
@@ -351,13 +462,14 @@ impl FilmTable {
                 .map(|h| h.join().expect("table builder thread"))
                 .collect()
         });
-        let mut nodes = vec![Node::default(); n_ecc * n_psi];
-        let mut profiles = vec![0.0; n_ecc * n_psi * n_theta];
+        let layout = res.layout();
+        let mut nodes = vec![Node::default(); res.nodes()];
+        let mut profiles = vec![0.0; res.nodes() * n_theta];
         for part in results {
             for (i, row_nodes, row_profiles) in part? {
-                nodes[i * n_psi..(i + 1) * n_psi].copy_from_slice(&row_nodes);
-                profiles[i * n_psi * n_theta..(i + 1) * n_psi * n_theta]
-                    .copy_from_slice(&row_profiles);
+                let (a, b) = (layout.start(i), layout.start(i + 1));
+                nodes[a..b].copy_from_slice(&row_nodes);
+                profiles[a * n_theta..b * n_theta].copy_from_slice(&row_profiles);
             }
         }
         Ok(FilmTable {
@@ -369,6 +481,7 @@ impl FilmTable {
             profiles,
             n_theta,
             res,
+            layout,
             u_max,
             couette_factor: couette_factor(grid),
         })
@@ -395,35 +508,40 @@ impl FilmTable {
         )
     }
 
-    /// The fractional column index of ψ, its column and the fraction past it.
-    fn column_coordinate(&self, psi: f64) -> (usize, f64) {
-        let n = self.res.n_psi;
+    /// The column of ψ among `n` columns and the fraction past it.
+    fn column_coordinate(n: usize, psi: f64) -> (usize, f64) {
         let fp = wrap_angle_rad(psi) / TAU * n as f64;
         let ip = (fp.floor() as usize).min(n - 1);
         (ip, fp - ip as f64)
     }
 
-    /// The four nodes around (ε, ψ) and their bilinear weights (rows, columns, row weights,
-    /// column weights): for the mid-plane profile, where a smooth display suffices.
-    fn bilinear(&self, eps: f64, psi: f64) -> ([usize; 2], [usize; 2], [f64; 2], [f64; 2]) {
+    /// The four nodes around (ε, ψ) (each row's two columns at its own spacing) and their
+    /// bilinear weights: for the mid-plane profile, where a smooth display suffices.
+    fn bilinear(&self, eps: f64, psi: f64) -> ([usize; 4], [f64; 4]) {
         let (fu, _) = self.row_coordinate(eps);
         let iu = fu.floor() as usize;
-        let (ip, tp) = self.column_coordinate(psi);
         let tu = fu - iu as f64;
-        (
-            [iu, (iu + 1).min(self.res.n_ecc - 1)],
-            [ip, (ip + 1) % self.res.n_psi],
-            [1.0 - tu, tu],
-            [1.0 - tp, tp],
-        )
+        let rows = [iu, (iu + 1).min(self.res.n_ecc - 1)];
+        let mut index = [0; 4];
+        let mut weight = [0.0; 4];
+        for (a, (&r, wr)) in rows.iter().zip([1.0 - tu, tu]).enumerate() {
+            let n = self.layout.columns(r);
+            let (ip, tp) = Self::column_coordinate(n, psi);
+            let start = self.layout.start(r);
+            index[2 * a] = start + ip;
+            index[2 * a + 1] = start + (ip + 1) % n;
+            weight[2 * a] = wr * (1.0 - tp);
+            weight[2 * a + 1] = wr * tp;
+        }
+        (index, weight)
     }
 
     /// The 4 × 4 Catmull–Rom stencil at (ε, ψ) with the weights' derivatives d/dε and d/dψ.
+    /// Each stencil row is interpolated in ψ on its own columns ([`WallRows`]).
     fn stencil_with_slopes(&self, eps: f64, psi: f64) -> Stencil {
-        let (n_ecc, n_psi) = (self.res.n_ecc, self.res.n_psi);
+        let n_ecc = self.res.n_ecc;
         let (fu, dfu) = self.row_coordinate(eps);
         let iu = fu.floor() as usize;
-        let (ip, tp) = self.column_coordinate(psi);
         // below the first interval: row −1 is row 1's mirror image (atanh map), or the linear
         // extrapolation of rows 0 and 1 (log map); beyond the last, the linear extrapolation of
         // the last two. Extrapolations are folded into the weights of the rows that exist.
@@ -446,28 +564,40 @@ impl FilmTable {
         } else {
             [iu - 1, iu, iu + 1, iu + 2]
         };
-        let cols = [
-            (ip + n_psi - 1) % n_psi,
-            ip,
-            (ip + 1) % n_psi,
-            (ip + 2) % n_psi,
-        ];
+        // the columns and weights in ψ on n columns
+        let in_psi = |n: usize| {
+            let (ip, tp) = Self::column_coordinate(n, psi);
+            let cols = [(ip + n - 1) % n, ip, (ip + 1) % n, (ip + 2) % n];
+            // d(fp)/dψ = N_ψ/2π
+            let dfp = n as f64 / TAU;
+            (
+                n,
+                cols,
+                catmull_rom(tp),
+                catmull_rom_slope(tp).map(|w| w * dfp),
+            )
+        };
+        let main = in_psi(self.layout.n_psi);
+        let wall = if self.layout.n_psi_wall == self.layout.n_psi {
+            main
+        } else {
+            in_psi(self.layout.n_psi_wall)
+        };
+        let per_row = rows.map(|r| if r < self.layout.wall_row { main } else { wall });
         let tu = fu - iu as f64;
-        // d(fp)/dψ = N_ψ/2π
-        let dfp = n_psi as f64 / TAU;
         Stencil {
-            rows,
+            start: rows.map(|r| self.layout.start(r)),
+            n_cols: per_row.map(|p| p.0),
             mirrored: [mirror, false, false, false],
             mirrored_force_sign: match self.res.frame {
                 ForceFrame::Source => 1.0,
                 ForceFrame::LineOfCentres => -1.0,
             },
-            cols,
-            n_psi,
+            cols: per_row.map(|p| p.1),
             wr: fold(catmull_rom(tu)),
-            wc: catmull_rom(tp),
+            wc: per_row.map(|p| p.2),
             dwr: fold(catmull_rom_slope(tu)).map(|w| w * dfu),
-            dwc: catmull_rom_slope(tp).map(|w| w * dfp),
+            dwc: per_row.map(|p| p.3),
         }
     }
 
@@ -481,9 +611,9 @@ impl FilmTable {
                 let (index, [_, sign]) = st.node(a, b);
                 let m = &self.nodes[index];
                 let w = [
-                    sign * st.wr[a] * st.wc[b],
-                    sign * st.dwr[a] * st.wc[b],
-                    sign * st.wr[a] * st.dwc[b],
+                    sign * st.wr[a] * st.wc[a][b],
+                    sign * st.dwr[a] * st.wc[a][b],
+                    sign * st.wr[a] * st.dwc[a][b],
                 ];
                 for (o, wk) in out.iter_mut().zip(w) {
                     o[0] += wk * m.force[0];
@@ -506,7 +636,7 @@ impl FilmTable {
         for a in 0..4 {
             for b in 0..4 {
                 let (index, sign) = st.node(a, b);
-                n.add(st.wr[a] * st.wc[b], sign, &self.nodes[index]);
+                n.add(st.wr[a] * st.wc[a][b], sign, &self.nodes[index]);
             }
         }
         if self.res.frame == ForceFrame::Source {
@@ -526,10 +656,10 @@ impl FilmTable {
             for b in 0..4 {
                 let (index, sign) = st.node(a, b);
                 let m = &self.nodes[index];
-                n.add(st.wr[a] * st.wc[b], sign, m);
+                n.add(st.wr[a] * st.wc[a][b], sign, m);
                 let (w_eps, w_psi) = (
-                    sign[1] * st.dwr[a] * st.wc[b],
-                    sign[1] * st.wr[a] * st.dwc[b],
+                    sign[1] * st.dwr[a] * st.wc[a][b],
+                    sign[1] * st.wr[a] * st.dwc[a][b],
                 );
                 f_eps[0] += w_eps * m.force[0];
                 f_eps[1] += w_eps * m.force[1];
@@ -643,37 +773,38 @@ impl FilmTable {
     }
 }
 
-/// Rows and columns of a 4 × 4 interpolation stencil, the weights and their derivatives.
+/// Rows and columns of a 4 × 4 interpolation stencil, the weights and their derivatives; each
+/// stencil row has its own columns and ψ-weights (its own spacing, [`WallRows`]).
 struct Stencil {
-    rows: [usize; 4],
+    /// each stencil row's first node in the table, and its column count
+    start: [usize; 4],
+    n_cols: [usize; 4],
     /// rows read as their mirror image through the centre, f(−ε, ψ) = −f(ε, ψ + π), i.e.
     /// g(−ε, ψ) = g(ε, ψ + π) for the force in the source's frame ([`source_frame`])
     mirrored: [bool; 4],
     /// the sign of a mirrored row's force: −1 in the line of centres, +1 in the source's frame
     mirrored_force_sign: f64,
-    cols: [usize; 4],
-    n_psi: usize,
+    cols: [[usize; 4]; 4],
     wr: [f64; 4],
-    wc: [f64; 4],
+    wc: [[f64; 4]; 4],
     /// d wr / dε
     dwr: [f64; 4],
     /// d wc / dψ
-    dwc: [f64; 4],
+    dwc: [[f64; 4]; 4],
 }
 
 impl Stencil {
     /// The index of node (a, b) of the stencil in the table, and the signs of its angles' unit
     /// vectors and of its force (−1 in a mirrored row; a force in the source's frame keeps its
     /// sign there).
+    #[inline]
     fn node(&self, a: usize, b: usize) -> (usize, [f64; 2]) {
         if self.mirrored[a] {
-            let col = (self.cols[b] + self.n_psi / 2) % self.n_psi;
-            (
-                self.rows[a] * self.n_psi + col,
-                [-1.0, self.mirrored_force_sign],
-            )
+            let n = self.n_cols[a];
+            let col = (self.cols[a][b] + n / 2) % n;
+            (self.start[a] + col, [-1.0, self.mirrored_force_sign])
         } else {
-            (self.rows[a] * self.n_psi + self.cols[b], [1.0, 1.0])
+            (self.start[a] + self.cols[a][b], [1.0, 1.0])
         }
     }
 }
@@ -709,14 +840,13 @@ fn row(
     film: &mut FiniteFilm,
     geometry: &BearingGeometry,
     eps: f64,
-    res: &TableResolution,
+    [n_psi, m]: [usize; 2],
+    frame: ForceFrame,
 ) -> Result<(Vec<Node>, Vec<f64>), FilmError> {
     let c = geometry.radial_clearance_m;
     let n_theta = film.grid().n_theta;
-    let n_psi = res.n_psi;
     let mut nodes = Vec::with_capacity(n_psi);
     let mut profiles = vec![0.0; n_psi * n_theta];
-    let m = res.grid_phases;
     let kappa = couette_factor(film.grid());
     for j in 0..n_psi {
         let psi = TAU * j as f64 / n_psi as f64;
@@ -739,7 +869,7 @@ fn row(
             }
             let unit = |a: f64| [(a - alpha).cos(), (a - alpha).sin()];
             let share = 1.0 / m as f64;
-            let f = match res.frame {
+            let f = match frame {
                 ForceFrame::Source => source_frame(psi, back(pressure.force_n), -1.0),
                 ForceFrame::LineOfCentres => back(pressure.force_n),
             };

@@ -84,7 +84,7 @@ impl FilmModel for TabulatedFilm {
         let s = t.line_of_centres(&self.last);
         // bilinear between the four nodes around the state: the profile is for display and the
         // monitor's revolution-to-revolution pressure difference, not for the force
-        let (rows, cols, wr, wc) = t.bilinear(s.eps, s.psi);
+        let (index, weight) = t.bilinear(s.eps, s.psi);
         let len = out.len().max(1);
         // θ_k − φ in grid columns of the line-of-centres frame, linear between the two columns
         // around it (a nearest column would jump as the attitude turns)
@@ -104,10 +104,7 @@ impl FilmModel for TabulatedFilm {
         // then sample the blend; larger grids blend at each output angle
         let mut blend = [0.0; 512];
         // the four nodes: weight and the start of the profile
-        let nodes: [(f64, usize); 4] = std::array::from_fn(|n| {
-            let (a, b) = (n / 2, n % 2);
-            (wr[a] * wc[b], (rows[a] * t.res.n_psi + cols[b]) * t.n_theta)
-        });
+        let nodes: [(f64, usize); 4] = std::array::from_fn(|n| (weight[n], index[n] * t.n_theta));
         let profile = |start: usize| &t.profiles[start..start + t.n_theta];
         if t.n_theta <= blend.len() {
             let blend = &mut blend[..t.n_theta];
