@@ -133,7 +133,11 @@ fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
         "{:?}",
         cal.viscosity
     );
-    assert_covers("sample bag, plant × 1.05", cal.viscosity.as_ref().unwrap(), 1.05);
+    assert_covers(
+        "sample bag, plant × 1.05",
+        cal.viscosity.as_ref().unwrap(),
+        1.05,
+    );
     let p = cal.unbalance.planes[0];
     assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
     let dphi = (p.phase_deg + 180.0).rem_euclid(360.0) - 180.0;
