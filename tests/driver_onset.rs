@@ -114,13 +114,16 @@ fn plant_and_driver(revs: f64) -> (Track, Track, u64) {
     (p, d, driver.counts().starts)
 }
 
-/// Measured (session 13): before the fix the first keyphasor event turned the running,
-/// unlocked twin's angle by the plant's one step ahead (2π/64 = 0.098 rad): the unbalance force
-/// jumped in phase, an impulse, and the twin's journal left the plain twin's by 0.6 µm
-/// (0.5 % of c), its sub-synchronous seed ×18 after 40 revolutions. Now the twin restarts at
-/// that event, angle zero there, as a twin that waited for it: step by step it keeps to the
-/// plain twin within 10⁻¹² m over 40 revolutions (the later events correct the angle by a
-/// nanosecond's turn of the stamp's rounding, ~10⁻⁶ rad), and its seed is the plain twin's.
+/// Measured (session 13): before the fix the driver's twin was bitwise the plain twin's up to
+/// step 64, then the first keyphasor event turned the running, unlocked twin's angle by the
+/// plant's one step ahead (2π/64 = 0.098 rad): the unbalance force jumped in phase, an
+/// impulse; from step 65 on the journals parted, by 0.56 µm within 41 revolutions, and the
+/// sub-synchronous amplitude after 40 revolutions was × 8.2 the plain twin's. Now the twin
+/// restarts at that event, angle zero there, as a twin that waited for it: over 40
+/// revolutions it keeps to the plain twin within 3.6·10⁻¹² m (the later events turn its angle
+/// by the stamps' nanosecond rounding, ~10⁻⁶ rad, ~6 µm/rad × 10⁻⁶ each: the 10⁻¹⁰ m
+/// asserted is 5,000× below the kick's 0.56 µm), and its sub-synchronous amplitude is the
+/// plain twin's to 10⁻⁴ (1 % asserted).
 #[test]
 fn a_twin_started_before_the_first_keyphasor_follows_a_plain_twin() {
     let (plant, driver, starts) = plant_and_driver(41.0);
@@ -151,6 +154,6 @@ fn a_twin_started_before_the_first_keyphasor_follows_a_plain_twin() {
         driver.subsync[r], plant.subsync[r]
     );
     assert!(n >= 36 * 64, "{n} steps compared");
-    assert!(worst < 1e-12, "journals {worst:e} m apart");
+    assert!(worst < 1e-10, "journals {worst:e} m apart");
     assert!((seed - 1.0).abs() < 0.01, "seed × {seed}");
 }
