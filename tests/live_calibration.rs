@@ -570,8 +570,10 @@ fn nonlinear_onset_after_live_calibration() {
         after - plant,
         own - plant
     );
-    // one start each: the twins ran the plant's whole history
-    assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 1));
+    // two starts each: at the first speed, and again at the first keyphasor event (a twin
+    // running unlocked restarts there rather than being turned onto it); the twins ran the
+    // plant's whole history from then on
+    assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 2));
     assert!((own - plant).abs() < 30.0);
     assert!((after - plant).abs() < 150.0);
 }
@@ -638,7 +640,12 @@ fn onset_against_the_film_grid() {
 /// Study (README, "The onset after a live calibration", the grid study's 212 rpm): the machine
 /// file's plant (60 × 10, direct film, a plain twin) against twins of the same machine through
 /// the driver: tabulated, direct, and direct with the plant's own time step; from 8,000 rpm (16
-/// revolutions), the 400 rpm/s run-up. Ignored; asserts only that each finds an onset.
+/// revolutions), the 400 rpm/s run-up. Before session 13's fix the driver's twins whipped
+/// 212–277 rpm early (8,964 table, 8,899 direct against 9,176): the first keyphasor event turned
+/// the running twin's angle by 0.098 rad, an unbalance impulse (tests/driver_onset.rs). Now the
+/// direct twins (the plant's own model) whip within 30 rpm of the plant, the replay rule's
+/// resolution (~21 rpm, one block of 8 revolutions at 400 rpm/s) plus its block phase; the
+/// table's −21…−42 rpm against the direct film (README) is not asserted. Ignored (1.5 min).
 #[test]
 #[ignore]
 fn onset_through_the_driver_against_a_plain_twin() {
@@ -671,4 +678,8 @@ fn onset_through_the_driver_against_a_plain_twin() {
         onset(1, true),
         onset(2, true)
     );
+    for i in [1, 2] {
+        let gap = onset(i, true) - onset(0, false);
+        assert!(gap.abs() < 30.0, "driver {i}: {gap:+.0} rpm from the plant");
+    }
 }

@@ -232,7 +232,8 @@ impl Driver {
     }
 
     /// A keyphasor event stamped `stamp_ns`, received at `now_ns`: checked against the speed,
-    /// then the twin's angle is corrected; without a speed topic, its interval is the speed.
+    /// then the twin's angle is corrected (a twin not yet locked restarts at the event);
+    /// without a speed topic, its interval is the speed.
     pub(super) fn take_keyphasor(
         &mut self,
         now_ns: i64,
@@ -252,7 +253,15 @@ impl Driver {
             .filter(|_| !self.signals.speed_from_keyphasor)
             .filter(|s| (now_ns - s.received_ns) <= tolerance)
             .map(|s| s.speed_rad_s);
-        let angle = self.session.as_ref().map(|s| s.angle_at(t));
+        // a twin running unlocked (started by a speed before the first event) restarts at the
+        // event, angle 0 there, instead of being turned onto it: turning a running twin jumps
+        // its unbalance force's phase, an impulse that seeds its whirl (README, "The onset
+        // after a live calibration": 0.098 rad, the run-up onset 200 rpm early)
+        let restart = self.session.is_some() && !self.signals.keyphasor.is_locked();
+        let angle = match (&self.session, restart) {
+            (Some(s), false) => Some(s.angle_at(t)),
+            _ => None,
+        };
         let after = self.signals.events.newest_ns().is_none_or(|n| t > n);
         let ev = match self.signals.keyphasor.event(t, angle, topic_speed) {
             Ok(ev) => ev,
@@ -265,6 +274,9 @@ impl Driver {
             }
         };
         self.signals.events.push(t);
+        if restart {
+            self.session = None;
+        }
         if let (Some(c), Some(s)) = (ev.correction_rad, self.session.as_mut()) {
             s.shift_angle(c);
         }
