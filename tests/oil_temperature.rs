@@ -273,6 +273,18 @@ fn a_calibrated_viscosity_follows_later_oil_temperatures() {
         Fed::Taken
     );
     let expected = 1.10 * s_law(60.0) / s_law(40.0);
+    // mid-blend the temperature moves the blend's target, not the twin: still near the start
+    assert!((twin(&d) / s_law(40.0) - 1.0).abs() < 0.01, "{}", twin(&d));
+    // past the blend (`CALIBRATION_BLEND_S`) the twin is at the calibrated scale for 60 °C
+    let blend_ms = (rotor_twin::driver::calibration::CALIBRATION_BLEND_S * 1e3) as i64;
+    for k in 1..=(blend_ms / 10 + 2) {
+        let speed = Input::Speed {
+            speed_rad_s: 8000.0 * std::f64::consts::PI / 30.0,
+            accel_rad_s2: 0.0,
+            stamp_ns: 0,
+        };
+        d.feed(t0 + 2_000_000 + k * 10_000_000, speed, &mut emit);
+    }
     println!(
         "calibrated × 1.10 at 40 °C, then 60 °C: × {:.5} (law alone × {:.5})",
         twin(&d),

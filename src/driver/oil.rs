@@ -204,7 +204,9 @@ impl Driver {
         self.rotor
             .set_film_viscosity_scales(&self.oil.scales)
             .map_err(|e| format!("oil temperature: {e}"))?;
-        if let Some(s) = self.session.as_mut() {
+        // a calibration blending into the running twin takes the new scales as its target
+        // (`blend_targets`, next step); set here they would jump the twin there and back
+        if let Some(s) = self.session.as_mut().filter(|_| self.blend.is_none()) {
             s.twin_mut()
                 .set_viscosity_scales(&self.oil.scales)
                 .map_err(|e| format!("oil temperature: {e}"))?;
