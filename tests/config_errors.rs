@@ -16,6 +16,20 @@ fn with(from: &str, to: &str) -> String {
     DEFAULT_MACHINE_YAML.replacen(from, to, 1)
 }
 
+/// The built-in machine's MDM viscosity table, as both film bearings carry it.
+const MDM_TABLE: &str = "        table: {temperatures_c: [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0, 110.0, 120.0],\n                viscosities_pa_s: [1.16888e-3, 1.02439e-3, 0.903011e-3, 0.800000e-3, 0.712838e-3, 0.639124e-3,\n                                   0.575962e-3, 0.520959e-3, 0.472895e-3, 0.431143e-3, 0.394765e-3, 0.362473e-3]}\n";
+
+/// The built-in machine with the first film bearing's MDM table replaced by Walther's two points
+/// at 40 and 80 °C (kinematic viscosities `nu_mm2_s`, as YAML text).
+fn with_walther(nu_mm2_s: &str) -> String {
+    with(
+        MDM_TABLE,
+        &format!(
+            "        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: {nu_mm2_s}\n"
+        ),
+    )
+}
+
 fn says(e: &ConfigError, field: &str, value: &str, rule: &str) {
     let text = e.to_string();
     assert!(text.starts_with("machine.yaml: "), "{text}");
@@ -67,19 +81,13 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
     );
     // the viscosity–temperature law (issue 12): points, range, agreement at the design point
     says(
-        &error_of(&with(
-            "kinematic_viscosities_mm2_s: [0.889, 0.60]",
-            "kinematic_viscosities_mm2_s: [0.60, 0.889]",
-        )),
+        &error_of(&with_walther("[0.60, 0.889]")),
         "bearings[0].lubricant.viscosity_temperature.(law)",
         "[0.6, 0.889]",
         "must fall as the temperature rises",
     );
     says(
-        &error_of(&with(
-            "kinematic_viscosities_mm2_s: [0.889, 0.60]",
-            "kinematic_viscosities_mm2_s: [0.95, 0.60]",
-        )),
+        &error_of(&with_walther("[0.95, 0.60]")),
         "bearings[0].lubricant.viscosity_temperature.kinematic_viscosities_mm2_s",
         "[0.95, 0.6]",
         "agree within 1 %",
@@ -106,7 +114,7 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
     // refused, not silently left at the machine file's viscosity (each may have its own law)
     says(
         &error_of(&with(
-            "      viscosity_temperature:  # as bearing_pulley_end's (one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.60]\n        design_supply_temperature_c: 40.0\n        valid_range_c: [10.0, 120.0]\n",
+            &format!("      viscosity_temperature:  # as bearing_pulley_end's (one oil supply)\n{MDM_TABLE}        design_supply_temperature_c: 40.0\n        valid_range_c: [10.0, 120.0]\n"),
             "",
         )),
         "bearings[1].lubricant.viscosity_temperature",
@@ -116,8 +124,8 @@ fn out_of_range_values_are_named_with_field_value_and_rule() {
     // a second bearing with a law of its own is taken (one scale per bearing)
     assert!(MachineDescription::from_yaml(
         &with(
-            "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.60]",
-            "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.50]",
+            &format!("(one oil supply)\n{MDM_TABLE}"),
+            "(one oil supply)\n        temperatures_c: [40.0, 80.0]\n        kinematic_viscosities_mm2_s: [0.889, 0.50]\n",
         ),
         "own law"
     )
