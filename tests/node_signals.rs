@@ -244,7 +244,7 @@ fn offline_scale(celsius: f64) -> f64 {
 /// Cyclone peer, best effort, on /plant/oil_temperature (the node's rotor_twin/oil_temperature
 /// remapped): 60 °C for the first 3 s, then 50 °C, then one NaN and one 1,000 °C and nothing
 /// more. The node's viscosity in force, as its /diagnostics (status `<node>: model`) reports it
-/// per film bearing, moves to the driver's scale for 60 °C (× 0.8114 on the built-in law) and
+/// per film bearing, moves to the driver's scale for 60 °C (× 0.7989 on the built-in law) and
 /// then 50 °C, each equal to the offline driver's to the 5 decimals printed; the NaN and the
 /// absurd value are refused, counted (`refused_inputs` ≥ 2) and warned about (`bad_input`
 /// naming the temperature), and the last good 50 °C stays in force; every Temperature sent is

@@ -110,13 +110,14 @@ pub struct BearingArgs {
     /// Oil supply temperature (°C), with --thermal.
     #[arg(long, default_value_t = 40.0)]
     supply_temperature_c: f64,
-    /// Specific heat c_p of the oil (J/(kg·K)), with --thermal (default: the ASSUMED 1,900 of MDM).
-    #[arg(long, default_value_t = 1900.0)]
+    /// Specific heat c_p of the oil (J/(kg·K)), with --thermal (default: MDM's at 40–42 °C, from
+    /// the Colonna et al. 2008 equation of state; tests/reference/mdm_viscosity.csv).
+    #[arg(long, default_value_t = 1820.0)]
     specific_heat_j_per_kg_k: f64,
-    /// Walther's law through two points °C:mm²/s, with --thermal (default: the machine file's MDM
-    /// points).
-    #[arg(long, default_value = "40:0.889,80:0.60")]
-    viscosity_points: String,
+    /// Walther's law through two points °C:mm²/s, e.g. 40:0.889,80:0.60, with --thermal
+    /// (default: the built-in machine's MDM viscosity table).
+    #[arg(long)]
+    viscosity_points: Option<String>,
     /// Cavitation condition of the finite film: reynolds or mass-conserving (JFO, issue 18).
     #[arg(long, value_enum, default_value_t = CavitationKind::Reynolds)]
     cavitation: CavitationKind,
@@ -292,7 +293,7 @@ fn film_from_flags(args: &BearingArgs) -> anyhow::Result<(Box<dyn FilmModel>, Lu
 /// The oil of `--thermal` from the flags.
 fn thermal_oil(args: &BearingArgs) -> anyhow::Result<crate::film::ThermalOil> {
     super::bearing_thermal::thermal_oil(
-        &args.viscosity_points,
+        args.viscosity_points.as_deref(),
         args.density_kg_m3,
         args.specific_heat_j_per_kg_k,
         args.supply_temperature_c,

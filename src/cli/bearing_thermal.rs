@@ -4,17 +4,53 @@ use crate::film::{
     FilmModel, FiniteFilm, JournalKinematics, ThermalFilm, ThermalOil, ViscosityLaw, WaltherLaw,
     ZERO_CELSIUS_K,
 };
+use crate::rotor::{BearingModel, MachineDescription, Rotor, DEFAULT_MACHINE_YAML};
 use anyhow::Context;
 use serde::Serialize;
 
-/// The oil of `--thermal`: Walther's law through two `°C:mm²/s` points (`40:0.889,80:0.60`, the
-/// machine file's MDM points), density ρ, c_p and supply temperature; used from 0 to 250 °C.
+/// The oil of `--thermal`: Walther's law through two `°C:mm²/s` points if `points` is given,
+/// else the built-in machine's MDM table (config/orc_microturbine_100kw.yaml); density ρ, c_p
+/// and supply temperature (inside the law's range).
 pub(crate) fn thermal_oil(
-    points: &str,
+    points: Option<&str>,
     density_kg_m3: f64,
     specific_heat_j_per_kg_k: f64,
     supply_temperature_c: f64,
 ) -> anyhow::Result<ThermalOil> {
+    let law = match points {
+        Some(points) => ViscosityLaw::Walther(walther_through(points, density_kg_m3)?),
+        None => built_in_law()?,
+    };
+    let range = law.range_k();
+    let supply_k = supply_temperature_c + ZERO_CELSIUS_K;
+    anyhow::ensure!(
+        supply_k.is_finite() && (range[0]..=range[1]).contains(&supply_k),
+        "invalid --supply-temperature-c {supply_temperature_c}: must lie within the oil law's {:.0}–{:.0} °C",
+        range[0] - ZERO_CELSIUS_K,
+        range[1] - ZERO_CELSIUS_K
+    );
+    Ok(ThermalOil {
+        law,
+        specific_heat_j_per_kg_k,
+        supply_temperature_k: supply_k,
+    })
+}
+
+/// The built-in machine's viscosity–temperature law (its first film bearing's: MDM's curve).
+fn built_in_law() -> anyhow::Result<ViscosityLaw> {
+    let desc = MachineDescription::from_yaml(DEFAULT_MACHINE_YAML, "built-in machine")?;
+    Rotor::from_description(&desc)
+        .bearings
+        .iter()
+        .find_map(|b| match &b.model {
+            BearingModel::Film(f) => f.viscosity_law,
+            _ => None,
+        })
+        .context("the built-in machine has no viscosity–temperature law")
+}
+
+/// Walther's law through two `°C:mm²/s` points, used from 0 to 250 °C.
+fn walther_through(points: &str, density_kg_m3: f64) -> anyhow::Result<WaltherLaw> {
     let parsed: Vec<(f64, f64)> = points
         .split(',')
         .map(|p| {
@@ -35,18 +71,8 @@ pub(crate) fn thermal_oil(
         );
     };
     let range = [ZERO_CELSIUS_K, 250.0 + ZERO_CELSIUS_K];
-    let law = WaltherLaw::through([a, b], density_kg_m3, range)
-        .map_err(|e| anyhow::anyhow!("invalid --viscosity-points '{points}': {e}"))?;
-    let supply_k = supply_temperature_c + ZERO_CELSIUS_K;
-    anyhow::ensure!(
-        supply_k.is_finite() && (range[0]..=range[1]).contains(&supply_k),
-        "invalid --supply-temperature-c {supply_temperature_c}: must lie within 0–250 °C"
-    );
-    Ok(ThermalOil {
-        law: ViscosityLaw::Walther(law),
-        specific_heat_j_per_kg_k,
-        supply_temperature_k: supply_k,
-    })
+    WaltherLaw::through([a, b], density_kg_m3, range)
+        .map_err(|e| anyhow::anyhow!("invalid --viscosity-points '{points}': {e}"))
 }
 
 /// The thermal figures of the `--json` report (°C where named so).

@@ -343,7 +343,7 @@ mod tests {
         FiniteFilm::new(g, Lubricant::new(900.0, 0.8e-3).unwrap(), grid).unwrap()
     }
 
-    /// The machine file's MDM law (Walther through ν 0.889 mm²/s at 40 °C, 0.60 at 80 °C) and
+    /// Session 13's MDM law (Walther through ν 0.889 mm²/s at 40 °C, an assumed 0.60 at 80 °C) and
     /// the README's ASSUMED c_p of 1,900 J/(kg·K), supplied at 40 °C.
     fn mdm() -> ThermalOil {
         let c = |t: f64| t + ZERO_CELSIUS_K;
