@@ -303,7 +303,8 @@ fn a_best_effort_temperature_on_the_bus_sets_the_viscosity_and_bad_ones_are_refu
 /// 3 mean positions. Not asserted: the unbalance (the peer's 1X circle is not the plant's
 /// unbalance response: a Float64 is timed by its receive time, so the plant's own 1X at its
 /// 5,000–8,000 rpm would need stamped samples, and its nonlinear transient a minute of solving
-/// per speed; tests/live_calibration.rs checks it through the driver); the speeds are low for the
+/// per speed; tests/live_calibration.rs checks it through the driver, tests/node_bus_unbalance.rs
+/// through the bus from stamped samples of the solved plant); the speeds are low for the
 /// same reason (16 samples a revolution from Python: 930 Hz at 3,500 rpm).
 #[test]
 fn the_node_calibrates_the_viscosity_from_best_effort_dc_probes_of_an_independent_peer() {
