@@ -61,9 +61,30 @@ fn linear_orbit_beyond_the_clearance_is_flagged() {
             assert_eq!(b["state"], "beyond_clearance", "{b}");
         }
     }
-    // per revolution: every one with a journal beyond ε 1 is labelled so, the others not
-    let text = std::fs::read_to_string(&csv).unwrap();
-    std::fs::remove_file(&csv).ok();
+    history_labels_beyond_the_clearance(&csv, 600);
+
+    let (ok, out, err) = run_cli(&[
+        "simulate",
+        "--speed-rpm",
+        "8000",
+        "--revs",
+        "4",
+        "--steps-per-rev",
+        "32",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["valid"], true, "{out}");
+    assert!(v["prehistory_fallbacks"].is_u64(), "{out}");
+}
+
+/// The `--history-csv` at `csv` of a run of `revs` revolutions (removed after): every
+/// revolution with a journal beyond ε 1 is labelled `beyond_clearance`, the others not, and
+/// there is at least one.
+fn history_labels_beyond_the_clearance(csv: &std::path::Path, revs: usize) {
+    let text = std::fs::read_to_string(csv).unwrap();
+    std::fs::remove_file(csv).ok();
     let header = text.lines().next().unwrap().split(',');
     let eps: Vec<usize> = header
         .enumerate()
@@ -84,22 +105,7 @@ fn linear_orbit_beyond_the_clearance_is_flagged() {
         }
     }
     println!("history: {beyond} of {rows} revolutions beyond the clearance");
-    assert!(beyond > 0 && rows == 600, "{beyond} of {rows}");
-
-    let (ok, out, err) = run_cli(&[
-        "simulate",
-        "--speed-rpm",
-        "8000",
-        "--revs",
-        "4",
-        "--steps-per-rev",
-        "32",
-        "--json",
-    ]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(v["valid"], true, "{out}");
-    assert!(v["prehistory_fallbacks"].is_u64(), "{out}");
+    assert!(beyond > 0 && rows == revs, "{beyond} of {rows}");
 }
 
 /// `simulate`'s JSON carries the prehistory fallback count (README "Prehistory": substeps whose
