@@ -355,7 +355,7 @@ struct BearingSummary {
     pressure_valid: bool,
     span_revolutions: usize,
     beyond_clearance: bool,
-    state: RotorState,
+    state: ReportedState,
 }
 
 /// The `--json` report of `simulate`.
@@ -369,7 +369,7 @@ struct SimulateReport {
     delta: Option<f64>,
     revs: usize,
     steps_per_rev: usize,
-    state: RotorState,
+    state: ReportedState,
     evidence: String,
     rev_to_rev_orbit_diff: f64,
     rev_to_rev_pressure_diff: f64,
@@ -397,6 +397,55 @@ struct SimulateReport {
     /// The kicks applied: [t (s), node, J_x, J_y (N·s)].
     kicks: Vec<[f64; 4]>,
     bearings: Vec<BearingSummary>,
+}
+
+/// The state `simulate` reports: the monitor's, except for a journal that left its clearance
+/// circle without a wall (the linear coupling, `beyond_clearance`): its motion is none the
+/// machine can make, so it carries no whirl or whip label (issue 11: a linear run at ε = 970
+/// was labelled "whip", then "whirl").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+enum ReportedState {
+    Stable,
+    Growing,
+    Whirl,
+    Whip,
+    /// Outside the model's validity: the journal beyond the clearance, no wall to stop it.
+    BeyondClearance,
+}
+
+impl ReportedState {
+    fn new(state: RotorState, beyond_clearance: bool) -> Self {
+        match (beyond_clearance, state) {
+            (true, _) => Self::BeyondClearance,
+            (false, RotorState::Stable) => Self::Stable,
+            (false, RotorState::Growing) => Self::Growing,
+            (false, RotorState::Whirl) => Self::Whirl,
+            (false, RotorState::Whip) => Self::Whip,
+        }
+    }
+
+    /// The name in the JSON and the history CSV.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Stable => "stable",
+            Self::Growing => "growing",
+            Self::Whirl => "whirl",
+            Self::Whip => "whip",
+            Self::BeyondClearance => "beyond_clearance",
+        }
+    }
+}
+
+/// Whether bearing `k` (all bearings when None) of run `r` was beyond its clearance without
+/// a wall in any revolution.
+fn left_clearance(r: &TransientResult, k: Option<usize>) -> bool {
+    r.history.iter().any(|rev| {
+        rev.bearings
+            .iter()
+            .enumerate()
+            .any(|(i, b)| b.beyond_clearance && k.is_none_or(|k| k == i))
+    })
 }
 
 /// Whether run `r` stayed inside what its model can represent, and why not: with the linear
@@ -479,7 +528,7 @@ fn summarise(
         delta: (args.options.model == ModelArg::Prehistory).then_some(args.options.delta),
         revs: args.options.revs,
         steps_per_rev: args.options.steps_per_rev,
-        state: rep.state,
+        state: ReportedState::new(rep.state, left_clearance(r, None)),
         evidence: rep.evidence(),
         rev_to_rev_orbit_diff: rep.rev_to_rev_orbit_diff,
         rev_to_rev_pressure_diff: rep.rev_to_rev_pressure_diff,
@@ -495,7 +544,8 @@ fn summarise(
             .bearings
             .iter()
             .zip(&r.bearing_names)
-            .map(|(b, name)| BearingSummary {
+            .enumerate()
+            .map(|(k, (b, name))| BearingSummary {
                 name: name.clone(),
                 orbit_pp_x_m: b.orbit_pp_x_m,
                 orbit_pp_y_m: b.orbit_pp_y_m,
@@ -522,7 +572,7 @@ fn summarise(
                 pressure_valid: b.pressure_valid,
                 span_revolutions: b.span_revolutions,
                 beyond_clearance: b.beyond_clearance,
-                state: b.state,
+                state: ReportedState::new(b.state, left_clearance(r, Some(k))),
             })
             .collect(),
     }
@@ -618,7 +668,7 @@ fn write_history_csv(path: &Path, r: &TransientResult) -> anyhow::Result<()> {
             rev.revolution,
             rev.time_s,
             crate::units::rad_s_to_rpm(rev.speed_rad_s),
-            rev.state.warning_kind().replace("none", "stable")
+            ReportedState::new(rev.state, rev.bearings.iter().any(|b| b.beyond_clearance)).name()
         );
         for b in &rev.bearings {
             csv += &format!(
