@@ -587,4 +587,37 @@ mod tests {
         assert!(ev.relocked);
         assert!((ev.correction_rad.unwrap() - 90f64.to_radians()).abs() < 1e-9);
     }
+
+    /// Keyphasor only (no speed topic) at 9,000 rpm: an extra pulse at 0.4 T is refused and
+    /// keeps the history (the next true event's interval, T, is accepted); a missed pulse is
+    /// refused once (2T, breaks the history; the next T is judged by the last accepted speed,
+    /// not by the refused 4,500 rpm). Then a stop of 10 T and a restart at 8,000 rpm (−11 %):
+    /// 3 refusals in a row, after which the intervals are judged afresh and the next gives
+    /// 8,000 rpm to 10⁻⁶ (the stamps' 1 ns in 7.5 ms).
+    #[test]
+    fn extra_and_missed_pulses_cost_one_refusal_and_a_new_speed_is_learnt() {
+        let mut lock = KeyphasorLock::new(KeyphasorSettings::default());
+        for k in 0..4 {
+            lock.event(rev_ns(k), None, None).unwrap();
+        }
+        let t = rev_ns(3) + (rev_ns(4) - rev_ns(3)) * 2 / 5;
+        let extra = lock.event(t, None, None).unwrap_err();
+        assert!(extra.why.contains("extra pulse") && !extra.breaks_history);
+        let w = lock.event(rev_ns(4), None, None).unwrap();
+        assert!((w.interval_speed_rad_s.unwrap() / W - 1.0).abs() < 1e-6);
+        let missed = lock.event(rev_ns(6), None, None).unwrap_err();
+        assert!(missed.why.contains("missed pulse") && missed.breaks_history);
+        lock.event(rev_ns(7), None, None).unwrap();
+        // a stop, then 8,000 rpm
+        let w2 = W * 8.0 / 9.0;
+        let at = |k: i64| rev_ns(17) + (k as f64 * TAU / w2 * 1e9).round() as i64;
+        for k in 0..3 {
+            let r = lock.event(at(k), None, None).unwrap_err();
+            assert!(r.breaks_history, "{}", r.why);
+        }
+        let ev = lock.event(at(3), None, None).unwrap();
+        let got = ev.interval_speed_rad_s.unwrap();
+        assert!((got / w2 - 1.0).abs() < 1e-6, "{got} rad/s");
+        lock.event(at(4), None, None).unwrap();
+    }
 }
