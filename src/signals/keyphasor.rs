@@ -181,8 +181,8 @@ pub struct KeyphasorSettings {
     pub gain: f64,
     /// Largest accepted relative difference between the keyphasor's speed 2π/Δt and the
     /// reference speed (the speed topic's, else the last accepted interval's). Default 0.1: a
-    /// missed pulse doubles the interval, an extra one shortens it; a run-up changes the speed by far less than
-    /// 10 % a revolution (the sample bag: 0.02 %).
+    /// missed pulse doubles the interval, an extra one shortens it; a run-up changes the speed
+    /// by far less than 10 % a revolution (the sample bag: 0.02 %).
     pub interval_tolerance: f64,
     /// Largest accepted angle error once locked (degrees). Default 20°: 50 times the drift of
     /// a 0.1 %-accurate speed over a revolution.
