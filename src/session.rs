@@ -281,6 +281,16 @@ impl Session {
         }
     }
 
+    /// Re-references the twin's angle, and the angles its probe predictions are interpolated
+    /// from, to a keyphasor mark turned by `delta_rad` (rad) against the shaft, its heavy spots
+    /// by −`delta_rad`: the motion unchanged ([`crate::dynamics::Twin::turn_reference`]).
+    pub fn turn_reference(&mut self, delta_rad: f64) {
+        if delta_rad.is_finite() {
+            self.twin.turn_reference(delta_rad);
+            self.history.shift_angles(delta_rad);
+        }
+    }
+
     /// The twin's shaft angle (rad) at `stamp_ns` (ns since the epoch), extrapolated from its
     /// present time at its present speed.
     pub fn angle_at(&self, stamp_ns: i64) -> f64 {

@@ -447,6 +447,15 @@ pub(super) struct Blend {
 }
 
 impl Blend {
+    /// Turns both ends' unbalance phasors by `delta_rad` (a keyphasor relock restates every
+    /// heavy spot from the new mark).
+    pub(super) fn turn_unbalance(&mut self, delta_rad: f64) {
+        let (s, c) = delta_rad.sin_cos();
+        for u in self.from_unbalance.iter_mut().chain(&mut self.to_unbalance) {
+            *u = [u[0] * c - u[1] * s, u[0] * s + u[1] * c];
+        }
+    }
+
     /// Sets `twin` to the values at fraction `f` of the way.
     fn set(&mut self, twin: &mut crate::dynamics::Twin, f: f64) -> Result<(), String> {
         for ((n, a), b) in self

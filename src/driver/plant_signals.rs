@@ -265,34 +265,79 @@ impl Driver {
         let after = self.signals.events.newest_ns().is_none_or(|n| t > n);
         let ev = match self.signals.keyphasor.event(t, angle, topic_speed) {
             Ok(ev) => ev,
-            Err(why) => {
-                if after {
-                    // a missed, extra or moved pulse: the plant's angle counts afresh from it
+            Err(r) => {
+                if after && r.breaks_history {
+                    // a missed or moved pulse: the plant's angle counts afresh from it (an
+                    // extra pulse is ignored: the events around it still count)
                     self.signals.events.restart_at(t);
                 }
-                return Fed::Refused(why);
+                return Fed::Refused(r.why);
             }
         };
         self.signals.events.push(t);
         if restart {
             self.session = None;
         }
-        if let (Some(c), Some(s)) = (ev.correction_rad, self.session.as_mut()) {
-            s.shift_angle(c);
-        }
-        if ev.relocked {
-            emit(input_warning(
-                now_ns,
-                WarningKind::BadInput,
-                "keyphasor: the reference moved and held; the twin's angle is locked to the new one"
-                    .into(),
-            ));
+        match (ev.correction_rad, ev.relocked) {
+            (Some(c), true) => self.move_mark(c, now_ns, emit),
+            (Some(c), false) => {
+                if let Some(s) = self.session.as_mut() {
+                    s.shift_angle(c);
+                }
+            }
+            (None, _) => {}
         }
         let fed = match (ev.interval_speed_rad_s, topic_speed) {
             (Some(w), None) => self.speed_from_interval(now_ns, w, emit),
             _ => Fed::Taken,
         };
         self.start_at_event(t, fed, emit)
+    }
+
+    /// A relock (the lock moved to a new offset `c`, rad, after consecutive agreeing events):
+    /// the keyphasor's mark, or its probe, moved against the shaft; the plant's shaft did not
+    /// jump, so neither does the twin's motion. Everything fixed to the shaft is restated from
+    /// the new mark: the twin's angle turns by c and each heavy spot by −c (the unbalance force
+    /// at angle + phase, hence the motion, unchanged: no impulse), as do the unbalance the
+    /// driver keeps (the machine file's, received, calibrated, a blend's ends: −c) and the
+    /// slow-roll runouts (lag +c). The phase lags after it are read from the new mark. (Turning
+    /// the twin's angle alone, as the lock did before session 14, jumps the unbalance force's
+    /// phase: an impulse that seeds the whirl near the threshold.)
+    fn move_mark(&mut self, c: f64, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        if let Some(s) = self.session.as_mut() {
+            s.turn_reference(c);
+        }
+        for u in &mut self.rotor.unbalance {
+            u.phase_rad -= c;
+        }
+        for u in self.unbalance.iter_mut().flatten() {
+            u.phase_rad -= c;
+        }
+        let calibrated = self.calibration.as_mut().and_then(|a| a.unbalance.as_mut());
+        for u in calibrated.into_iter().flatten() {
+            u.1 -= c;
+        }
+        if let Some(b) = self.blend.as_mut() {
+            b.turn_unbalance(-c);
+        }
+        let lag = |r: &mut OneXVector| {
+            r.phase_lag_deg = (r.phase_lag_deg + c.to_degrees()).rem_euclid(360.0);
+        };
+        let file = self.rotor.proximity_probes.iter_mut();
+        file.filter_map(|p| p.runout.as_mut()).for_each(lag);
+        self.signals
+            .measured_runout
+            .iter_mut()
+            .flatten()
+            .for_each(lag);
+        emit(input_warning(
+            now_ns,
+            WarningKind::BadInput,
+            format!(
+                "keyphasor: the mark moved by {:.1}° against the shaft and held; phases re-referenced to the new mark (the twin's motion unchanged: its angle and heavy spots restated, no impulse)",
+                -c.to_degrees()
+            ),
+        ));
     }
 
     /// With a keyphasor the twin starts at an event, its angle 0 there: locked from its first

@@ -6,11 +6,17 @@
 //! δω/ω, the angle error left between two events is 2π·δω/ω (0.36° at 0.1 %).
 //!
 //! Checks (each refusal is the driver's `bad_input`, and the twin carries on with the speed):
-//! an event not after the previous one; an interval that contradicts the speed by more than
-//! [`KeyphasorSettings::interval_tolerance`] (a missed or an extra pulse); an angle error beyond
-//! [`KeyphasorSettings::max_jump_deg`] once locked (the mark or the sensor moved, or a glitch):
-//! refused, and only after [`KeyphasorSettings::relock_events`] consecutive events agreeing on a
-//! new offset does the lock move to it.
+//! an event not after the previous one; an interval that contradicts the reference speed (the
+//! speed topic's, else the last accepted interval's) by more than
+//! [`KeyphasorSettings::interval_tolerance`]: too short, an extra pulse (ignored: the next
+//! event's interval runs from the one before it), too long, a missed pulse or a stop (the
+//! intervals run on from it); an angle error beyond [`KeyphasorSettings::max_jump_deg`] once
+//! locked (the mark or the sensor moved, or a glitch): refused, and only after
+//! [`KeyphasorSettings::relock_events`] consecutive events agreeing on a new offset does the
+//! lock move to it (a relock: the driver re-references the twin to the new mark without
+//! turning its unbalance force, `Driver::move_mark`). Without a speed topic, as many
+//! consecutive interval refusals mean the speed itself changed (a stop and a restart): the
+//! next interval is taken as the new speed.
 
 use std::f64::consts::{PI, TAU};
 
@@ -174,15 +180,16 @@ pub struct KeyphasorSettings {
     /// error halves every revolution, and one noisy event moves the angle by half its noise.
     pub gain: f64,
     /// Largest accepted relative difference between the keyphasor's speed 2π/Δt and the
-    /// reference speed (the speed topic's, else the last interval's). Default 0.1: a missed pulse
-    /// doubles the interval, an extra one halves it; a run-up changes the speed by far less than
-    /// 10 % a revolution (the sample bag: 0.02 %).
+    /// reference speed (the speed topic's, else the last accepted interval's). Default 0.1: a
+    /// missed pulse doubles the interval, an extra one shortens it; a run-up changes the speed
+    /// by far less than 10 % a revolution (the sample bag: 0.02 %).
     pub interval_tolerance: f64,
     /// Largest accepted angle error once locked (degrees). Default 20°: 50 times the drift of
     /// a 0.1 %-accurate speed over a revolution.
     pub max_jump_deg: f64,
     /// Consecutive events agreeing (within `max_jump_deg`) on a new offset before the lock
-    /// moves to it. Default 3.
+    /// moves to it; also, without a speed topic, the interval refusals in a row after which
+    /// the speed is judged afresh. Default 3.
     pub relock_events: u32,
 }
 
@@ -227,6 +234,25 @@ impl PhaseReference {
     }
 }
 
+/// Why an event is refused, and whether the plant's angle counts afresh from it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeyphasorRefusal {
+    /// The reason, for the `bad_input` warning.
+    pub why: String,
+    /// False for an extra pulse (ignored: the events around it still count the revolutions)
+    /// and an event not after the previous one; true otherwise (a missed pulse, a stop, a jump).
+    pub breaks_history: bool,
+}
+
+impl KeyphasorRefusal {
+    fn breaking(why: String) -> Self {
+        Self {
+            why,
+            breaks_history: true,
+        }
+    }
+}
+
 /// What one accepted event gives.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KeyphasorEvent {
@@ -234,7 +260,8 @@ pub struct KeyphasorEvent {
     pub correction_rad: Option<f64>,
     /// The speed from the interval since the previous event, 2π/Δt (rad/s), if there was one.
     pub interval_speed_rad_s: Option<f64>,
-    /// The lock moved to a new offset after consecutive agreeing jumps (to be reported).
+    /// The lock moved to a new offset after consecutive agreeing jumps (to be reported; the
+    /// correction is then the mark's move, not the shaft's: re-reference, do not turn the twin).
     pub relocked: bool,
 }
 
@@ -243,7 +270,10 @@ pub struct KeyphasorEvent {
 pub struct KeyphasorLock {
     settings: KeyphasorSettings,
     last_event_ns: Option<i64>,
+    /// the last accepted interval's speed (rad/s)
     last_interval_speed: Option<f64>,
+    /// consecutive events refused by the interval check
+    interval_refusals: u32,
     locked: bool,
     /// a jump being confirmed: its angle error (rad) and how many events agreed
     pending: Option<(f64, u32)>,
@@ -298,7 +328,7 @@ impl KeyphasorLock {
         t_ns: i64,
         twin_angle_rad: Option<f64>,
         speed_rad_s: Option<f64>,
-    ) -> Result<KeyphasorEvent, String> {
+    ) -> Result<KeyphasorEvent, KeyphasorRefusal> {
         let interval_speed = self.check_interval(t_ns, speed_rad_s)?;
         let Some(theta) = twin_angle_rad else {
             return Ok(KeyphasorEvent {
@@ -308,7 +338,7 @@ impl KeyphasorLock {
             });
         };
         let e = wrap_pi(-theta);
-        let (correction, relocked) = self.correction(e)?;
+        let (correction, relocked) = self.correction(e).map_err(KeyphasorRefusal::breaking)?;
         Ok(KeyphasorEvent {
             correction_rad: Some(correction),
             interval_speed_rad_s: interval_speed,
@@ -316,38 +346,83 @@ impl KeyphasorLock {
         })
     }
 
-    /// Checks the interval since the last event against the reference speed; records the event
-    /// time (also when refused, so that one bad pulse costs one interval).
-    fn check_interval(&mut self, t_ns: i64, speed: Option<f64>) -> Result<Option<f64>, String> {
+    /// Checks the interval since the last event against the reference speed (the speed topic's,
+    /// else the last accepted interval's); records the event time, also when refused as a missed
+    /// pulse or a stop (one bad pulse costs one interval), not for an extra pulse.
+    fn check_interval(
+        &mut self,
+        t_ns: i64,
+        speed: Option<f64>,
+    ) -> Result<Option<f64>, KeyphasorRefusal> {
         let Some(last) = self.last_event_ns else {
             self.last_event_ns = Some(t_ns);
             return Ok(None);
         };
         if t_ns <= last {
-            return Err(format!(
-                "keyphasor event at {:.6} s is not after the previous one ({:.6} s)",
-                t_ns as f64 * 1e-9,
-                last as f64 * 1e-9
-            ));
+            return Err(KeyphasorRefusal {
+                why: format!(
+                    "keyphasor event at {:.6} s is not after the previous one ({:.6} s)",
+                    t_ns as f64 * 1e-9,
+                    last as f64 * 1e-9
+                ),
+                breaks_history: false,
+            });
         }
-        self.last_event_ns = Some(t_ns);
         let dt = (t_ns - last) as f64 * 1e-9;
         let w = TAU / dt;
-        let reference = speed.filter(|s| *s > 0.0).or(self.last_interval_speed);
-        self.last_interval_speed = Some(w);
-        if let Some(r) = reference {
-            let tol = self.settings.interval_tolerance;
-            if (w / r - 1.0).abs() > tol {
-                return Err(format!(
-                    "keyphasor interval {:.6} s ({:.1} rpm) contradicts the speed {:.1} rpm by more than {:.0} % (a missed or extra pulse, or a stop)",
-                    dt,
-                    w * 30.0 / PI,
-                    r * 30.0 / PI,
-                    tol * 100.0
-                ));
+        let topic = speed.filter(|s| *s > 0.0);
+        let tol = self.settings.interval_tolerance;
+        match topic.or(self.last_interval_speed) {
+            Some(r) if (w / r - 1.0).abs() > tol => {
+                Err(self.refuse_interval(t_ns, dt, w, r, topic))
+            }
+            _ => {
+                self.last_event_ns = Some(t_ns);
+                self.last_interval_speed = Some(w);
+                self.interval_refusals = 0;
+                Ok(Some(w))
             }
         }
-        Ok(Some(w))
+    }
+
+    /// Refuses an event whose interval `dt` (s, speed `w`) contradicts the reference `r`: too
+    /// short, an extra pulse, ignored; too long, a missed pulse or a stop, recorded. Without a
+    /// speed topic, after [`KeyphasorSettings::relock_events`] such refusals in a row the
+    /// intervals are judged afresh from this event (the speed changed).
+    fn refuse_interval(
+        &mut self,
+        t_ns: i64,
+        dt: f64,
+        w: f64,
+        r: f64,
+        topic: Option<f64>,
+    ) -> KeyphasorRefusal {
+        let extra = w > r;
+        if !extra {
+            self.last_event_ns = Some(t_ns);
+        }
+        self.interval_refusals += 1;
+        let afresh = topic.is_none() && self.interval_refusals >= self.settings.relock_events;
+        if afresh {
+            self.last_event_ns = Some(t_ns);
+            self.last_interval_speed = None;
+            self.interval_refusals = 0;
+        }
+        let what = match (extra, afresh) {
+            (_, true) => "the speed changed: judged afresh from this event",
+            (true, false) => "an extra pulse: ignored",
+            (false, false) => "a missed pulse or a stop",
+        };
+        KeyphasorRefusal {
+            why: format!(
+                "keyphasor interval {:.6} s ({:.1} rpm) contradicts the speed {:.1} rpm by more than {:.0} % ({what})",
+                dt,
+                w * 30.0 / PI,
+                r * 30.0 / PI,
+                self.settings.interval_tolerance * 100.0
+            ),
+            breaks_history: !extra || afresh,
+        }
     }
 
     /// The angle correction for an error `e` (rad) at an event.
@@ -481,7 +556,10 @@ mod tests {
         lock.event(0, Some(0.0), Some(W)).unwrap();
         lock.event(rev_ns(1), Some(TAU), Some(W)).unwrap();
         // a missed pulse: the interval is two revolutions
-        let why = lock.event(rev_ns(3), Some(3.0 * TAU), Some(W)).unwrap_err();
+        let why = lock
+            .event(rev_ns(3), Some(3.0 * TAU), Some(W))
+            .unwrap_err()
+            .why;
         assert!(why.contains("contradicts the speed"), "{why}");
         // the next one is fine again
         lock.event(rev_ns(4), Some(4.0 * TAU), Some(W)).unwrap();
@@ -489,6 +567,7 @@ mod tests {
         assert!(lock
             .event(rev_ns(4), Some(4.0 * TAU), Some(W))
             .unwrap_err()
+            .why
             .contains("not after"));
         // the mark moved by 90°: refused twice, the third agreeing event relocks
         for k in 5..7 {
@@ -498,7 +577,8 @@ mod tests {
                     Some(k as f64 * TAU - 90f64.to_radians()),
                     Some(W),
                 )
-                .unwrap_err();
+                .unwrap_err()
+                .why;
             assert!(why.contains("jumped by 90.0°"), "{why}");
         }
         let ev = lock
@@ -506,5 +586,38 @@ mod tests {
             .unwrap();
         assert!(ev.relocked);
         assert!((ev.correction_rad.unwrap() - 90f64.to_radians()).abs() < 1e-9);
+    }
+
+    /// Keyphasor only (no speed topic) at 9,000 rpm: an extra pulse at 0.4 T is refused and
+    /// keeps the history (the next true event's interval, T, is accepted); a missed pulse is
+    /// refused once (2T, breaks the history; the next T is judged by the last accepted speed,
+    /// not by the refused 4,500 rpm). Then a stop of 10 T and a restart at 8,000 rpm (−11 %):
+    /// 3 refusals in a row, after which the intervals are judged afresh and the next gives
+    /// 8,000 rpm to 10⁻⁶ (the stamps' 1 ns in 7.5 ms).
+    #[test]
+    fn extra_and_missed_pulses_cost_one_refusal_and_a_new_speed_is_learnt() {
+        let mut lock = KeyphasorLock::new(KeyphasorSettings::default());
+        for k in 0..4 {
+            lock.event(rev_ns(k), None, None).unwrap();
+        }
+        let t = rev_ns(3) + (rev_ns(4) - rev_ns(3)) * 2 / 5;
+        let extra = lock.event(t, None, None).unwrap_err();
+        assert!(extra.why.contains("extra pulse") && !extra.breaks_history);
+        let w = lock.event(rev_ns(4), None, None).unwrap();
+        assert!((w.interval_speed_rad_s.unwrap() / W - 1.0).abs() < 1e-6);
+        let missed = lock.event(rev_ns(6), None, None).unwrap_err();
+        assert!(missed.why.contains("missed pulse") && missed.breaks_history);
+        lock.event(rev_ns(7), None, None).unwrap();
+        // a stop, then 8,000 rpm
+        let w2 = W * 8.0 / 9.0;
+        let at = |k: i64| rev_ns(17) + (k as f64 * TAU / w2 * 1e9).round() as i64;
+        for k in 0..3 {
+            let r = lock.event(at(k), None, None).unwrap_err();
+            assert!(r.breaks_history, "{}", r.why);
+        }
+        let ev = lock.event(at(3), None, None).unwrap();
+        let got = ev.interval_speed_rad_s.unwrap();
+        assert!((got / w2 - 1.0).abs() < 1e-6, "{got} rad/s");
+        lock.event(at(4), None, None).unwrap();
     }
 }

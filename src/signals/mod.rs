@@ -8,7 +8,7 @@ pub mod phase;
 pub mod probes;
 
 pub use keyphasor::{
-    KeyphasorEvent, KeyphasorEvents, KeyphasorLock, KeyphasorSettings, PhaseReference, Unbracketed,
-    KEYPHASOR_JITTER_S, KEYPHASOR_STOP_REVS,
+    KeyphasorEvent, KeyphasorEvents, KeyphasorLock, KeyphasorRefusal, KeyphasorSettings,
+    PhaseReference, Unbracketed, KEYPHASOR_JITTER_S, KEYPHASOR_STOP_REVS,
 };
 pub use phase::{keyphasor_one_x, one_x_vector, OneXVector};

@@ -143,6 +143,19 @@ impl Twin {
         }
     }
 
+    /// Re-references the rotor's angle to a mark turned by `delta_rad` (rad) against the shaft:
+    /// the angle turns by `delta_rad` and every heavy spot by −`delta_rad`, so the unbalance
+    /// force (at angle + phase, eq. of `unbalance_force`) and the motion are unchanged (a
+    /// keyphasor relock, `Driver::move_mark`). A non-finite value is ignored.
+    pub fn turn_reference(&mut self, delta_rad: f64) {
+        if delta_rad.is_finite() {
+            self.shift_angle(delta_rad);
+            for u in &mut self.unbalance {
+                u.phase_rad -= delta_rad;
+            }
+        }
+    }
+
     /// The last step's output (the initial state before the first step).
     pub fn output(&self) -> &StepOutput {
         &self.output
