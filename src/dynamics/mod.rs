@@ -211,9 +211,9 @@ pub enum TwinError {
         /// The film model's error (in this error's text, not again as its source).
         cause: FilmError,
     },
-    /// The step did not converge even with a quarter of the time step; the state is unchanged.
+    /// The step did not converge even with a sixteenth of the time step; the state is unchanged.
     #[error(
-        "step at t = {time_s:.6} s did not converge ({iterations} Newton iterations, even at h/4)"
+        "step at t = {time_s:.6} s did not converge ({iterations} Newton iterations, even at h/16)"
     )]
     NotConverged {
         /// Time (s).

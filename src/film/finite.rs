@@ -791,6 +791,16 @@ impl FilmModel for FiniteFilm {
             self.content_old.copy_from_slice(&self.content_saved);
         }
     }
+
+    fn memory(&self) -> Option<(Vec<f64>, Vec<bool>)> {
+        self.twin_form
+            .then(|| (self.content_old.clone(), self.free.clone()))
+    }
+
+    fn set_memory(&mut self, phi0: &[f64], full: &[bool]) -> Result<(), FilmError> {
+        self.set_committed_fraction(phi0)?;
+        self.set_full_nodes(full)
+    }
 }
 
 mod mass_conserving;

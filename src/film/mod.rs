@@ -187,6 +187,22 @@ pub trait FilmModel {
 
     /// Returns to the state of the last [`FilmModel::save_memory`]. No-op without memory.
     fn restore_memory(&mut self) {}
+
+    /// A film with memory: its committed fluid fraction φ⁰ and the full nodes of its last solve
+    /// (to record a state); `None` without memory.
+    fn memory(&self) -> Option<(Vec<f64>, Vec<bool>)> {
+        None
+    }
+
+    /// Sets what [`FilmModel::memory`] gives (a recorded state, once a step has begun); an
+    /// error without memory or on a size mismatch.
+    fn set_memory(&mut self, _phi0: &[f64], _full: &[bool]) -> Result<(), FilmError> {
+        Err(FilmError::InvalidParameter {
+            name: "film memory",
+            value: 0.0,
+            rule: "only a mass-conserving film in a time step has one",
+        })
+    }
 }
 
 /// Wraps an angle (rad) to [0, 2π).

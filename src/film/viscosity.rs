@@ -444,6 +444,14 @@ impl FilmModel for ViscosityScaledFilm {
     fn restore_memory(&mut self) {
         self.inner.restore_memory();
     }
+
+    fn memory(&self) -> Option<(Vec<f64>, Vec<bool>)> {
+        self.inner.memory()
+    }
+
+    fn set_memory(&mut self, phi0: &[f64], full: &[bool]) -> Result<(), FilmError> {
+        self.inner.set_memory(phi0, full)
+    }
 }
 
 #[cfg(test)]

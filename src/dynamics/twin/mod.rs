@@ -7,6 +7,17 @@ use crate::film::{FilmCoefficients, FilmModel, JournalKinematics};
 use crate::rotor::Unbalance;
 use faer::Mat;
 
+/// Substep levels of a step that Newton cannot take whole: h, h/2, …, h/16. Wall contact
+/// with the mass-conserving film needs the deep ones (issue 18: at 9,000 rpm, t = 0.352 s, the
+/// film's slope changes within 40 pm of the iterate where φ's sets switch, and Newton cycles
+/// between two iterates at h, h/2 and h/4; at h/16 the film's share of the iteration matrix
+/// I + S D, ∝ h, is small enough for it to converge).
+const LEVELS: usize = 5;
+
+/// The levels kept factored at the running speed (h, h/2, h/4); the deeper ones are factored
+/// when a step first needs them at a speed (rarely: a speed change need not pay for them).
+const EAGER_LEVELS: usize = 3;
+
 /// Marks a full DOF that is held (rigid bearing) and so not in the reduced system.
 const HELD: usize = usize::MAX;
 
@@ -64,7 +75,7 @@ pub struct Twin {
     external: Vec<f64>,
     links: Vec<BearingLink>,
     b_dofs: Vec<usize>,
-    /// factors for h, h/2, h/4
+    /// factors for h, h/2, …, h/16 ([`LEVELS`])
     factors: Vec<StepFactor>,
     probes: Vec<ProbeStation>,
     state: State,
@@ -378,6 +389,33 @@ impl Twin {
                 readings_m: angles.map(|(sin, cos)| x[0] * cos + x[1] * sin),
             };
         }
+    }
+
+    /// Bearing `bearing`'s film memory (mass-conserving: the committed fluid fraction φ⁰ and the
+    /// full nodes, node `i·n_z + j`), to record a state; `None` without memory.
+    pub fn film_memory(&self, bearing: usize) -> Option<(Vec<f64>, Vec<bool>)> {
+        self.links.get(bearing).and_then(|l| l.film.memory())
+    }
+
+    /// Sets bearing `bearing`'s film memory to a recorded one (after a first step: the film
+    /// must be in a time step).
+    pub fn set_film_memory(
+        &mut self,
+        bearing: usize,
+        phi0: &[f64],
+        full: &[bool],
+    ) -> Result<(), TwinError> {
+        let Some(link) = self.links.get_mut(bearing) else {
+            return Err(TwinError::Setup(format!("no bearing {bearing}")));
+        };
+        let name = link.name.clone();
+        link.film
+            .set_memory(phi0, full)
+            .map_err(|cause| TwinError::Film {
+                bearing: name,
+                time_s: self.state.time_s,
+                cause,
+            })
     }
 
     /// Journal kinematics of bearing `bearing` now (relative to its pedestal).

@@ -38,7 +38,7 @@ impl Twin {
             *qi += r;
         }
         let mut factors = Vec::new();
-        for level in 0..3 {
+        for level in 0..super::LEVELS {
             let h = config.time_step_s / f64::from(1u32 << level);
             factors.push(
                 StepFactor::new(&sys.m, &sys.c, &sys.g, &sys.k, h, speed_rad_s, &b_dofs)

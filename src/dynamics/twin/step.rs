@@ -37,7 +37,10 @@ impl Twin {
         for l in &mut self.links {
             l.film.save_memory();
         }
-        for level in 0..3 {
+        for level in 0..self.factors.len() {
+            if level >= super::EAGER_LEVELS {
+                self.factor_level_at(level, self.factors[0].speed_rad_s);
+            }
             let substeps = 1usize << level;
             // the state to return to if the step must be retried (scratch reused: no
             // allocation); a failed `advance` leaves the state as it was, so one substep
@@ -101,7 +104,17 @@ impl Twin {
     /// Factors the step's K_eff again at `speed` (rad/s), every substep level (what a speed
     /// change beyond the tolerance costs; `rotor-twin bench factor` times it).
     pub(crate) fn renew_factors(&mut self, speed: f64) {
-        for f in &mut self.factors {
+        for f in self.factors.iter_mut().take(super::EAGER_LEVELS) {
+            f.refactor(&self.m, &self.c, &self.g, &self.k, speed, &self.b_dofs);
+        }
+    }
+
+    /// Factors level `level` at `speed` (rad/s) if it was factored at another speed: the
+    /// deep levels (h/8, h/16), used only by the rare step that fails at h/4, are brought to
+    /// the running speed when first needed there.
+    fn factor_level_at(&mut self, level: usize, speed: f64) {
+        let f = &mut self.factors[level];
+        if f.speed_rad_s != speed {
             f.refactor(&self.m, &self.c, &self.g, &self.k, speed, &self.b_dofs);
         }
     }
@@ -346,6 +359,23 @@ impl Twin {
         ev.damping = r.damping_n_s_per_m;
     }
 
+    /// The largest residual |g| of a bearing, g = q_B − a − S f_B, as a share of its clearance.
+    fn residual_norm(&self, level: usize) -> f64 {
+        let nb = self.b_dofs.len();
+        let sm = &self.factors[level].s;
+        let g = |i: usize| {
+            let mut g = self.qb[i] - self.a_b[i];
+            for k in 0..nb {
+                g -= sm[i * nb + k] * self.f_b[k];
+            }
+            g
+        };
+        self.links
+            .iter()
+            .map(|l| g(l.b_offset).hypot(g(l.b_offset + 1)) / l.clearance_m)
+            .fold(0.0, f64::max)
+    }
+
     /// One Newton move Δ = −J⁻¹ g, g = q_B − a − S f_B, J = I + S D, limited to a fifth of the
     /// clearance, and f_B carried to the new iterate as f_B − D Δ. Ok(true) when converged.
     fn newton_move(&mut self, level: usize) -> Result<bool, Option<TwinError>> {
@@ -365,6 +395,12 @@ impl Twin {
                 self.jac[i * nb + j] = v;
             }
         }
+        let traced = trace::from().is_some_and(|t| self.state.time_s >= t);
+        let residual = if traced {
+            self.residual_norm(level)
+        } else {
+            0.0
+        };
         if !solve_small(&self.jac, &mut self.delta, nb) {
             return Err(None);
         }
@@ -374,6 +410,9 @@ impl Twin {
             largest = largest.max(self.delta[o].hypot(self.delta[o + 1]) / link.clearance_m);
         }
         let scale = if largest > 0.2 { 0.2 / largest } else { 1.0 };
+        if traced {
+            self.trace_move(level, residual, largest);
+        }
         for i in 0..nb {
             self.delta[i] *= scale;
             self.qb[i] += self.delta[i];
@@ -462,5 +501,46 @@ impl Newmark {
             a1: 4.0 / h,
             a2: 2.0 / h,
         }
+    }
+}
+
+/// Diagnosis only, read once from the environment: `ROTOR_TWIN_NEWTON_TRACE=<t in s>` prints
+/// every Newton move of the steps from t on to stderr (residual, move, and each bearing's ε,
+/// contact, force and coefficients at the iterate).
+mod trace {
+    use std::sync::OnceLock;
+
+    pub(super) fn from() -> Option<f64> {
+        static FROM: OnceLock<Option<f64>> = OnceLock::new();
+        *FROM.get_or_init(|| {
+            std::env::var("ROTOR_TWIN_NEWTON_TRACE")
+                .ok()
+                .and_then(|s| s.parse().ok())
+        })
+    }
+}
+
+impl Twin {
+    /// Prints one Newton move (diagnosis: [`trace`]).
+    fn trace_move(&self, level: usize, residual: f64, largest: f64) {
+        let mut line = format!(
+            "newton t {:.6} level {level} |g|/c {residual:.3e} |d|/c {largest:.3e}",
+            self.state.time_s
+        );
+        for l in &self.links {
+            let o = l.b_offset;
+            let e = self.qb[o].hypot(self.qb[o + 1]) / l.clearance_m;
+            let ev = &l.last;
+            line += &format!(
+                " | e {e:.5} contact {} F ({:.1}, {:.1}) Kxx {:.3e} Cxx {:.3e} Cyy {:.3e}",
+                u8::from(ev.contact),
+                ev.force_n[0],
+                ev.force_n[1],
+                ev.stiffness[(0, 0)],
+                ev.damping[(0, 0)],
+                ev.damping[(1, 1)]
+            );
+        }
+        eprintln!("{line}");
     }
 }
