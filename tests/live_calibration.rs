@@ -584,8 +584,8 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// through the same driver, tabulated film and keyphasor lock, predicts the plant's onset within
 /// the 30 rpm (measured +21 rpm). The calibrated twin takes the estimate over
 /// `CALIBRATION_BLEND_S` (1 s): measured −107 rpm (before calibration −128), asserted within
-/// 150 rpm (the −107 and the spread of the onset with the seed: 48 against 100 revolutions of
-/// blend move it 83 rpm, `tests/onset_study.rs`). Taken at once, as before session 13, the
+/// 130 rpm; session 14 measured why (below, and README): the machine file's twins start the
+/// run-up with × 1.9 the plant's whirl, the speed steps' kicks taken with the wrong unbalance. Taken at once, as before session 13, the
 /// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
 /// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
 /// is not met by the run-up onset (README, "The onset after a live calibration": it moves
@@ -594,9 +594,28 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// `predicted_onset_after_calibration`).
 #[test]
 fn nonlinear_onset_after_live_calibration() {
-    let [plant, before, after, own] = onset_after_live_calibration(None, 0.0, None, false);
+    let ([plant, before, after, own], seed) = onset_after_live_calibration(None, 0.0, None, false);
+    // the whirl's seed at the run-up's start (plant, linear twin, twins before, after, own):
+    // measured 0.271, –, 0.520, 0.516, 0.253 µm. The twin of the plant's machine ran the
+    // plant's history with the plant's values, so the speed steps kicked it as they kicked
+    // the plant (× 0.93: its onset +21 rpm, one block of the rule); the machine file's twins
+    // took the same steps with the machine file's unbalance (140 g·mm at stage 4, not 280 at
+    // stage 7), so their free whirl started × 1.9 the plant's, and the calibration's blend did
+    // not undo it: ln 1.9 = 0.64 e-fold, and the lead stays × 2.2–2.3 up the run-up (at 9,000 rpm
+    // the plant's whirl grows 1.08 e-fold per 100 rpm): some 75–80 rpm of the −107.
+    let ratio = |i: usize| seed[i] / seed[0];
+    println!(
+        "seed over the plant's at the run-up's start: before × {:.2}, after × {:.2}, own × {:.2}",
+        ratio(2),
+        ratio(3),
+        ratio(4)
+    );
+    assert!((ratio(4) - 0.93).abs() < 0.1, "{seed:?}");
+    assert!((ratio(3) - 1.90).abs() < 0.2, "{seed:?}");
     assert!((own - plant).abs() < 30.0);
-    assert!((after - plant).abs() < 150.0);
+    // measured −107 rpm (before calibration −128, stated): the seed's; asserted within 130 rpm
+    // (the measured and one block of the rule, ≈ 21 rpm)
+    assert!((after - plant).abs() < 130.0);
     let _ = before;
 }
 
@@ -621,7 +640,7 @@ fn nonlinear_onset_study() {
     };
     let observer = (gains.stiffness_n_m > 0.0 || gains.damping_n_s_m > 0.0).then_some(gains);
     let keep = std::env::var("ONSET12_OBS_KEEP").is_ok();
-    let r = onset_after_live_calibration((ramp > 0.0).then_some(ramp), hold, observer, keep);
+    let (r, _) = onset_after_live_calibration((ramp > 0.0).then_some(ramp), hold, observer, keep);
     println!("RESULT ramp {ramp} hold {hold} observer {observer:?} keep {keep}: {r:?}");
 }
 
@@ -637,7 +656,7 @@ fn onset_after_live_calibration(
     hold_s: f64,
     observer: Option<ObserverGains>,
     keep: bool,
-) -> [f64; 4] {
+) -> ([f64; 4], Vec<f64>) {
     let twin = twin_rotor();
     let nonlinear = |rotor: &Rotor| {
         let settings = DriverSettings::new(
@@ -667,6 +686,7 @@ fn onset_after_live_calibration(
         rig.run(8000.0, hold_s * 8000.0 / 60.0, true);
     }
     rig.print_subsync("at the run-up's start");
+    let seed = rig.subsync_m();
     if !keep {
         for d in &mut rig.drivers[1..] {
             d.set_observer(None).unwrap();
@@ -690,7 +710,7 @@ fn onset_after_live_calibration(
     // running unlocked restarts there rather than being turned onto it); the twins ran the
     // plant's whole history from then on
     assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 2));
-    [plant, before, after, own]
+    ([plant, before, after, own], seed)
 }
 
 /// The twin's films on `n_theta × n_z`.
