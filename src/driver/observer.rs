@@ -96,6 +96,46 @@ impl Observer {
     }
 }
 
+impl super::Driver {
+    /// Turns the nudging observer on with `gains`, or off (None): off, the forces it holds on
+    /// the running twin are taken away at once. Off by default.
+    pub fn set_observer(&mut self, gains: Option<ObserverGains>) -> Result<(), String> {
+        if let Some(g) = gains {
+            g.check()?;
+            self.observer = Some(Observer::new(g, self.rotor.probes.len()));
+            return Ok(());
+        }
+        self.observer = None;
+        if let Some(s) = self.session.as_mut() {
+            for p in &self.rotor.probes {
+                s.twin_mut()
+                    .set_external_force(p.node, [0.0; 2])
+                    .map_err(|e| format!("observer: {e}"))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The observer's gains, when it is on.
+    pub fn observer(&self) -> Option<ObserverGains> {
+        self.observer.as_ref().map(|o| o.gains)
+    }
+
+    /// A compared sample of station `k`: its residual `r_m` (measured − twin, m) at `t_s` (s of
+    /// twin time) moves the observer's force at the station's node.
+    pub(super) fn observe(&mut self, k: usize, r_m: [f64; 2], t_s: f64) {
+        let (Some(o), Some(s)) = (self.observer.as_mut(), self.session.as_mut()) else {
+            return;
+        };
+        let Some(p) = self.rotor.probes.get(k) else {
+            return;
+        };
+        let f = o.update(k, r_m, t_s);
+        // the node is the machine's own probe station's: cannot fail
+        let _ = s.twin_mut().set_external_force(p.node, f);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,45 +177,5 @@ mod tests {
         }
         .check()
         .is_err());
-    }
-}
-
-impl super::Driver {
-    /// Turns the nudging observer on with `gains`, or off (None): off, the forces it holds on
-    /// the running twin are taken away at once. Off by default.
-    pub fn set_observer(&mut self, gains: Option<ObserverGains>) -> Result<(), String> {
-        if let Some(g) = gains {
-            g.check()?;
-            self.observer = Some(Observer::new(g, self.rotor.probes.len()));
-            return Ok(());
-        }
-        self.observer = None;
-        if let Some(s) = self.session.as_mut() {
-            for p in &self.rotor.probes {
-                s.twin_mut()
-                    .set_external_force(p.node, [0.0; 2])
-                    .map_err(|e| format!("observer: {e}"))?;
-            }
-        }
-        Ok(())
-    }
-
-    /// The observer's gains, when it is on.
-    pub fn observer(&self) -> Option<ObserverGains> {
-        self.observer.as_ref().map(|o| o.gains)
-    }
-
-    /// A compared sample of station `k`: its residual `r_m` (measured − twin, m) at `t_s` (s of
-    /// twin time) moves the observer's force at the station's node.
-    pub(super) fn observe(&mut self, k: usize, r_m: [f64; 2], t_s: f64) {
-        let (Some(o), Some(s)) = (self.observer.as_mut(), self.session.as_mut()) else {
-            return;
-        };
-        let Some(p) = self.rotor.probes.get(k) else {
-            return;
-        };
-        let f = o.update(k, r_m, t_s);
-        // the node is the machine's own probe station's: cannot fail
-        let _ = s.twin_mut().set_external_force(p.node, f);
     }
 }
