@@ -18,9 +18,10 @@ use rand_distr::{Distribution, Normal};
 use rotor_twin::driver::calibration::estimate;
 use rotor_twin::driver::{
     Applied, Driver, DriverSettings, Fed, Input, LiveCalibration, LiveEstimate, ModelKind,
-    OneXBlock, OneXBlocks, ProbeRef, StationRef,
+    ObserverGains, OneXBlock, OneXBlocks, ProbeRef, StationRef,
 };
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
+use rotor_twin::monitor::{ClassifierSettings, Monitor};
 use rotor_twin::plant::plant_runout;
 use rotor_twin::replay::compare::{Sample, StationComparison};
 use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor};
@@ -60,12 +61,25 @@ struct Rig {
     refused: usize,
     /// every driver's compared samples per station, as the replay collects them
     comparisons: Vec<Vec<StationComparison>>,
+    /// the plant's own monitor (its bearings' sub-synchronous amplitude, the whirl's seed)
+    plant_monitor: Monitor,
+    /// the seeds printed every this many seconds of plant time in a ramp (0: never), and when next
+    trace_s: f64,
+    next_trace_s: f64,
 }
 
 impl Rig {
     fn new(plant: Twin, drivers: Vec<Driver>, mark_deg: f64, probes: PlantProbes) -> Self {
         let mark_rad = mark_deg.to_radians();
+        let plant_monitor = Monitor::new(&plant, 256, ClassifierSettings::default());
         let mut rig = Rig {
+            plant_monitor,
+            // ONSET12_TRACE (s): the seeds along the whole history (studies)
+            trace_s: std::env::var("ONSET12_TRACE")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(0.0),
+            next_trace_s: 0.0,
             plant,
             blocks: OneXBlocks::new(Vec::new()),
             drivers: Vec::new(),
@@ -109,6 +123,37 @@ impl Rig {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The largest sub-synchronous amplitude over the bearings (m, the monitor's 16-revolution
+    /// spectrum at the last completed revolution): the plant's, then each driver's twin's.
+    fn subsync_m(&self) -> Vec<f64> {
+        let largest = |m: &Monitor| {
+            m.report()
+                .bearings
+                .iter()
+                .map(|b| b.subsync_amplitude_m)
+                .fold(0.0, f64::max)
+        };
+        let mut out = vec![largest(&self.plant_monitor)];
+        for d in &self.drivers {
+            out.push(d.session().map_or(f64::NAN, |s| largest(s.monitor())));
+        }
+        out
+    }
+
+    /// Prints [`Self::subsync_m`] (µm) with the plant's speed.
+    fn print_subsync(&self, what: &str) {
+        let a: Vec<String> = self
+            .subsync_m()
+            .iter()
+            .map(|a| format!("{:.4}", a * 1e6))
+            .collect();
+        println!(
+            "sub-synchronous amplitude {what} ({:.0} rpm, µm): plant, twins {}",
+            self.plant.output().speed_rad_s * 30.0 / PI,
+            a.join(", ")
+        );
+    }
+
     fn now_ns(&self) -> i64 {
         EPOCH_NS + (self.plant.time_s() * 1e9).round() as i64
     }
@@ -136,6 +181,11 @@ impl Rig {
                 accel_rad_s2: accel,
             };
             self.plant.step(&input).unwrap();
+            self.plant_monitor.record(&self.plant);
+            if self.trace_s > 0.0 && self.plant.time_s() >= self.next_trace_s {
+                self.next_trace_s = self.plant.time_s() + self.trace_s;
+                self.print_subsync("in the run-up");
+            }
             let t = self.now_ns();
             let w = self.plant.output().speed_rad_s;
             if t >= self.next_speed_ns {
@@ -295,15 +345,17 @@ fn calibrate(
     mark_deg: f64,
     probes: PlantProbes,
 ) -> (Rig, Vec<OneXBlock>, LiveEstimate) {
-    calibrate_with(twin, mark_deg, probes, Vec::new())
+    calibrate_with(twin, mark_deg, probes, Vec::new(), None)
 }
 
-/// [`calibrate`] with `more` drivers fed the same plant alongside.
+/// [`calibrate`] with `more` drivers fed the same plant alongside; the plant's speed steps from
+/// one calibration speed to the next at once, or ramps at `ramp_rpm_s` (rpm/s).
 fn calibrate_with(
     twin: &Rotor,
     mark_deg: f64,
     probes: PlantProbes,
     more: Vec<Driver>,
+    ramp_rpm_s: Option<f64>,
 ) -> (Rig, Vec<OneXBlock>, LiveEstimate) {
     let plant = plant_rotor(twin);
     let w8 = 8000.0 * PI / 30.0;
@@ -319,7 +371,12 @@ fn calibrate_with(
     let plant = Twin::new(&plant, config, w5).unwrap();
     let mut rig = Rig::new(plant, drivers, mark_deg, probes);
     let mut before = Vec::new();
+    let mut last_rpm = 5000.0;
     for rpm in [5000.0, 6500.0, 8000.0] {
+        if let (Some(rate), true) = (ramp_rpm_s, rpm > last_rpm) {
+            rig.ramp(last_rpm, rpm, (rpm - last_rpm) / rate, false);
+        }
+        last_rpm = rpm;
         rig.run(rpm, 8.0, false);
         before = rig.run(rpm, 16.5, true);
     }
@@ -527,8 +584,8 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// through the same driver, tabulated film and keyphasor lock, predicts the plant's onset within
 /// the 30 rpm (measured +21 rpm). The calibrated twin takes the estimate over
 /// `CALIBRATION_BLEND_S` (1 s): measured −107 rpm (before calibration −128), asserted within
-/// 150 rpm (the −107 and the spread of the onset with the seed: 48 against 100 revolutions of
-/// blend move it 83 rpm, `tests/onset_study.rs`). Taken at once, as before session 13, the
+/// 130 rpm; session 14 measured why (below, and README): the machine file's twins start the
+/// run-up with × 1.9 the plant's whirl, the speed steps' kicks taken with the wrong unbalance. Taken at once, as before session 13, the
 /// step kicked the rotor at 8,000 rpm, 280 rpm below its threshold where the whirl decays at
 /// only ~0.02/rev, and the kick seeded the whip: −481 rpm, which fails here. The 30 rpm
 /// is not met by the run-up onset (README, "The onset after a live calibration": it moves
@@ -537,6 +594,69 @@ fn the_node_recomputes_the_stability_threshold_when_the_oil_temperature_changes(
 /// `predicted_onset_after_calibration`).
 #[test]
 fn nonlinear_onset_after_live_calibration() {
+    let ([plant, before, after, own], seed) = onset_after_live_calibration(None, 0.0, None, false);
+    // the whirl's seed at the run-up's start (plant, linear twin, twins before, after, own):
+    // measured 0.271, –, 0.520, 0.516, 0.253 µm. The twin of the plant's machine ran the
+    // plant's history with the plant's values, so the speed steps kicked it as they kicked
+    // the plant (× 0.93: its onset +21 rpm, one block of the rule); the machine file's twins
+    // took the same steps with the machine file's unbalance (140 g·mm at stage 4, not 280 at
+    // stage 7), so their free whirl started × 1.9 the plant's, and the calibration's blend did
+    // not undo it: ln 1.9 = 0.64 e-fold, and the lead stays × 2.2–2.3 up the run-up (at 9,000 rpm
+    // the plant's whirl grows 1.08 e-fold per 100 rpm): some 75–80 rpm of the −107.
+    let ratio = |i: usize| seed[i] / seed[0];
+    println!(
+        "seed over the plant's at the run-up's start: before × {:.2}, after × {:.2}, own × {:.2}",
+        ratio(2),
+        ratio(3),
+        ratio(4)
+    );
+    assert!((ratio(4) - 0.93).abs() < 0.1, "{seed:?}");
+    assert!((ratio(3) - 1.90).abs() < 0.2, "{seed:?}");
+    assert!((own - plant).abs() < 30.0);
+    // measured −107 rpm (before calibration −128, stated): the seed's; asserted within 130 rpm
+    // (the measured and one block of the rule, ≈ 21 rpm)
+    assert!((after - plant).abs() < 130.0);
+    let _ = before;
+}
+
+/// Study of [`nonlinear_onset_after_live_calibration`]'s history (ignored; set by environment
+/// variables): ONSET12_RAMP (rpm/s of the plant between the calibration speeds, 0 = steps),
+/// ONSET12_HOLD (s at 8,000 rpm after the calibration is applied, before the run-up);
+/// ONSET12_OBS_C (N·s/m), ONSET12_OBS_K (N/m), ONSET12_OBS_FC (Hz): the nonlinear twins' nudging
+/// observer from the start (none when both gains are 0), off at the run-up's start unless
+/// ONSET12_OBS_KEEP is set.
+#[test]
+#[ignore]
+fn nonlinear_onset_study() {
+    let num = |name: &str, default: f64| {
+        std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
+    };
+    let ramp = num("ONSET12_RAMP", 0.0);
+    let hold = num("ONSET12_HOLD", 0.0);
+    let gains = ObserverGains {
+        stiffness_n_m: num("ONSET12_OBS_K", 0.0),
+        damping_n_s_m: num("ONSET12_OBS_C", 0.0),
+        cutoff_hz: num("ONSET12_OBS_FC", 270.0),
+    };
+    let observer = (gains.stiffness_n_m > 0.0 || gains.damping_n_s_m > 0.0).then_some(gains);
+    let keep = std::env::var("ONSET12_OBS_KEEP").is_ok();
+    let (r, _) = onset_after_live_calibration((ramp > 0.0).then_some(ramp), hold, observer, keep);
+    println!("RESULT ramp {ramp} hold {hold} observer {observer:?} keep {keep}: {r:?}");
+}
+
+/// The run of [`nonlinear_onset_after_live_calibration`]: the plant's history to 8,000 rpm
+/// (steps, or ramps at `ramp_rpm_s`), the calibration, `hold_s` more at 8,000 rpm, then the
+/// 400 rpm/s run-up to 9,400 rpm. Prints the whirl's seed (the bearings' largest
+/// sub-synchronous amplitude) of the plant and each twin along the way. Returns the onsets
+/// (rpm): the plant's, the twin's before and after calibration, the plant's own machine's.
+/// `observer`: the nonlinear twins' nudging observer from the start, off at the run-up's start
+/// (the onset an open-loop prediction from the assimilated state) unless `keep`.
+fn onset_after_live_calibration(
+    ramp_rpm_s: Option<f64>,
+    hold_s: f64,
+    observer: Option<ObserverGains>,
+    keep: bool,
+) -> ([f64; 4], Vec<f64>) {
     let twin = twin_rotor();
     let nonlinear = |rotor: &Rotor| {
         let settings = DriverSettings::new(
@@ -544,14 +664,17 @@ fn nonlinear_onset_after_live_calibration() {
             FilmEvaluation::Table,
             twin.rated_speed_rad_s,
         );
-        Driver::new(rotor.clone(), settings)
+        let mut d = Driver::new(rotor.clone(), settings);
+        d.set_observer(observer).unwrap();
+        d
     };
     let more = vec![
         nonlinear(&twin),
         nonlinear(&twin),
         nonlinear(&plant_rotor(&twin)),
     ];
-    let (mut rig, before, e) = calibrate_with(&twin, 0.0, PlantProbes::Pairs, more);
+    let (mut rig, before, e) = calibrate_with(&twin, 0.0, PlantProbes::Pairs, more, ramp_rpm_s);
+    rig.print_subsync("at the estimate");
     let (unbalance, viscosity_scale) = e.values();
     let applied = Applied {
         unbalance,
@@ -559,6 +682,19 @@ fn nonlinear_onset_after_live_calibration() {
     };
     rig.drivers[2].apply_calibration(applied).unwrap();
     check_and_apply(&mut rig, &before, &e, 120.0);
+    if hold_s > 0.0 {
+        rig.run(8000.0, hold_s * 8000.0 / 60.0, true);
+    }
+    rig.print_subsync("at the run-up's start");
+    let seed = rig.subsync_m();
+    if !keep {
+        for d in &mut rig.drivers[1..] {
+            d.set_observer(None).unwrap();
+        }
+    }
+    if rig.trace_s == 0.0 {
+        rig.trace_s = 0.25;
+    }
     rig.ramp(8000.0, 9400.0, 3.5, true);
     rig.finish_comparisons();
     let onset = |i: usize, predicted: bool| rig.onset_rpm(i, predicted);
@@ -574,8 +710,7 @@ fn nonlinear_onset_after_live_calibration() {
     // running unlocked restarts there rather than being turned onto it); the twins ran the
     // plant's whole history from then on
     assert!(rig.drivers[1..].iter().all(|d| d.counts().starts == 2));
-    assert!((own - plant).abs() < 30.0);
-    assert!((after - plant).abs() < 150.0);
+    ([plant, before, after, own], seed)
 }
 
 /// The twin's films on `n_theta × n_z`.

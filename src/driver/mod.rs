@@ -9,6 +9,7 @@
 pub mod calibration;
 mod clock;
 pub mod inputs;
+mod observer;
 mod oil;
 pub mod one_x;
 mod plant_signals;
@@ -20,6 +21,7 @@ pub use inputs::{
     check_probe, check_unbalance, seconds_to_ns, Input, InputLimits, ProbeRef, SpeedGate,
     SpeedUnit, StationRef,
 };
+pub use observer::ObserverGains;
 pub use oil::{
     FilmOil, HeatBalanceReport, OilDiagnostics, HEAT_BALANCE_SPEED_STEP,
     HEAT_BALANCE_TEMPERATURE_STEP_K,
@@ -162,6 +164,8 @@ pub struct Driver {
     oil: oil::OilState,
     /// an applied calibration on its way into the running nonlinear twin
     blend: Option<calibration::Blend>,
+    /// the nudging observer, when on (issue 12, session 14)
+    observer: Option<observer::Observer>,
 }
 
 impl Driver {
@@ -194,6 +198,7 @@ impl Driver {
             viscosity_correction: None,
             oil,
             blend: None,
+            observer: None,
         }
     }
 
@@ -449,6 +454,9 @@ impl Driver {
         }
         self.session = Some(s);
         self.blend = None;
+        if let Some(o) = self.observer.as_mut() {
+            o.reset();
+        }
         self.signals.keyphasor.unlock();
         self.counts.starts += 1;
         Fed::Started { speed_rad_s: w }
@@ -527,6 +535,8 @@ impl Driver {
             phase_reference: self.phase_reference(time_ns),
         };
         emit(Outgoing::Residual(r));
+        let residual = [0, 1].map(|j| measured[j] - comparison.predicted_m[j]);
+        self.observe(k, residual, t);
         Fed::Compared(comparison)
     }
 
