@@ -232,10 +232,11 @@ fn whip_state(rng: &mut Rng, c: f64, eps_range: (f64, f64)) -> (JournalKinematic
 /// coefficients in ε 0.98–0.995, [`WALL_BAND`]) (force: of |F|;
 /// coefficients: of the state's coefficient scale, `coefficient_error`): within the issue's
 /// 0.5 % everywhere. Measured, by band (`BANDS`), this table (u = atanh ε, 160 rows, 192
-/// columns × 8 phases, and 384 columns × 32 phases on the 83 rows at ε ≥ 0.95 (`WallRows`),
-/// U with the grid's Couette factor κ, the force in the source's frame): force 0.00, 0.00,
-/// 0.00, 0.00, 0.01, 0.01, 0.01, 0.01 %; coefficients 0.11, 0.07, 0.16, 0.12, 0.23, 0.32,
-/// 0.28, 0.27 % (`resolution_study`, session 13). The uniform 160 × 192 × 8 table of session
+/// columns × 8 phases, and 384 columns × 32 phases on the 98 rows at ε ≥ 0.90 (`WallRows`),
+/// U with the grid's Couette factor κ, the force in the source's frame): force 0.001, 0.001,
+/// 0.001, 0.001, 0.010, 0.001, 0.006, 0.014 %; coefficients 0.110, 0.073, 0.157, 0.124, 0.271,
+/// 0.187, 0.278, 0.274 % (session 14; with the wall rows from ε 0.95, session 13: 0.11, 0.07,
+/// 0.16, 0.12, 0.23, 0.32, 0.28, 0.27 %). The uniform 160 × 192 × 8 table of session
 /// 12 (main) reads 0.46 % in ε 0.95–0.98 and 1.17 % in ε 0.98–0.995, where the developed whip
 /// of the built-in rotor at 9,000 rpm spends all its time (ε 0.985–0.993): it fails here. The
 /// cause was the interpolation in ψ (session 12, `wall_error_decomposition`); finer columns

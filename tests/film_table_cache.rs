@@ -76,10 +76,10 @@ fn a_table_read_back_is_the_table_built_bit_for_bit_with_identical_film_forces()
     let Lookup::Hit(loaded) = load(&cache) else {
         panic!("the stored table must load from {}", path.display());
     };
-    // 77 rows of 192 columns, then the 83 rows at ε ≥ 0.95 of 384 (`WallRows`), 14 values a
+    // 62 rows of 192 columns, then the 98 rows at ε ≥ 0.90 of 384 (`WallRows`), 14 values a
     // node and the 12-angle profile
-    assert_eq!(TableResolution::DEFAULT.nodes(), 77 * 192 + 83 * 384);
-    assert_eq!(table.values().len(), (77 * 192 + 83 * 384) * (14 + 12));
+    assert_eq!(TableResolution::DEFAULT.nodes(), 62 * 192 + 98 * 384);
+    assert_eq!(table.values().len(), (62 * 192 + 98 * 384) * (14 + 12));
     assert!(same_bits(&table, &loaded), "a tabulated value differs");
     // what the twin reads: force, zone, friction, flows, the eight coefficients, the profile
     let (mut a, mut b) = (
