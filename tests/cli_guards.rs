@@ -775,3 +775,21 @@ fn long_numbers_are_shown_in_scientific_notation() {
     assert_eq!(shown_value(-1.23456e-7), "-1.235e-7");
     assert_eq!(shown_value(0.1 + 0.2), "3.000e-1");
 }
+
+/// `bearing --thermal` takes the built-in machine's MDM viscosity table by default (session 14),
+/// valid 10–120 °C: a supply temperature outside it is refused naming the flag, the value and
+/// the law's range (the Walther default before accepted 0–250 °C and read 130 °C off a law
+/// extrapolated past its points); inside it the thermal film runs and its peak lies above the
+/// supply (the seed bearing at 9,000 rpm: 47.9 °C for 40 °C, README "The seed bearing").
+#[test]
+fn thermal_supply_outside_the_oil_law_is_refused() {
+    let (ok, _, err) = run_cli(&["bearing", "--thermal", "--supply-temperature-c", "130"]);
+    assert!(!ok);
+    assert!(err.contains("--supply-temperature-c 130"), "{err}");
+    assert!(err.contains("10–120 °C"), "{err}");
+    let (ok, out, err) = run_cli(&["bearing", "--thermal", "--speed-rpm", "9000", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let peak = v["thermal"]["max_temperature_c"].as_f64().unwrap();
+    assert!((peak - 47.907).abs() < 0.05, "peak {peak} °C");
+}

@@ -4,7 +4,7 @@ use crate::film::{
     FilmModel, FiniteFilm, JournalKinematics, ThermalFilm, ThermalOil, ViscosityLaw, WaltherLaw,
     ZERO_CELSIUS_K,
 };
-use crate::rotor::{BearingModel, MachineDescription, Rotor, DEFAULT_MACHINE_YAML};
+use crate::rotor::{BearingModel, MachineDescription, Rotor};
 use anyhow::Context;
 use serde::Serialize;
 
@@ -38,8 +38,7 @@ pub(crate) fn thermal_oil(
 
 /// The built-in machine's viscosity–temperature law (its first film bearing's: MDM's curve).
 fn built_in_law() -> anyhow::Result<ViscosityLaw> {
-    let desc = MachineDescription::from_yaml(DEFAULT_MACHINE_YAML, "built-in machine")?;
-    Rotor::from_description(&desc)
+    Rotor::from_description(&MachineDescription::builtin_default())
         .bearings
         .iter()
         .find_map(|b| match &b.model {
