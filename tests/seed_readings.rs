@@ -1,6 +1,6 @@
 //! The seed's two readings with the film's own inertia (issue 11; README "Two readings of the
 //! seed"): (A) the built-in Ø55 rotor (a threshold crossing) and (B) the Ø63, 56 kg rotor of
-//! config/orc_microturbine_100kw_d63.yaml (linear-stable, whipping in a half-speed window without
+//! config/orc_microturbine_100kw.yaml (linear-stable, whipping in a half-speed window without
 //! film inertia). With `fluid_inertia: full` (Re* = 1.7 at 9,000 rpm; eq. I1 of
 //! `src/film/inertia.rs`) the two trade places at the seed's 9,000 rpm: (A) whips from a quiet
 //! start, later, and (B) settles.
@@ -76,7 +76,7 @@ fn subsync_growth(run: &TransientResult, from: usize, to: usize) -> f64 {
 #[test]
 fn with_full_film_inertia_the_shipped_rotor_whips_at_9000_and_the_d63_one_settles() {
     let a = at_9000(&rotor(None, FluidInertia::Full), 1250);
-    let d63 = Some("config/orc_microturbine_100kw_d63.yaml");
+    let d63 = Some("config/orc_microturbine_100kw.yaml");
     let b = at_9000(&rotor(d63, FluidInertia::Full), 400);
     let b_bare = at_9000(&rotor(d63, FluidInertia::None), 400);
     let (ga, gb) = (subsync_growth(&a, 100, 500), subsync_growth(&b, 100, 300));

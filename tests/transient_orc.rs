@@ -267,7 +267,7 @@ fn linear_model_growth_matches_its_eigenvalue() {
     assert!((run.growth_per_rev() - expected).abs() < 0.1 * expected);
 }
 
-/// The second reading of the seed (config/orc_microturbine_100kw_d63.yaml: Ø63 body, 56 kg;
+/// The second reading of the seed (config/orc_microturbine_100kw.yaml: Ø63 body, 56 kg;
 /// README "Two readings of the seed"): linear threshold above 9,000 rpm, so the linear model is
 /// stable there, while the nonlinear one is stable at 8,000 and whips at 9,000 from a quiet start
 /// with an amplitude above 30 µm, a p_max ratio of at least 2.3 (2.84 measured) at valid (full-film)
@@ -275,7 +275,7 @@ fn linear_model_growth_matches_its_eigenvalue() {
 #[test]
 fn second_reading_d63_is_linear_stable_and_whips_at_9000() {
     let desc = MachineDescription::load(Some(std::path::Path::new(
-        "config/orc_microturbine_100kw_d63.yaml",
+        "config/orc_microturbine_100kw.yaml",
     )))
     .unwrap();
     let rotor = Rotor::from_description(&desc);

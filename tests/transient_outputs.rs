@@ -107,14 +107,14 @@ fn rev_to_rev_difference_compares_the_same_shaft_angle() {
     );
 }
 
-/// The second reading's rotor (config/orc_microturbine_100kw_d63.yaml) whips at 9,000 rpm at
+/// The second reading's rotor (config/orc_microturbine_100kw.yaml) whips at 9,000 rpm at
 /// half speed: one revolution sees half a whirl. The peak-to-peak values are taken over the two
 /// revolutions of a whole whirl period (`span_revolutions` 2) and equal the extent of the orbit
 /// over the last two revolutions; before, the y peak-to-peak was 29 µm of an orbit 62 µm tall.
 #[test]
 fn half_speed_whirl_peak_to_peak_spans_its_whole_period() {
     let desc = MachineDescription::load(Some(std::path::Path::new(
-        "config/orc_microturbine_100kw_d63.yaml",
+        "config/orc_microturbine_100kw.yaml",
     )))
     .unwrap();
     let rotor = Rotor::from_description(&desc);
