@@ -71,7 +71,7 @@ fn the_sample_bag_streams_as_read_whole_and_sorted() {
     let dir = root.join("bags/orc_runup_synthetic");
     let bag = Bag::read(&dir).unwrap();
     let want = reference(&bag.files);
-    assert_eq!(want.len(), 37_601, "bags/README.md: 37,601 messages");
+    assert_eq!(want.len(), 76_627, "bags/README.md: 76,627 messages");
     let (got, peak) = streamed(&bag);
     assert_eq!(bag.message_count(), want.len());
     assert!(got == want, "streamed order or content differs");

@@ -45,8 +45,8 @@ fn machines_the_model_cannot_hold_are_refused_with_the_field() {
     );
     // 10,000 elements: 50 sections of 200
     let many = machine_with(
-        "  - {length_m: 0.73333333, outer_diameter_m: 0.055, material: steel, elements: 22}\n",
-        &"  - {length_m: 0.0146, outer_diameter_m: 0.055, material: steel, elements: 200}\n"
+        "  - {length_m: 0.73333333, outer_diameter_m: 0.063, material: steel, elements: 22}\n",
+        &"  - {length_m: 0.0146, outer_diameter_m: 0.063, material: steel, elements: 200}\n"
             .repeat(50),
     );
     let e = refusal(&many);
@@ -686,20 +686,21 @@ fn huge_numbers_are_not_echoed_whole() {
 /// accepted and `simulate` at 5e8 rpm reported "stable").
 #[test]
 fn a_rated_speed_no_shaft_survives_is_refused() {
-    // the shipped machine's largest shaft diameter is 60 mm: 500 m/s is 159,155 rpm
+    // the shipped machine's largest shaft diameter is its Ø63 mm body (reading (B), the default
+    // since session 15): 500 m/s is 500 / (π · 0.063 m) · 60 = 151,576 rpm
     let e = refusal(&machine_with(
         "rated_speed_rpm: 9000",
         "rated_speed_rpm: 1e9",
     ));
     assert!(
-        e.contains("rated_speed_rpm = 1000000000") && e.contains("at most 159154 rpm"),
+        e.contains("rated_speed_rpm = 1000000000") && e.contains("at most 151576 rpm") && e.contains("0.063 m"),
         "{e}"
     );
     MachineDescription::from_yaml(
         &machine_with("rated_speed_rpm: 9000", "rated_speed_rpm: 150000"),
         "m.yaml",
     )
-    .expect("150,000 rpm: 471 m/s on Ø 60 mm");
+    .expect("150,000 rpm: 495 m/s on Ø 63 mm");
 }
 
 /// Each field of `--kick` and `--speed-history` is checked before the run, the error naming it

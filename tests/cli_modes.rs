@@ -5,9 +5,11 @@ use common::run_cli;
 
 use serde_json::Value;
 
-/// The built-in microturbine: the contracted keys, a Campbell diagram, and the linear threshold in
-/// the window the seed reports (stable at 8,000 rpm, whip at 9,000: the shaft body diameter was
-/// identified for this, see config/orc_microturbine_100kw.yaml), with a half-frequency whirl.
+/// The built-in microturbine: the contracted keys, a Campbell diagram, and the linear threshold
+/// where the seed puts it for the linear model: ABOVE the rated 9,000 rpm ("a linear model predicts
+/// stable operation" there; reading (B), the Ø63 body, the default since session 15:
+/// config/orc_microturbine_100kw.yaml, 9,291 rpm in README "The microturbine"), with a
+/// half-frequency whirl (0.488 there).
 #[test]
 fn modes_json_and_plot_for_the_builtin_machine() {
     let svg = std::env::temp_dir().join(format!("rotor-twin-campbell-{}.svg", std::process::id()));
@@ -42,11 +44,11 @@ fn modes_json_and_plot_for_the_builtin_machine() {
     }
     let threshold = v["threshold_speed_rpm"].as_f64().unwrap();
     assert!(
-        (8000.0..9000.0).contains(&threshold),
-        "threshold {threshold}"
+        (9000.0..9400.0).contains(&threshold),
+        "threshold {threshold}: reading (B) is linear-stable at the rated 9,000 rpm"
     );
     let ratio = v["whirl_ratio_at_threshold"].as_f64().unwrap();
-    assert!((0.4..0.5).contains(&ratio), "whirl ratio {ratio}");
+    assert!((0.45..0.5).contains(&ratio), "whirl ratio {ratio}");
     let loads: f64 = v["bearing_loads_n"]
         .as_array()
         .unwrap()

@@ -5,8 +5,11 @@ mod common;
 mod svg_check;
 use common::run_cli;
 
-/// The built-in microturbine: its first forward mode's peak near 3,800 rpm at each bearing with
-/// an amplification factor and the API 684 margin beside it; both plots complete.
+/// The built-in microturbine (reading (B), Ø63, the default since session 15): its first forward
+/// mode's peak near 4,600 rpm at each bearing (4,575 / 4,598 rpm measured in session 15; `modes`
+/// puts the damped critical at 4,102 rpm with AF 2.54, and the films' damping carries the peak of
+/// the bearings' response above it; (A), Ø55, peaked near 3,800) with an amplification factor and
+/// the API 684 margin beside it; both plots complete.
 #[test]
 fn response_json_and_plots_for_the_builtin_machine() {
     let prefix = std::env::temp_dir().join(format!("rotor-twin-response-{}", std::process::id()));
@@ -29,7 +32,7 @@ fn response_json_and_plots_for_the_builtin_machine() {
     for s in stations {
         let peak = &s["peaks"][0];
         let nc = peak["speed_rpm"].as_f64().unwrap();
-        assert!((3500.0..4100.0).contains(&nc), "{}: peak {nc}", s["name"]);
+        assert!((4400.0..4800.0).contains(&nc), "{}: peak {nc}", s["name"]);
         for key in [
             "amplification_factor",
             "separation_margin_pct",

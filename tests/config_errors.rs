@@ -41,9 +41,9 @@ fn says(e: &ConfigError, field: &str, value: &str, rule: &str) {
 #[test]
 fn out_of_range_values_are_named_with_field_value_and_rule() {
     says(
-        &error_of(&with("outer_diameter_m: 0.055", "outer_diameter_m: -0.055")),
+        &error_of(&with("outer_diameter_m: 0.063", "outer_diameter_m: -0.063")),
         "shaft[3].outer_diameter_m",
-        "-0.055",
+        "-0.063",
         "greater than zero",
     );
     says(

@@ -27,8 +27,9 @@ pub struct SynthArgs {
     /// Seconds of the linear ramp.
     #[arg(long, default_value_t = 5.0)]
     pub ramp: f64,
-    /// Seconds at the end speed.
-    #[arg(long, default_value_t = 2.5)]
+    /// Seconds at the end speed (10 s: the built-in machine, reading (B), whips at 9,000 rpm
+    /// some 5 s after reaching it, out of its half-speed resonance; the sample bag's profile).
+    #[arg(long, default_value_t = 10.0)]
     pub hold_end: f64,
     /// Probe samples per revolution.
     #[arg(long, default_value_t = 16)]
