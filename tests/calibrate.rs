@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::calibration::{builtin_with_raw_probes, plant_rotor, twin_rotor};
+use common::calibration::{builtin_with_raw_probes, plant_rotor, twin_rotor, twin_rotor_d55};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rotor_twin::calibrate::{
@@ -19,9 +19,7 @@ use rotor_twin::calibrate::{
 use rotor_twin::dynamics::{Coupling, StepInput, Twin, TwinConfig};
 use rotor_twin::rotor::{MachineDescription, Rotor};
 
-/// The plant at `rpm` for 40 revolutions to settle, then 16 measured: one window fit per station
-/// (reading (B)'s 0.49X mode is lightly damped below its whip window, log dec ≈ 0.16 at 8,000 rpm,
-/// so the start's free motion needs ≈ 40 revolutions to fall below the 0.3 µm noise; 8 did for (A)).
+/// The plant at `rpm` for 8 revolutions to settle, then 16 measured: one window fit per station.
 fn measure(plant: &Rotor, rpm: f64, noise: &mut impl FnMut() -> f64) -> Vec<WindowFit> {
     let w = rpm * std::f64::consts::PI / 30.0;
     let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, 64);
@@ -31,9 +29,9 @@ fn measure(plant: &Rotor, rpm: f64, noise: &mut impl FnMut() -> f64) -> Vec<Wind
         accel_rad_s2: 0.0,
     };
     let mut samples = vec![Vec::new(); plant.probes.len()];
-    for k in 0..64 * 56 {
+    for k in 0..64 * 24 {
         twin.step(&input).unwrap();
-        if k >= 64 * 40 && k % 2 == 0 {
+        if k >= 64 * 8 && k % 2 == 0 {
             let out = twin.output();
             for (s, p) in samples.iter_mut().zip(&out.probes) {
                 s.push(AngleSample {
@@ -69,9 +67,14 @@ fn assert_covers(what: &str, v: &rotor_twin::calibrate::ViscosityEstimate, truth
     assert!(err.abs() <= 2.0 * v.scale_std, "{what}: {v:?}");
 }
 
+/// On reading (A) (config/orc_microturbine_100kw_d55.yaml), where the targets were set. On the
+/// default (B) the same plant and speeds (5,000 / 6,500 / 8,000 rpm, also 6,000 / 7,000 / 8,000,
+/// also 40 revolutions to settle) read × 1.175 ± 0.040 for × 1.10 (7 % off, covered at 1.9σ;
+/// residual 0.8 µm against 0.3 µm of noise): a bias of the 6-point static fit on the stiffer
+/// rotor, open (README Next steps 2); (B)'s sample bag, 78 windows, reads × 1.0518 for × 1.05.
 #[test]
 fn viscosity_then_unbalance_are_recovered_from_a_plant_that_differs() {
-    let mut twin = twin_rotor();
+    let mut twin = twin_rotor_d55();
     let plant = plant_rotor(&twin);
     let normal = Normal::new(0.0, 0.3e-6).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);

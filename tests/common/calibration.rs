@@ -12,6 +12,16 @@ pub fn twin_rotor() -> Rotor {
     twin_of(MachineDescription::builtin_default())
 }
 
+/// Reading (A) of the seed (config/orc_microturbine_100kw_d55.yaml, Ø55; the default until session
+/// 15) as [`twin_rotor`] makes it.
+pub fn twin_rotor_d55() -> Rotor {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/config/orc_microturbine_100kw_d55.yaml"
+    );
+    twin_of(MachineDescription::load(Some(std::path::Path::new(path))).unwrap())
+}
+
 /// [`twin_rotor`] with raw proximity probes `<station>_x` / `_y` at 45° and 135° (API 670's
 /// pair either side of vertical) in V at 7.87 V/mm, DC-coupled about a 1 mm (7.87 V) gap, each
 /// with the plant's slow-roll runout vector of `runout_m` (`plant::plant_runout`).
