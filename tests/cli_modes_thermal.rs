@@ -51,14 +51,43 @@ fn modes_thermal_json_for_the_builtin_machine() {
 /// The thermal threshold of reading (B) measured by tests/thermal_threshold.rs (rpm).
 const THERMAL_B_RPM: f64 = 9363.3;
 
-/// The thermal options need `--thermal`, `--thermal` refuses the fluid-inertia options, and a
-/// supply outside the MDM table's 10–120 °C is refused naming the range.
+/// The thermal options need `--thermal`, `--thermal` refuses the fluid-inertia options, a
+/// supply outside the MDM table's 10–120 °C is refused naming the range, and so is a
+/// one-point `--viscosity-points`.
 #[test]
 fn modes_thermal_refusals() {
+    let (ok, _, err) = run_cli(&["modes", "--thermal", "--viscosity-points", "40:0.889"]);
+    assert!(!ok && err.contains("exactly two"), "{err}");
     let (ok, _, err) = run_cli(&["modes", "--supply-temperature-c", "50"]);
     assert!(!ok && err.contains("--thermal"), "{err}");
     let (ok, _, err) = run_cli(&["modes", "--thermal", "--fluid-inertia"]);
     assert!(!ok && err.contains("--fluid-inertia"), "{err}");
     let (ok, _, err) = run_cli(&["modes", "--thermal", "--supply-temperature-c", "150"]);
     assert!(!ok && err.contains("10–120 °C"), "{err}");
+}
+
+/// `--viscosity-points` replaces the machine file's law: Walther's law through 0.888889 mm²/s
+/// at 40 °C and 0.888888 at 80 °C with the bearings' 900 kg/m³ is flat to 1.2e-6 and 1e-6 off
+/// the file's µ₀ = 0.8 mPa·s, so the thermal threshold is the isothermal one to the threshold's
+/// sensitivity (|d ln N/d ln µ| 0.12, README "Thermal film") times 2e-6: asserted to 1e-5.
+#[test]
+fn modes_thermal_with_a_flat_walther_law_gives_the_isothermal_threshold() {
+    let (ok, out, err) = run_cli(&[
+        "modes",
+        "--json",
+        "--thermal",
+        "--viscosity-points",
+        "40:0.888889,80:0.888888",
+        "--from-rpm",
+        "6000",
+        "--to-rpm",
+        "12000",
+        "--step-rpm",
+        "500",
+    ]);
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let thermal = v["thermal"]["threshold_speed_rpm"].as_f64().unwrap();
+    let iso = v["threshold_speed_rpm"].as_f64().unwrap();
+    assert!((thermal - iso).abs() < 1e-5 * iso, "{thermal} vs {iso}");
 }

@@ -189,3 +189,26 @@ fn the_thermal_threshold_of_both_readings_and_the_effective_temperature_route() 
         );
     }
 }
+
+/// A bearing the thermal film cannot carry is refused by name, never run isothermal in its
+/// place: here the film's fluid inertia (the thermal threshold is built without it); and the
+/// oils must be one per film bearing. Built-in machine (B).
+#[test]
+fn a_bearing_the_thermal_film_cannot_carry_is_refused_by_name() {
+    let mut with_inertia = rotor(None);
+    with_inertia.set_fluid_inertia(rotor_twin::film::FluidInertia::Temporal);
+    let statics = static_solution(&with_inertia).unwrap();
+    let oils = mdm_oils(&with_inertia);
+    let err = stability_threshold_thermal(&with_inertia, &statics, SPEEDS, &oils)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bearing_pulley_end") && err.contains("fluid inertia"),
+        "{err}"
+    );
+    let plain = rotor(None);
+    let err = stability_threshold_thermal(&plain, &statics, SPEEDS, &oils[..1])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("one oil per film bearing"), "{err}");
+}
