@@ -34,8 +34,9 @@
 //! (the hot-oil carry-over of the THD literature, mixing at the film's start). The march around
 //! the ring gives T_r = T_in + ΔT with ΔT independent of T_in (Φ and Q are fixed by the film of
 //! this iteration), so (E3) is solved in closed form: T_in = T_s + Q_r ΔT / (Q_in − Q_r).
-//! (E1) and (E2–E3) are iterated to a fixed point (under-relaxed; where the rupture flips
-//! between two grid nodes there is none on the grid and the relaxation shrinks, [`relaxation`]).
+//! (E1) and (E2–E3) are iterated to a fixed point (under-relaxed; should it not settle in 40
+//! iterations, e.g. a rupture flipping between two grid nodes, the relaxation shrinks:
+//! [`relaxation`]).
 //!
 //! **Approximations, stated**: adiabatic (no conduction into the solids: the hottest case);
 //! constant ρ and c_p; T uniform along the axis and across the film; the oil supplied where the
@@ -60,11 +61,13 @@ const FREE_ITERATIONS: usize = 40;
 const RELAXATION_DECAY: f64 = 0.8;
 
 /// The relaxation of iteration `k` (1-based): [`RELAXATION`] for the first
-/// [`FREE_ITERATIONS`], then shrinking geometrically. Why: the discrete pressure zone ends at a
-/// grid node, so the march (E2–E3) jumps where the field moves the rupture across a node; when
-/// the fixed point lies at such a flip there is none on the grid (the residual stays at the
-/// jump, seen on reading (A)'s outboard bearing near 8,600 rpm: 200 iterations without
-/// settling). The shrinking steps stop the field at the flip, within the jump of either side.
+/// [`FREE_ITERATIONS`], then shrinking geometrically. Why: on reading (A)'s outboard bearing
+/// near 8,600 rpm, during the threshold search (not at the equilibria, which settle in 13
+/// iterations from cold), the iteration ran 200 times without settling. The likely cause,
+/// not isolated: the discrete pressure zone ends at a grid node, so the march (E2–E3) jumps
+/// where the field moves the rupture across a node, and a fixed point at such a flip does not
+/// exist on the grid. The shrinking steps stop the field there, within the jump of either side;
+/// solves that settle in the free iterations are unchanged.
 fn relaxation(k: usize) -> f64 {
     RELAXATION * RELAXATION_DECAY.powi(k.saturating_sub(FREE_ITERATIONS) as i32)
 }
