@@ -49,6 +49,22 @@ pub struct ModesArgs {
     /// Write a drawing of the rotor model (shaft, discs, bearings, probes; to scale) to this SVG.
     #[arg(long)]
     rotor_plot: Option<PathBuf>,
+    /// Also the stability threshold with every film bearing's adiabatic thermal film (eq.
+    /// E1–E3 of src/film/thermal.rs): each speed's equilibrium and coefficients at its own
+    /// temperature field (the Campbell diagram stays isothermal).
+    #[arg(long, conflicts_with_all = ["fluid_inertia", "fluid_inertia_full"])]
+    thermal: bool,
+    /// Oil supply temperature (°C), with --thermal.
+    #[arg(long, default_value_t = 40.0, requires = "thermal")]
+    supply_temperature_c: f64,
+    /// Specific heat c_p of the oil (J/(kg·K)), with --thermal (default: MDM's, as `bearing
+    /// --thermal`).
+    #[arg(long, default_value_t = 1820.0, requires = "thermal")]
+    specific_heat_j_per_kg_k: f64,
+    /// Walther's law through two points °C:mm²/s, with --thermal (default: each bearing's
+    /// viscosity_temperature law of the machine file).
+    #[arg(long, requires = "thermal")]
+    viscosity_points: Option<String>,
 }
 
 /// Frequencies set apart as modes of a massless shaft's own mass (Hz).
@@ -93,6 +109,9 @@ struct ModesReport {
     /// viscosities were taken at (the threshold found at them, or the rated speed when stable).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     effective_temperatures: Vec<EffectiveTemperatureRow>,
+    /// With `--thermal`: the threshold with the adiabatic thermal film.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    thermal: Option<super::bearing_thermal::ThermalThresholdReport>,
 }
 
 /// One heated bearing in the `modes` report.
@@ -201,6 +220,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     }
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     check_outputs(args)?;
+    let oils = thermal_oils(args, &rotor)?;
     let statics = static_solution(&rotor).context("static deflection")?;
     let heated = heat_for_threshold(&mut rotor, &statics, (from, to, step), desc.rated_speed_rpm)
         .context("effective temperatures")?;
@@ -208,6 +228,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
     let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
     let threshold = threshold(args, &rotor, &statics, [from, to, step])?;
+    let thermal = thermal_report(&rotor, &statics, [from, to, step], oils, threshold)?;
     let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) =
         critical_speeds(&rotor, &statics, &points)
             .context("critical speeds")?
@@ -251,6 +272,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         campbell: points,
         mode_shapes: shapes,
         effective_temperatures: heated,
+        thermal,
     };
     write_campbell(args, &report)?;
     if args.json {
@@ -281,6 +303,46 @@ fn threshold(
         stability_threshold(rotor, statics, from, to, step)
     }
     .context("stability threshold")
+}
+
+/// With `--thermal`, each film bearing's oil (checked before anything is computed).
+fn thermal_oils(
+    args: &ModesArgs,
+    rotor: &Rotor,
+) -> anyhow::Result<Option<Vec<crate::film::ThermalOil>>> {
+    if !args.thermal {
+        return Ok(None);
+    }
+    anyhow::ensure!(
+        !rotor.has_oil_heating(),
+        "--thermal sets each film's viscosity from its own temperature field: the machine \
+         file's oil_heating (an effective temperature) cannot be used with it"
+    );
+    super::bearing_thermal::rotor_oils(
+        rotor,
+        args.viscosity_points.as_deref(),
+        args.specific_heat_j_per_kg_k,
+        args.supply_temperature_c,
+    )
+    .map(Some)
+}
+
+/// With `--thermal` (`oils`), the threshold with the thermal film over `[from, to, step]`
+/// (rpm) beside the isothermal `threshold`.
+fn thermal_report(
+    rotor: &Rotor,
+    statics: &crate::rotor::StaticSolution,
+    speeds: [f64; 3],
+    oils: Option<Vec<crate::film::ThermalOil>>,
+    threshold: Option<crate::rotor::Threshold>,
+) -> anyhow::Result<Option<super::bearing_thermal::ThermalThresholdReport>> {
+    let Some(oils) = oils else {
+        return Ok(None);
+    };
+    let rated_rpm = rad_s_to_rpm(rotor.rated_speed_rad_s);
+    let iso = threshold.map(|t| t.speed_rpm);
+    super::bearing_thermal::threshold_report(rotor, statics, speeds, &oils, iso, rated_rpm)
+        .map(Some)
 }
 
 /// The `--plot` Campbell diagram.
@@ -333,6 +395,9 @@ fn print_tables(r: &ModesReport) {
     print_criticals(r);
     if let Some(s) = &r.mode_shapes {
         print_shapes(s);
+    }
+    if let Some(t) = &r.thermal {
+        super::bearing_thermal::print_threshold(t);
     }
 }
 

@@ -14,6 +14,7 @@ mod modal;
 pub mod mode_tracking;
 mod oil_heating;
 mod statics;
+mod thermal_threshold;
 mod unbalance_response;
 mod zone_following;
 
@@ -39,6 +40,10 @@ pub use modal::{
 };
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};
+pub use thermal_threshold::{
+    effective_temperature_threshold, stability_threshold_thermal, thermal_equilibria,
+    ThermalBearing,
+};
 pub use unbalance_response::{
     influence_coefficients, journal_orbits, required_separation_margin_pct, response_peaks,
     response_stations, unbalance_response, ResponsePeak, Station, StationResponse,

@@ -512,6 +512,12 @@ impl BearingSolvers {
         )
     }
 
+    /// These film solvers, one per bearing in the rotor's order (None for a bearing without a
+    /// film): e.g. the thermal films of [`super::stability_threshold_thermal`].
+    pub(crate) fn from_films(films: Vec<Option<Box<dyn FilmModel + Send>>>) -> Self {
+        Self(films, None)
+    }
+
     /// These solvers, the convective inertia's slopes taken with the zone following the state
     /// (central differences, steps `step` × c and × c ω).
     pub(crate) fn following_zone(self, step: f64) -> Self {
@@ -714,7 +720,7 @@ pub fn stability_threshold_zone_following(
 }
 
 /// The threshold search over `[from, to, step]` (rpm) with these film solvers.
-fn threshold_with(
+pub(super) fn threshold_with(
     rotor: &Rotor,
     statics: &StaticSolution,
     [from_rpm, to_rpm, step_rpm]: [f64; 3],
