@@ -182,7 +182,11 @@ fn a_relock_re_references_the_phase_without_kicking_the_twin() {
     assert!(plain.refused.is_empty(), "{:?}", plain.refused);
     assert!(n >= 38 * 64, "{n} steps compared");
     assert!(worst < 1e-9, "journals {worst:e} m apart");
-    assert!((seed - 1.0).abs() < 0.01, "sub-synchronous × {seed}");
+    // the monitor's revolutions start at the mark, so a 90° move shifts its windows by a quarter
+    // revolution: on the default (B) at 8,500 rpm, whose 0.49X motion decays, that is × 0.986
+    // with the journals 3e-12 m apart (session 15; (A)'s growing motion read within 1 %); the
+    // kick this guards against read × 83
+    assert!((seed - 1.0).abs() < 0.03, "sub-synchronous × {seed}");
     assert!((shift + 90.0).abs() < 0.5, "lag moved by {shift}°");
 }
 
