@@ -52,7 +52,8 @@ fn node_talks_to_an_independent_peer_and_records() {
             && stations.iter().any(|s| s == "probe_pulley_end"),
         "{peer}"
     );
-    // the stability margin: the linear threshold of `rotor-twin modes` (8,471 rpm = 887.1 rad/s)
+    // the stability margin: the linear threshold of `rotor-twin modes` on the node's machine,
+    // reading (A), config/orc_microturbine_100kw_d55.yaml (8,471 rpm = 887.1 rad/s)
     let m = &peer["margin"];
     assert_eq!(m["threshold_found"], true, "{peer}");
     let threshold = m["threshold_speed"].as_f64().unwrap();
