@@ -102,6 +102,11 @@ pub struct DriverCounts {
     /// Probe samples refused because another source feeds their station (raw probes and a
     /// `ProbeDisplacement` topic for one station: [`StationSource`]).
     pub second_source_refused: u64,
+    /// Keyphasor relocks: the mark moved against the shaft and held (phases re-referenced).
+    pub relocks: u64,
+    /// Steady speed mismatches found between the keyphasor and the speed topic (each scales
+    /// the speed topic: [`Driver::speed_scale`]).
+    pub speed_mismatches: u64,
 }
 
 /// The latest accepted speed input.
@@ -396,10 +401,14 @@ impl Driver {
         } else {
             0
         };
-        let (w, a) = match self.gate.check(w, a, stamp_ns, now_ns) {
+        let (mut w, mut a) = match self.gate.check(w, a, stamp_ns, now_ns) {
             Ok(v) => v,
             Err(why) => return Fed::Refused(why),
         };
+        if let (false, Some(k)) = (from_keyphasor, self.signals.speed_scale) {
+            // the keyphasor found the topic off by a steady factor: the shaft's speed
+            (w, a) = (w * k, a * k);
+        }
         self.speed = Some(SpeedInput {
             speed_rad_s: w,
             accel_rad_s2: a,

@@ -84,6 +84,9 @@ pub struct SignalState {
     stop_warned: bool,
     /// The speed in force came from keyphasor intervals (no speed topic speaks).
     pub(super) speed_from_keyphasor: bool,
+    /// The factor a steady speed mismatch found between the shaft's speed (the keyphasor's)
+    /// and the speed topic's: every topic speed is scaled by it (None: none found).
+    pub(super) speed_scale: Option<f64>,
     /// The last keyphasor speed (rad/s) and when (ns), for its acceleration.
     last_kp_speed: Option<(f64, i64)>,
     stations: Vec<RawStation>,
@@ -278,8 +281,14 @@ impl Driver {
         if restart {
             self.session = None;
         }
+        if let Some(rho) = ev.speed_ratio {
+            self.scale_speed_topic(rho, now_ns, emit);
+        }
         match (ev.correction_rad, ev.relocked) {
-            (Some(c), true) => self.move_mark(c, now_ns, emit),
+            (Some(c), true) => {
+                self.counts.relocks += 1;
+                self.move_mark(c, now_ns, emit);
+            }
             (Some(c), false) => {
                 if let Some(s) = self.session.as_mut() {
                     s.shift_angle(c);
@@ -292,6 +301,42 @@ impl Driver {
             _ => Fed::Taken,
         };
         self.start_at_event(t, fed, emit)
+    }
+
+    /// The factor found between the shaft's speed (from the keyphasor) and the speed topic's
+    /// by a steady speed mismatch (None: none found); every speed topic value is scaled by it.
+    pub fn speed_scale(&self) -> Option<f64> {
+        self.signals.speed_scale
+    }
+
+    /// A steady speed mismatch: over the last revolutions the plant turned `rho` times as fast
+    /// as the twin. The speed topic is wrong (a tachometer's scale, a wrong pulses-per-turn
+    /// count), not the mark: from now on every topic speed is scaled so that the twin turns at
+    /// the keyphasor's speed, the speed in force at once; counted and warned about, with the
+    /// ratio. A later mismatch refines the factor (one near 1 says the topic agrees again).
+    fn scale_speed_topic(&mut self, rho: f64, now_ns: i64, emit: &mut impl FnMut(Outgoing)) {
+        let scale = self.signals.speed_scale.unwrap_or(1.0) * rho;
+        self.signals.speed_scale = Some(scale);
+        if let Some(s) = self.speed.as_mut() {
+            s.speed_rad_s *= rho;
+            s.accel_rad_s2 *= rho;
+        }
+        self.counts.speed_mismatches += 1;
+        let settings = self.signals.keyphasor.settings();
+        emit(input_warning(
+            now_ns,
+            WarningKind::BadInput,
+            format!(
+                "speed mismatch: over the last {} revolutions the keyphasor's shaft turned {rho:.5} times as fast as the twin at the speed topic (its phase drifting {:+.2}° a revolution, steadily: the speed is wrong, the mark did not move); the speed topic now scaled by {scale:.5}{}",
+                settings.mismatch_revs,
+                360.0 * (1.0 - 1.0 / rho),
+                if (scale - 1.0).abs() <= settings.speed_mismatch {
+                    " (it agrees with the keyphasor again)"
+                } else {
+                    ""
+                }
+            ),
+        ));
     }
 
     /// A relock (the lock moved to a new offset `c`, rad, after consecutive agreeing events):
