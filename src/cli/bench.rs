@@ -149,8 +149,7 @@ struct TwinFigures {
 fn orc_9000_rotor(args: &BenchArgs) -> anyhow::Result<crate::rotor::Rotor> {
     use crate::rotor::{MachineDescription, Rotor};
     let desc = MachineDescription::load(args.config.as_deref())?;
-    let mut rotor =
-        crate::transient::with_grid(&Rotor::from_description(&desc), Some(args.grid));
+    let mut rotor = crate::transient::with_grid(&Rotor::from_description(&desc), Some(args.grid));
     for b in &mut rotor.bearings {
         if let crate::rotor::BearingModel::Film(f) = &mut b.model {
             f.flow = args.flow;

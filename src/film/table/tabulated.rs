@@ -294,11 +294,24 @@ mod tests {
             }
         };
         let below = |x: f64| f64::from_bits(x.to_bits() - 1);
-        let mut angles = vec![0.0, -0.0, TAU, -TAU, below(TAU), -below(TAU), -1e-300, 1e-300];
+        let mut angles = vec![
+            0.0,
+            -0.0,
+            TAU,
+            -TAU,
+            below(TAU),
+            -below(TAU),
+            -1e-300,
+            1e-300,
+        ];
         angles.extend((-3000..=3000).map(|k| k as f64 * 0.00627 + 1e-7));
         for a in angles {
             let (got, want) = (wrap_angle_rad(a), reference(a));
-            assert_eq!(got.to_bits(), want.to_bits(), "angle {a:e}: {got} vs {want}");
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "angle {a:e}: {got} vs {want}"
+            );
             assert!((0.0..TAU).contains(&got), "angle {a:e}: {got}");
         }
     }
