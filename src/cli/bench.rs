@@ -48,6 +48,11 @@ pub struct BenchArgs {
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
+    /// ORC-9000 and factor: the machine description (YAML) instead of the built-in one (e.g.
+    /// reading (A) of the seed, `config/orc_microturbine_100kw_d55.yaml`, whose whip runs on
+    /// the wall), at the same 9,000 rpm and 128 steps a revolution.
+    #[arg(long)]
+    config: Option<std::path::PathBuf>,
     /// ORC-9000: measure exactly this many steps instead of `--seconds` (a fixed amount of work,
     /// e.g. for counting instructions under `valgrind --tool=callgrind`, which a loaded machine
     /// does not change).
@@ -121,6 +126,8 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
 #[derive(Debug, Serialize)]
 struct TwinFigures {
     workload: &'static str,
+    /// The machine description: `--config`'s path, or "built-in".
+    machine: String,
     phase: &'static str,
     steps: usize,
     time_step_us: f64,
@@ -138,24 +145,22 @@ struct TwinFigures {
     max_eccentricity_ratio: f64,
 }
 
-/// The built-in microturbine on the bench's film grid and flow regime.
-fn orc_9000_rotor(args: &BenchArgs) -> crate::rotor::Rotor {
+/// The microturbine (built-in, or `--config`) on the bench's film grid and flow regime.
+fn orc_9000_rotor(args: &BenchArgs) -> anyhow::Result<crate::rotor::Rotor> {
     use crate::rotor::{MachineDescription, Rotor};
-    let mut rotor = crate::transient::with_grid(
-        &Rotor::from_description(&MachineDescription::builtin_default()),
-        Some(args.grid),
-    );
+    let desc = MachineDescription::load(args.config.as_deref())?;
+    let mut rotor = crate::transient::with_grid(&Rotor::from_description(&desc), Some(args.grid));
     for b in &mut rotor.bearings {
         if let crate::rotor::BearingModel::Film(f) = &mut b.model {
             f.flow = args.flow;
         }
     }
-    rotor
+    Ok(rotor)
 }
 
 fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     use crate::dynamics::{Coupling, StepInput, Twin, TwinConfig};
-    let rotor = orc_9000_rotor(args);
+    let rotor = orc_9000_rotor(args)?;
     let omega = rpm_to_rad_s(9000.0);
     let config = TwinConfig {
         film: args.film.into(),
@@ -180,27 +185,13 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
             write_trace(&mut trace, out)?;
         }
     }
-    let budget = Duration::from_secs_f64(args.seconds);
-    let mut times = Vec::with_capacity(1 << 20);
-    let mut iterations = 0;
-    let (mut contact_steps, mut max_eps) = (0usize, 0.0_f64);
-    let start = Instant::now();
-    let t0 = twin.time_s();
-    while measure_more(args.steps, start, budget, times.len()) {
-        if ramp > 0.0 {
-            // at most 1.5× the start speed: the ramp stays below the twin's limit
-            let t = twin.time_s() - t0 + config.time_step_s;
-            input.speed_rad_s = (omega + ramp * t).min(1.5 * omega);
-            input.accel_rad_s2 = ramp;
-        }
-        let t = Instant::now();
-        let out = twin.step(&input)?;
-        times.push(t.elapsed().as_secs_f64() * 1e6);
-        iterations += out.newton_iterations;
-        contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
-        max_eps = (out.bearings.iter()).fold(max_eps, |m, b| m.max(b.eccentricity_ratio));
-        write_trace(&mut trace, out)?;
-    }
+    let window = measure_window(&mut twin, args, &mut input, ramp, &mut trace)?;
+    let Window {
+        mut times,
+        iterations,
+        contact_steps,
+        max_eps,
+    } = window;
     if let Some(w) = trace.as_mut() {
         std::io::Write::flush(w)?;
     }
@@ -211,6 +202,10 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
     let h_us = config.time_step_s * 1e6;
     let fig = TwinFigures {
         workload: "ORC-9000",
+        machine: args
+            .config
+            .as_ref()
+            .map_or("built-in".into(), |p| p.display().to_string()),
         phase: match (args.whip, ramp > 0.0) {
             (_, true) => "speed ramp from 9,000 rpm",
             (true, false) => "developed oil whip",
@@ -228,6 +223,54 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         max_eccentricity_ratio: max_eps,
     };
     print_twin_figures(args, &fig)
+}
+
+/// What the measured window of ORC-9000 gave: each step's time (µs), the Newton iterations,
+/// the steps in wall contact and the largest eccentricity ratio.
+struct Window {
+    times: Vec<f64>,
+    iterations: usize,
+    contact_steps: usize,
+    max_eps: f64,
+}
+
+/// The measured steps of ORC-9000 (`--steps`, else `--seconds`), in a function of their own
+/// (never inlined) so that a count of instructions can be limited to them:
+/// `valgrind --tool=callgrind --collect-atstart=no '--toggle-collect=*bench::measure_window*'`.
+#[inline(never)]
+fn measure_window(
+    twin: &mut crate::dynamics::Twin,
+    args: &BenchArgs,
+    input: &mut crate::dynamics::StepInput,
+    ramp: f64,
+    trace: &mut Option<std::io::BufWriter<std::fs::File>>,
+) -> anyhow::Result<Window> {
+    let budget = Duration::from_secs_f64(args.seconds);
+    let (omega, h) = (input.speed_rad_s, twin.config().time_step_s);
+    let mut w = Window {
+        times: Vec::with_capacity(1 << 20),
+        iterations: 0,
+        contact_steps: 0,
+        max_eps: 0.0,
+    };
+    let start = Instant::now();
+    let t0 = twin.time_s();
+    while measure_more(args.steps, start, budget, w.times.len()) {
+        if ramp > 0.0 {
+            // at most 1.5× the start speed: the ramp stays below the twin's limit
+            let t = twin.time_s() - t0 + h;
+            input.speed_rad_s = (omega + ramp * t).min(1.5 * omega);
+            input.accel_rad_s2 = ramp;
+        }
+        let t = Instant::now();
+        let out = twin.step(input)?;
+        w.times.push(t.elapsed().as_secs_f64() * 1e6);
+        w.iterations += out.newton_iterations;
+        w.contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
+        w.max_eps = (out.bearings.iter()).fold(w.max_eps, |m, b| m.max(b.eccentricity_ratio));
+        write_trace(trace, out)?;
+    }
+    Ok(w)
 }
 
 /// ORC-9000's `--steps`, if given: 1 to 2²⁴ measured steps.
@@ -251,7 +294,7 @@ fn print_twin_figures(args: &BenchArgs, fig: &TwinFigures) -> anyhow::Result<()>
     if args.json {
         outln!("{}", serde_json::to_string_pretty(fig)?);
     } else {
-        outln!("ORC-9000 ({}): microturbine at 9,000 rpm, 30 elements, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, args.grid.n_theta, args.grid.n_z, args.film);
+        outln!("ORC-9000 ({}): microturbine ({}) at 9,000 rpm, film {}x{} ({:?}), 128 steps/rev, nonlinear", fig.phase, fig.machine, args.grid.n_theta, args.grid.n_z, args.film);
         outln!(
             "  {} steps: median {:.1} µs, p99 {:.1} µs, max {:.1} µs, mean {:.1} µs per step of {:.1} µs → real-time factor {:.3}; {:.2} Newton iterations a step; largest ε {:.3}, {:.1} % of the steps in wall contact",
             fig.steps, fig.median_step_us, fig.p99_step_us, fig.max_step_us, fig.mean_step_us, fig.time_step_us, fig.real_time_factor, fig.newton_iterations_per_step,
@@ -430,7 +473,7 @@ fn measure(
 fn factor_cases(args: &BenchArgs) -> anyhow::Result<Vec<CaseFigures>> {
     use crate::dynamics::{Coupling, Twin, TwinConfig};
     use crate::rotor::{MachineDescription, Rotor};
-    let rotor = Rotor::from_description(&MachineDescription::builtin_default());
+    let rotor = Rotor::from_description(&MachineDescription::load(args.config.as_deref())?);
     let omega = rpm_to_rad_s(9000.0);
     let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128);
     let mut twin = Twin::new(&rotor, config, omega)?;

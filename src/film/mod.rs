@@ -207,8 +207,19 @@ pub trait FilmModel {
 
 /// Wraps an angle (rad) to [0, 2π).
 pub fn wrap_angle_rad(angle: f64) -> f64 {
-    let a = angle.rem_euclid(std::f64::consts::TAU);
-    if a >= std::f64::consts::TAU {
+    use std::f64::consts::TAU;
+    // within a turn (atan2's angles and their sums: the film's every call) the remainder is the
+    // angle itself (fmod is exact): rem_euclid without its library call, the same result
+    let a = if angle.abs() < TAU {
+        if angle < 0.0 {
+            angle + TAU
+        } else {
+            angle
+        }
+    } else {
+        angle.rem_euclid(TAU)
+    };
+    if a >= TAU {
         0.0
     } else {
         a

@@ -279,6 +279,43 @@ mod tests {
         }
     }
 
+    /// `wrap_angle_rad`'s path within a turn (no library remainder) gives, bit for bit, what
+    /// the Euclidean remainder gives (the reference: `f64::rem_euclid`, then 2π → 0), for
+    /// angles across ±3 turns and at the edges (±0, ±2π and the doubles next to them, a
+    /// negative angle so small that adding 2π rounds to 2π).
+    #[test]
+    fn angle_wrap_is_the_euclidean_remainder() {
+        let reference = |a: f64| {
+            let r = a.rem_euclid(TAU);
+            if r >= TAU {
+                0.0
+            } else {
+                r
+            }
+        };
+        let below = |x: f64| f64::from_bits(x.to_bits() - 1);
+        let mut angles = vec![
+            0.0,
+            -0.0,
+            TAU,
+            -TAU,
+            below(TAU),
+            -below(TAU),
+            -1e-300,
+            1e-300,
+        ];
+        angles.extend((-3000..=3000).map(|k| k as f64 * 0.00627 + 1e-7));
+        for a in angles {
+            let (got, want) = (wrap_angle_rad(a), reference(a));
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "angle {a:e}: {got} vs {want}"
+            );
+            assert!((0.0..TAU).contains(&got), "angle {a:e}: {got}");
+        }
+    }
+
     /// The profile's column wrap is the Euclidean remainder for every column within three turns
     /// either way (the reference: `i64::rem_euclid`), for grids of one to 61 columns.
     #[test]
