@@ -1,7 +1,8 @@
 //! The seed's two readings with the film's own inertia (issue 11; README "Two readings of the
-//! seed"): (A) the built-in Ø55 rotor (a threshold crossing) and (B) the Ø63, 56 kg rotor of
-//! config/orc_microturbine_100kw.yaml (linear-stable, whipping in a half-speed window without
-//! film inertia). With `fluid_inertia: full` (Re* = 1.7 at 9,000 rpm; eq. I1 of
+//! seed"): (A) the Ø55 rotor of config/orc_microturbine_100kw_d55.yaml (a threshold crossing; the
+//! built-in default until session 15) and (B) the Ø63, 56 kg rotor of
+//! config/orc_microturbine_100kw.yaml, the built-in default since session 15 (linear-stable,
+//! whipping in a half-speed window without film inertia). With `fluid_inertia: full` (Re* = 1.7 at 9,000 rpm; eq. I1 of
 //! `src/film/inertia.rs`) the two trade places at the seed's 9,000 rpm: (A) whips from a quiet
 //! start, later, and (B) settles.
 
@@ -75,8 +76,14 @@ fn subsync_growth(run: &TransientResult, from: usize, to: usize) -> f64 {
 ///   it, so the test fails if `full` does nothing.
 #[test]
 fn with_full_film_inertia_the_shipped_rotor_whips_at_9000_and_the_d63_one_settles() {
-    let a = at_9000(&rotor(None, FluidInertia::Full), 1250);
-    let d63 = Some("config/orc_microturbine_100kw.yaml");
+    let a = at_9000(
+        &rotor(
+            Some("config/orc_microturbine_100kw_d55.yaml"),
+            FluidInertia::Full,
+        ),
+        1250,
+    );
+    let d63 = None; // the built-in machine, reading (B)
     let b = at_9000(&rotor(d63, FluidInertia::Full), 400);
     let b_bare = at_9000(&rotor(d63, FluidInertia::None), 400);
     let (ga, gb) = (subsync_growth(&a, 100, 500), subsync_growth(&b, 100, 300));
