@@ -553,6 +553,11 @@ fn zone_following_threshold_is_the_transients_own() {
         .speed_rpm;
     let (ok, out, err) = common::run_cli(&[
         "modes",
+        "--config",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/config/orc_microturbine_100kw_d55.yaml"
+        ),
         "--fluid-inertia-full",
         "--zone-following",
         "--from-rpm",
