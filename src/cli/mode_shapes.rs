@@ -56,11 +56,12 @@ pub(crate) struct ModeShapes {
 }
 
 /// The `n_modes` lowest damped modes at `speed_rpm`, the film bearings linearised at their
-/// static equilibrium under `statics` (as in the Campbell diagram).
+/// static equilibrium under `statics` (as in the Campbell diagram; with `follow`, a step, on the
+/// tabulated film with the zone-following slopes, as the diagram of `--zone-following`).
 pub(crate) fn mode_shapes(
     rotor: &Rotor,
     statics: &StaticSolution,
-    speed_rpm: f64,
+    (speed_rpm, follow): (f64, Option<f64>),
     n_modes: usize,
 ) -> anyhow::Result<ModeShapes> {
     anyhow::ensure!(
@@ -76,7 +77,10 @@ pub(crate) fn mode_shapes(
         omega > 0.0 || !has_film,
         "invalid --shapes-rpm 0: a film bearing carries no static load at rest; give a speed above zero"
     );
-    let mut solvers = crate::rotor::BearingSolvers::new(rotor);
+    let mut solvers = match follow {
+        Some(step) => crate::rotor::BearingSolvers::tabulated(rotor)?.following_zone(step),
+        None => crate::rotor::BearingSolvers::new(rotor),
+    };
     let (coefs, eps) = solvers.at_speed(rotor, &statics.bearing_loads_n, omega)?;
     let shapes = damped_mode_shapes(rotor, omega, &coefs)?;
     let modes = shapes

@@ -25,20 +25,9 @@ pub struct ModesArgs {
     /// Write the Campbell diagram to this SVG file.
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Give every film bearing its film's temporal fluid inertia (added mass, weightless),
-    /// whatever the machine file's `fluid_inertia` says.
-    #[arg(long)]
-    fluid_inertia: bool,
-    /// As --fluid-inertia, plus the convective inertia of the rotating film as stiffness and
-    /// damping (`fluid_inertia: full`).
-    #[arg(long, conflicts_with = "fluid_inertia")]
-    fluid_inertia_full: bool,
-    /// With --fluid-inertia-full: the stability threshold on the tabulated film with the
-    /// convective inertia's slopes taken with the pressure zone and κ following the journal,
-    /// as the nonlinear transient has them (its own threshold; the Campbell diagram keeps the
-    /// held slopes).
-    #[arg(long, requires = "fluid_inertia_full")]
-    zone_following: bool,
+    /// The film's inertia.
+    #[command(flatten)]
+    inertia: FilmInertiaArgs,
     /// Damped mode shapes at this speed (rpm): each node's orbit and the deflected line of the
     /// lowest --modes modes (at most 6 drawn).
     #[arg(long)]
@@ -65,6 +54,73 @@ pub struct ModesArgs {
     /// viscosity_temperature law of the machine file).
     #[arg(long, requires = "thermal")]
     viscosity_points: Option<String>,
+}
+
+/// The film's inertia options of `modes` and `response` (one model for the Campbell diagram,
+/// the threshold, the critical speeds and the unbalance response).
+#[derive(Debug, Clone, Args)]
+pub(crate) struct FilmInertiaArgs {
+    /// Give every film bearing its film's temporal fluid inertia (added mass, weightless),
+    /// whatever the machine file's `fluid_inertia` says.
+    #[arg(long)]
+    fluid_inertia: bool,
+    /// As --fluid-inertia, plus the convective inertia of the rotating film as stiffness and
+    /// damping (`fluid_inertia: full`).
+    #[arg(long, conflicts_with = "fluid_inertia")]
+    fluid_inertia_full: bool,
+    /// With the convective inertia (--fluid-inertia-full or `fluid_inertia: full` in the
+    /// machine file): the tabulated film, the convective inertia's slopes taken with the
+    /// pressure zone and κ following the journal, as the nonlinear transient has them, for
+    /// every linear result (threshold, Campbell diagram, critical speeds, response).
+    #[arg(long, conflicts_with = "fluid_inertia")]
+    zone_following: bool,
+}
+
+/// [`FilmInertiaArgs::model`] of the inertialess film (the plots' titles leave it out).
+pub(crate) const NO_FILM_INERTIA: &str = "no film inertia";
+
+impl FilmInertiaArgs {
+    /// Sets the film's inertia of `rotor` as asked; the zone-following step (share of the
+    /// clearance) with --zone-following, refused when no film bearing carries the convective
+    /// inertia (nothing would follow).
+    pub(crate) fn apply(&self, rotor: &mut Rotor) -> anyhow::Result<Option<f64>> {
+        if self.fluid_inertia {
+            rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
+        }
+        if self.fluid_inertia_full {
+            rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
+        }
+        if !self.zone_following {
+            return Ok(None);
+        }
+        let convective = rotor.bearings.iter().any(|b| {
+            matches!(&b.model, crate::rotor::BearingModel::Film(f)
+                if f.inertia.is_some_and(|i| i.convective))
+        });
+        anyhow::ensure!(
+            convective,
+            "--zone-following takes the convective film inertia's slopes, and no film bearing \
+             carries it: add --fluid-inertia-full or `fluid_inertia: full` in the machine file"
+        );
+        Ok(Some(crate::rotor::ZONE_FOLLOWING_STEP))
+    }
+
+    /// The linear model's film, as the reports name it.
+    pub(crate) fn model(rotor: &Rotor, follow: Option<f64>) -> String {
+        let choice = rotor.bearings.iter().find_map(|b| match &b.model {
+            crate::rotor::BearingModel::Film(f) => Some(f.inertia.map(|i| i.convective)),
+            _ => None,
+        });
+        match (choice.flatten(), follow) {
+            (None, _) => NO_FILM_INERTIA.into(),
+            (Some(false), _) => "film inertia temporal (added mass)".into(),
+            (Some(true), None) => "film inertia full, zone and κ held".into(),
+            (Some(true), Some(s)) => format!(
+                "film inertia full, zone and κ following (film table, steps {} % c)",
+                s * 100.0
+            ),
+        }
+    }
 }
 
 /// Frequencies set apart as modes of a massless shaft's own mass (Hz).
@@ -101,6 +157,8 @@ struct ModesReport {
     threshold_speed_rpm: Option<f64>,
     whirl_ratio_at_threshold: Option<f64>,
     threshold_frequency_hz: Option<f64>,
+    /// The film's inertia of the linearisation (Campbell diagram, threshold, critical speeds).
+    film_inertia: String,
     campbell: Vec<CampbellPoint>,
     /// The damped mode shapes at `--shapes-rpm` (absent without it).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -212,12 +270,7 @@ fn check_outputs(args: &ModesArgs) -> anyhow::Result<()> {
 pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
     let desc = args.range.machine()?;
     let mut rotor = Rotor::from_description(&desc);
-    if args.fluid_inertia {
-        rotor.set_fluid_inertia(crate::film::FluidInertia::Temporal);
-    }
-    if args.fluid_inertia_full {
-        rotor.set_fluid_inertia(crate::film::FluidInertia::Full);
-    }
+    let follow = args.inertia.apply(&mut rotor)?;
     let (speeds, from, to, step) = speed_range(args, desc.rated_speed_rpm)?;
     check_outputs(args)?;
     let oils = thermal_oils(args, &rotor)?;
@@ -226,17 +279,24 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         .context("effective temperatures")?;
     let free_free = natural_frequencies(&rotor, Constraint::FreeFree)?;
     let pinned = natural_frequencies(&rotor, Constraint::Pinned)?;
-    let points = campbell(&rotor, &statics, &speeds, args.modes).context("Campbell diagram")?;
-    let threshold = threshold(args, &rotor, &statics, [from, to, step])?;
+    let points = match follow {
+        Some(s) => crate::rotor::campbell_zone_following(&rotor, &statics, &speeds, args.modes, s),
+        None => campbell(&rotor, &statics, &speeds, args.modes),
+    }
+    .context("Campbell diagram")?;
+    let threshold = threshold(follow, &rotor, &statics, [from, to, step])?;
     let thermal = thermal_report(&rotor, &statics, [from, to, step], oils, threshold)?;
-    let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) =
-        critical_speeds(&rotor, &statics, &points)
-            .context("critical speeds")?
-            .into_iter()
-            .partition(|c| c.critical);
+    let crossings = match follow {
+        Some(s) => crate::rotor::critical_speeds_zone_following(&rotor, &statics, &points, s),
+        None => critical_speeds(&rotor, &statics, &points),
+    };
+    let (criticals, damped): (Vec<CriticalSpeed>, Vec<CriticalSpeed>) = crossings
+        .context("critical speeds")?
+        .into_iter()
+        .partition(|c| c.critical);
     let shapes = args
         .shapes_rpm
-        .map(|rpm| super::mode_shapes::mode_shapes(&rotor, &statics, rpm, args.modes))
+        .map(|rpm| super::mode_shapes::mode_shapes(&rotor, &statics, (rpm, follow), args.modes))
         .transpose()
         .context("mode shapes")?;
     write_shape_plots(args, &rotor, shapes.as_ref())?;
@@ -269,6 +329,7 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
         threshold_speed_rpm: threshold.map(|t| t.speed_rpm),
         whirl_ratio_at_threshold: threshold.map(|t| t.whirl_ratio),
         threshold_frequency_hz: threshold.map(|t| t.frequency_hz),
+        film_inertia: FilmInertiaArgs::model(&rotor, follow),
         campbell: points,
         mode_shapes: shapes,
         effective_temperatures: heated,
@@ -287,20 +348,16 @@ pub(crate) fn run(args: &ModesArgs) -> anyhow::Result<()> {
 /// The stability threshold over `[from, to, step]` (rpm): the held linearisation, or with
 /// `--zone-following` the tabulated film's with the zone-following slopes.
 fn threshold(
-    args: &ModesArgs,
+    follow: Option<f64>,
     rotor: &Rotor,
     statics: &crate::rotor::StaticSolution,
     [from, to, step]: [f64; 3],
 ) -> anyhow::Result<Option<crate::rotor::Threshold>> {
-    if args.zone_following {
-        crate::rotor::stability_threshold_zone_following(
-            rotor,
-            statics,
-            [from, to, step],
-            crate::rotor::ZONE_FOLLOWING_STEP,
-        )
-    } else {
-        stability_threshold(rotor, statics, from, to, step)
+    match follow {
+        Some(s) => {
+            crate::rotor::stability_threshold_zone_following(rotor, statics, [from, to, step], s)
+        }
+        None => stability_threshold(rotor, statics, from, to, step),
     }
     .context("stability threshold")
 }
@@ -350,7 +407,10 @@ fn write_campbell(args: &ModesArgs, report: &ModesReport) -> anyhow::Result<()> 
     if let Some(path) = &args.plot {
         crate::plot::campbell_svg(
             path,
-            &format!("Campbell diagram: {}", report.machine),
+            &match report.film_inertia.as_str() {
+                NO_FILM_INERTIA => format!("Campbell diagram: {}", report.machine),
+                model => format!("Campbell diagram: {} — {model}", report.machine),
+            },
             &report.campbell,
             report.threshold_speed_rpm,
             &report.critical_speeds,
@@ -495,7 +555,10 @@ fn print_frequencies(r: &ModesReport) {
 
 /// The Campbell diagram as a table.
 fn print_campbell(r: &ModesReport) {
-    println!("  Campbell diagram (film bearings linearised at their static equilibrium):");
+    println!(
+        "  Campbell diagram (film bearings linearised at their static equilibrium; {}):",
+        r.film_inertia
+    );
     println!(
         "    {:>8}  modes: frequency Hz / log dec / F(orward) B(ackward) and mode id (followed by shape)",
         "rpm"

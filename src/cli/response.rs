@@ -2,8 +2,8 @@
 //! plots at the bearings and probe stations, peaks, amplification factors, separation margins.
 
 use crate::rotor::{
-    response_peaks, static_solution, unbalance_response, ResponsePeak, Rotor, Station,
-    StationResponse,
+    response_peaks, static_solution, unbalance_response, unbalance_response_zone_following,
+    ResponsePeak, Rotor, Station, StationResponse,
 };
 use anyhow::Context;
 use clap::Args;
@@ -28,6 +28,9 @@ pub struct ResponseArgs {
     /// Write the Bode plot to PREFIX_bode.svg and the polar plot to PREFIX_polar.svg.
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// The film's inertia (as `modes`).
+    #[command(flatten)]
+    inertia: super::modes::FilmInertiaArgs,
 }
 
 /// One station of the report.
@@ -43,6 +46,9 @@ struct StationReport {
 #[derive(Debug, Serialize)]
 struct ResponseReport {
     machine: String,
+    /// The film's inertia of the linearisation (added mass in the mass matrix; with `full` the
+    /// convective inertia's stiffness and damping, zone held or following).
+    film_inertia: String,
     /// Unbalances applied: node, m·e (g·mm), heavy-spot angle (deg).
     unbalance_g_mm: Vec<(usize, f64, f64)>,
     min_operating_rpm: f64,
@@ -83,7 +89,8 @@ fn operating_range(args: &ResponseArgs, rated: f64) -> anyhow::Result<(f64, f64)
 
 pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
     let desc = args.range.machine()?;
-    let rotor = Rotor::from_description(&desc);
+    let mut rotor = Rotor::from_description(&desc);
+    let follow = args.inertia.apply(&mut rotor)?;
     let rated = desc.rated_speed_rpm;
     let speeds = speed_grid(args, rated)?;
     let (n_min, n_max) = operating_range(args, rated)?;
@@ -92,7 +99,11 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
         "the machine has no unbalance: add one under `unbalance:` in the machine file"
     );
     let statics = static_solution(&rotor).context("static deflection")?;
-    let r = unbalance_response(&rotor, &statics, &speeds).context("unbalance response")?;
+    let r = match follow {
+        Some(step) => unbalance_response_zone_following(&rotor, &statics, &speeds, step),
+        None => unbalance_response(&rotor, &statics, &speeds),
+    }
+    .context("unbalance response")?;
     let stations = r
         .stations
         .iter()
@@ -108,6 +119,7 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
         .collect();
     let report = ResponseReport {
         machine: desc.name.clone(),
+        film_inertia: super::modes::FilmInertiaArgs::model(&rotor, follow),
         unbalance_g_mm: desc
             .unbalance
             .iter()
@@ -118,6 +130,17 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
         speeds_rpm: speeds,
         stations,
     };
+    write_plots(args, &report)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_tables(&report);
+    }
+    Ok(())
+}
+
+/// The `--plot PREFIX` Bode and polar plots.
+fn write_plots(args: &ResponseArgs, report: &ResponseReport) -> anyhow::Result<()> {
     if let Some(prefix) = &args.plot {
         let with = |suffix: &str| plot_path(prefix, suffix);
         let curves: Vec<crate::plot::ResponseCurve> = report
@@ -130,11 +153,14 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
             })
             .collect();
         for (path, bode) in [(with("_bode.svg"), true), (with("_polar.svg"), false)] {
-            let title = format!(
+            let mut title = format!(
                 "Unbalance response ({}): {}",
                 if bode { "Bode" } else { "polar, x" },
                 report.machine
             );
+            if report.film_inertia != super::modes::NO_FILM_INERTIA {
+                title.push_str(&format!(" — {}", report.film_inertia));
+            }
             let written = if bode {
                 crate::plot::bode_svg(&path, &title, &report.speeds_rpm, &curves)
             } else {
@@ -143,18 +169,13 @@ pub(crate) fn run(args: &ResponseArgs) -> anyhow::Result<()> {
             written.with_context(|| format!("writing {}", path.display()))?;
         }
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print_tables(&report);
-    }
     Ok(())
 }
 
 fn print_tables(r: &ResponseReport) {
     println!(
-        "rotor-twin response: {} (linear model, film bearings linearised at each speed)",
-        r.machine
+        "rotor-twin response: {} (linear model, film bearings linearised at each speed; {})",
+        r.machine, r.film_inertia
     );
     for (node, me, deg) in &r.unbalance_g_mm {
         println!("  unbalance {me:.1} g·mm at node {node}, {deg:.0}°");

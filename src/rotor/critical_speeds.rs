@@ -54,7 +54,29 @@ pub fn critical_speeds(
     statics: &StaticSolution,
     points: &[CampbellPoint],
 ) -> Result<Vec<CriticalSpeed>, RotorError> {
-    let mut follower = Follower::new(rotor, statics);
+    critical_speeds_with(rotor, statics, points, BearingSolvers::new(rotor))
+}
+
+/// [`critical_speeds`] of a diagram of [`super::campbell_zone_following`]: located with the same
+/// tabulated film and zone-following slopes (steps `step` × c and × c ω).
+pub fn critical_speeds_zone_following(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    points: &[CampbellPoint],
+    step: f64,
+) -> Result<Vec<CriticalSpeed>, RotorError> {
+    let solvers = BearingSolvers::tabulated(rotor)?.following_zone(step);
+    critical_speeds_with(rotor, statics, points, solvers)
+}
+
+/// The crossings located with these film solvers.
+fn critical_speeds_with(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    points: &[CampbellPoint],
+    solvers: BearingSolvers,
+) -> Result<Vec<CriticalSpeed>, RotorError> {
+    let mut follower = Follower::new(rotor, statics, solvers);
     let mut out: Vec<(CriticalSpeed, f64)> = Vec::new();
     for (w, id) in brackets(points) {
         if let Some(found) = follower.locate(&w, id)? {
@@ -122,11 +144,11 @@ struct Follower<'a> {
 type Sample = (f64, f64, ModeShape);
 
 impl<'a> Follower<'a> {
-    fn new(rotor: &'a Rotor, statics: &'a StaticSolution) -> Self {
+    fn new(rotor: &'a Rotor, statics: &'a StaticSolution, solvers: BearingSolvers) -> Self {
         Self {
             rotor,
             statics,
-            solvers: BearingSolvers::new(rotor),
+            solvers,
             n_nodes: rotor.n_nodes(),
             ell2: tilt_weight_m2(rotor),
         }

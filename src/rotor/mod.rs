@@ -18,7 +18,10 @@ mod thermal_threshold;
 mod unbalance_response;
 mod zone_following;
 
-pub use critical_speeds::{critical_speeds, CriticalSpeed, API_684_MIN_AMPLIFICATION_FACTOR};
+pub use critical_speeds::{
+    critical_speeds, critical_speeds_zone_following, CriticalSpeed,
+    API_684_MIN_AMPLIFICATION_FACTOR,
+};
 pub use element::{Disc, ElementMatrix, Material, ShaftElement};
 pub use error::{ConfigError, RotorError};
 pub use forces::unbalance_force;
@@ -33,10 +36,10 @@ pub use machine::{
 };
 pub(crate) use modal::BearingSolvers;
 pub use modal::{
-    campbell, damped_mode_shapes, damped_modes, natural_frequencies, stability_threshold,
-    stability_threshold_tabulated, stability_threshold_zone_following, undamped_frequencies_hz,
-    BearingCoefficientSet, CampbellPoint, Constraint, Mode, ModeShape, NaturalFrequencies,
-    Threshold, WhirlDirection,
+    campbell, campbell_zone_following, damped_mode_shapes, damped_modes, natural_frequencies,
+    stability_threshold, stability_threshold_tabulated, stability_threshold_zone_following,
+    undamped_frequencies_hz, BearingCoefficientSet, CampbellPoint, Constraint, Mode, ModeShape,
+    NaturalFrequencies, Threshold, WhirlDirection,
 };
 pub use oil_heating::BearingTemperature;
 pub use statics::{static_solution, StaticSolution};
@@ -46,8 +49,8 @@ pub use thermal_threshold::{
 };
 pub use unbalance_response::{
     influence_coefficients, journal_orbits, required_separation_margin_pct, response_peaks,
-    response_stations, unbalance_response, ResponsePeak, Station, StationResponse,
-    UnbalanceResponse,
+    response_stations, unbalance_response, unbalance_response_zone_following, ResponsePeak,
+    Station, StationResponse, UnbalanceResponse,
 };
 pub use zone_following::{following_minus_held, ZONE_FOLLOWING_STEP};
 

@@ -615,7 +615,39 @@ pub fn campbell(
     speeds_rpm: &[f64],
     n_modes: usize,
 ) -> Result<Vec<CampbellPoint>, RotorError> {
-    let mut solvers = BearingSolvers::new(rotor);
+    campbell_with(
+        rotor,
+        statics,
+        speeds_rpm,
+        n_modes,
+        BearingSolvers::new(rotor),
+    )
+}
+
+/// [`campbell`] on every film bearing's tabulated film with the convective inertia's slopes of
+/// `fluid_inertia: full` taken with the pressure zone and κ following the state
+/// ([`super::zone_following`], steps `step` × c and × c ω): the eigenvalues whose threshold is
+/// [`stability_threshold_zone_following`]'s (one linearisation for the diagram and the
+/// threshold). Without the convective inertia the tabulated film's held diagram.
+pub fn campbell_zone_following(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: &[f64],
+    n_modes: usize,
+    step: f64,
+) -> Result<Vec<CampbellPoint>, RotorError> {
+    let solvers = BearingSolvers::tabulated(rotor)?.following_zone(step);
+    campbell_with(rotor, statics, speeds_rpm, n_modes, solvers)
+}
+
+/// The Campbell diagram with these film solvers.
+fn campbell_with(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: &[f64],
+    n_modes: usize,
+    mut solvers: BearingSolvers,
+) -> Result<Vec<CampbellPoint>, RotorError> {
     let (n_nodes, ell2) = (rotor.n_nodes(), tilt_weight_m2(rotor));
     // a few modes more than shown are followed, so that a mode entering from above keeps its id
     let followed = n_modes + 4;

@@ -98,6 +98,31 @@ pub fn unbalance_response(
     statics: &StaticSolution,
     speeds_rpm: &[f64],
 ) -> Result<UnbalanceResponse, RotorError> {
+    response_with(rotor, statics, speeds_rpm, BearingSolvers::new(rotor))
+}
+
+/// [`unbalance_response`] on every film bearing's tabulated film with the convective inertia's
+/// slopes of `fluid_inertia: full` taken with the pressure zone and κ following the state
+/// (steps `step` × c and × c ω; [`super::ZONE_FOLLOWING_STEP`]), as
+/// [`super::stability_threshold_zone_following`] takes them: the linearisation of the
+/// transient on the table. The added mass is the same as [`unbalance_response`]'s.
+pub fn unbalance_response_zone_following(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: &[f64],
+    step: f64,
+) -> Result<UnbalanceResponse, RotorError> {
+    let solvers = BearingSolvers::tabulated(rotor)?.following_zone(step);
+    response_with(rotor, statics, speeds_rpm, solvers)
+}
+
+/// The unbalance response with these film solvers.
+fn response_with(
+    rotor: &Rotor,
+    statics: &StaticSolution,
+    speeds_rpm: &[f64],
+    mut solvers: BearingSolvers,
+) -> Result<UnbalanceResponse, RotorError> {
     if let Some(&bad) = speeds_rpm.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
         return Err(RotorError::InvalidInput {
             name: "unbalance-response speed (rpm)",
@@ -106,7 +131,6 @@ pub fn unbalance_response(
         });
     }
     let stations = response_stations(rotor);
-    let mut solvers = BearingSolvers::new(rotor);
     let mut response = vec![Vec::with_capacity(speeds_rpm.len()); stations.len()];
     for &rpm in speeds_rpm {
         let omega = rpm_to_rad_s(rpm);
