@@ -16,8 +16,15 @@ use common::run_cli;
 #[test]
 fn linear_orbit_beyond_the_clearance_is_flagged() {
     let csv = std::env::temp_dir().join(format!("rotor-twin-linear-{}.csv", std::process::id()));
+    // reading (A) (Ø55): its linear model is unstable at 9,000 rpm (threshold 8,471); the built-in
+    // reading (B) is linear-stable there
     let (ok, out, err) = run_cli(&[
         "simulate",
+        "--config",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/config/orc_microturbine_100kw_d55.yaml"
+        ),
         "--speed-rpm",
         "9000",
         "--model",
