@@ -693,7 +693,9 @@ fn a_rated_speed_no_shaft_survives_is_refused() {
         "rated_speed_rpm: 1e9",
     ));
     assert!(
-        e.contains("rated_speed_rpm = 1000000000") && e.contains("at most 151576 rpm") && e.contains("0.063 m"),
+        e.contains("rated_speed_rpm = 1000000000")
+            && e.contains("at most 151576 rpm")
+            && e.contains("0.063 m"),
         "{e}"
     );
     MachineDescription::from_yaml(

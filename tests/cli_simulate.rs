@@ -170,7 +170,10 @@ fn a_kick_below_the_threshold_starts_a_lasting_whip() {
         let mut args = vec![
             "simulate",
             "--config",
-            concat!(env!("CARGO_MANIFEST_DIR"), "/config/orc_microturbine_100kw_d55.yaml"),
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/config/orc_microturbine_100kw_d55.yaml"
+            ),
             "--speed-rpm",
             "8000",
             "--revs",

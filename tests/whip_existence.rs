@@ -191,7 +191,10 @@ fn the_default_machines_whip_persists_down_to_8650_rpm_and_is_gone_at_8500() {
         .iter()
         .find(|r| r.0 > 400 && r.3 < 10e-6)
         .map_or(f64::NAN, |r| r.1);
-    let held: Vec<_> = rows.iter().filter(|r| r.0 >= 450 && r.1 >= 8650.0).collect();
+    let held: Vec<_> = rows
+        .iter()
+        .filter(|r| r.0 >= 450 && r.1 >= 8650.0)
+        .collect();
     let weakest = held.iter().map(|r| r.3).fold(f64::INFINITY, f64::min);
     println!(
         "(B) run-down: weakest whip at ≥ 8,650 rpm {:.2} µm over {} revolutions, collapse below \
