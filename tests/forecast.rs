@@ -126,7 +126,7 @@ fn the_forecast_announces_the_whip_more_than_a_second_ahead_on_the_sample_bag() 
     assert_eq!(f["whip"]["false_announcements"], 0);
     // the forecasts are at bag time every 0.5 s from the twin's start
     let n = f["forecasts"].as_array().unwrap().len();
-    assert_eq!(n, 16, "forecasts in the 8 s bag");
+    assert_eq!(n, 32, "forecasts in the 15.5 s bag");
 }
 
 /// A stable recording: 3 s at 8,000 rpm from a plant (5 % more viscous oil, its unbalance

@@ -8,11 +8,14 @@
 //! 0, and its probe pairs (DC: the static position included) get 0.3 µm of noise; the driver
 //! (linear twin) is fed the speed, the keyphasor and the probes in time order, as the node feeds
 //! it. Targets (the issue's): viscosity within 3 %, unbalance within 10 % and 10°; after the
-//! estimate is applied the predicted 1X within 5 % and 5° of the measured at 8,000 rpm.
+//! estimate is applied the predicted 1X within 5 % and 5° of the measured at 8,000 rpm (10 % on
+//! the built-in (B), the raw-probe test). The twin is reading (A) (config/orc_microturbine_100kw_d55.yaml,
+//! Ø55, the built-in machine until session 15) wherever an onset or a threshold is checked: those
+//! figures are (A)'s threshold crossing; the raw-probe calibration runs on the built-in (B).
 
 mod common;
 
-use common::calibration::{plant_rotor, twin_rotor, twin_rotor_with_raw_probes};
+use common::calibration::{plant_rotor, twin_rotor_d55, twin_rotor_with_raw_probes};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rotor_twin::driver::calibration::estimate;
@@ -495,7 +498,7 @@ fn predicted_onset_after_calibration(twin: &Rotor, driver: &mut Driver) {
 
 #[test]
 fn the_live_estimate_recovers_the_plant_and_applying_it_moves_the_prediction_onto_it() {
-    let twin = twin_rotor();
+    let twin = twin_rotor_d55();
     let (mut rig, before, e) = calibrate(&twin, 0.0, PlantProbes::Pairs);
     check_and_apply(&mut rig, &before, &e, 120.0);
     predicted_onset_after_calibration(&twin, &mut rig.drivers[0]);
@@ -660,7 +663,7 @@ fn onset_after_live_calibration(
     observer: Option<ObserverGains>,
     keep: bool,
 ) -> ([f64; 4], Vec<f64>) {
-    let twin = twin_rotor();
+    let twin = twin_rotor_d55();
     let nonlinear = |rotor: &Rotor| {
         let settings = DriverSettings::new(
             ModelKind::Nonlinear,
@@ -739,7 +742,7 @@ fn on_grid(rotor: &Rotor, n_theta: usize, n_z: usize) -> Rotor {
 #[test]
 #[ignore]
 fn onset_against_the_film_grid() {
-    let machine = twin_rotor();
+    let machine = twin_rotor_d55();
     let grids = [(60, 10), (72, 12), (90, 15), (120, 20)];
     let drivers: Vec<Driver> = grids
         .iter()
@@ -787,7 +790,7 @@ fn onset_against_the_film_grid() {
 #[test]
 #[ignore]
 fn onset_through_the_driver_against_a_plain_twin() {
-    let machine = twin_rotor();
+    let machine = twin_rotor_d55();
     let w8 = 8000.0 * PI / 30.0;
     let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w8, 64);
     let driver = |film: FilmEvaluation, same_step: bool| {
