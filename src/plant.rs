@@ -117,6 +117,10 @@ pub struct PlantSignals {
     /// the journal's static position taken out by a high pass, [`RAW_AC_TIME_CONSTANT_S`]),
     /// only the motion about it.
     pub ac_coupled: bool,
+    /// Relative error of the speed topic: it reports (1 + e) times the shaft's speed and
+    /// acceleration (a tachometer's scale, a wrong pulses-per-turn count; 0: true). The
+    /// keyphasor, the probes and the plant itself keep the true speed.
+    pub speed_topic_error: f64,
 }
 
 /// Time constant of the plant's AC coupling (s): 0.1, a first-order high pass (an exponential
@@ -388,6 +392,8 @@ struct PlantBag {
     /// keyphasor and raw probe signals (issue 12)
     keyphasor: Option<usize>,
     probe_signal: Option<usize>,
+    /// what the speed topic reports over the true speed: 1 + `speed_topic_error`
+    speed_topic_factor: f64,
 }
 
 fn header(ns: i64, frame: &str) -> Header {
@@ -434,7 +440,7 @@ impl PlantBag {
                 "keyphasor {}; speed topic {}; probes {}",
                 sig.keyphasor_angle_deg
                     .map_or("none".into(), |a| format!("at plant shaft angle {a}° (unbalance phases published from the mark)")),
-                if sig.no_speed_topic { "none (the speed is the keyphasor's)" } else { "/rotor_twin/speed" },
+                if sig.no_speed_topic { "none (the speed is the keyphasor's)".into() } else if sig.speed_topic_error != 0.0 { format!("/rotor_twin/speed, off by {:+} %", sig.speed_topic_error * 100.0) } else { "/rotor_twin/speed".to_string() },
                 if sig.raw_probes && sig.ac_coupled {
                     format!("raw (ProbeSignal in V, {RAW_SENSITIVITY_V_PER_M} V/m, AC: high pass of {RAW_AC_TIME_CONSTANT_S} s; runout {:.2} µm, high spot {RUNOUT_HIGH_SPOT_DEG}° from the mark)", sig.runout_m * 1e6)
                 } else if sig.raw_probes {
@@ -468,6 +474,7 @@ impl PlantBag {
                 false => None,
             },
             rec,
+            speed_topic_factor: 1.0 + sig.speed_topic_error,
         })
     }
 
@@ -535,8 +542,8 @@ impl PlantBag {
         let ns = stamp(t);
         let m = messages::RotorSpeed {
             header: header(ns, "rotor"),
-            speed: profile.speed_rad_s(t),
-            acceleration: profile.accel_rad_s2(t),
+            speed: profile.speed_rad_s(t) * self.speed_topic_factor,
+            acceleration: profile.accel_rad_s2(t) * self.speed_topic_factor,
         };
         self.rec.write(h, &m, ns as u64, ns as u64)
     }

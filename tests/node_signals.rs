@@ -143,6 +143,14 @@ fn the_node_publishes_phase_lags_from_a_header_keyphasor_and_float64_probes() {
     let stale = peer["warnings"]["stale_input"].to_string();
     assert!(stale.contains("keyphasor stopped"), "{stale}");
     assert_eq!(rec["diagnostics"]["keyphasor"], "stopped");
+    // a true speed topic: no relock, no mismatch, no scale (the counts are in `/diagnostics`)
+    assert_eq!(
+        rec["diagnostics"]["keyphasor_relocks"], "0",
+        "{}",
+        rec["diagnostics"]
+    );
+    assert_eq!(rec["diagnostics"]["speed_mismatches"], "0");
+    assert_eq!(rec["diagnostics"]["speed_topic_scale"], "none");
     // recorded as received, in their own types
     let c = &rec["counts"];
     assert_eq!(

@@ -124,6 +124,9 @@ fn a_plant_keyphasor_anywhere_and_raw_probes_with_runout_give_the_true_phase_lag
     let (dir, truth) = plant_bag("raw", 0.35, signals);
     let report = replay_of(&dir, &machine_with_raw_probes(Some(5e-6)));
     assert!(report.rejected.is_empty(), "{:?}", report.rejected);
+    let kp = report.keyphasor.clone().expect("a keyphasor report");
+    assert_eq!((kp.relocks, kp.speed_mismatches), (0, 0), "{kp:?}");
+    assert!(kp.speed_topic_scale.is_none(), "{kp:?}");
     let mut worst = (0.0f64, 0.0f64);
     for (k, st) in report.stations.iter().enumerate() {
         let t = truth.one_x_probe_axes[k].expect("truth with a keyphasor");
@@ -177,12 +180,57 @@ fn a_plant_keyphasor_anywhere_and_raw_probes_with_runout_give_the_true_phase_lag
     assert!(miss > 10.0, "runout uncompensated should show: {miss}°");
 }
 
+/// A speed topic 3 % high (a tachometer's scale error) with a keyphasor at 123°: the replay
+/// finds the mismatch from the keyphasor's phase drift (README "Plant signals", a steady ratio
+/// over 3 revolutions), scales the speed topic by 1/1.03 and says so in its report, with no
+/// relock; the twin then turns at the shaft's speed, so its predicted 1X lag meets the measured
+/// one within the 5°. The factor found is the ratio of the keyphasor's intervals to
+/// the told speed, exact but for the stamps' nanosecond rounding (`tests/keyphasor_speed_mismatch.rs`
+/// measured it within 1.5·10⁻⁸): asserted to 10⁻⁵.
+#[test]
+fn a_speed_topic_three_percent_high_is_found_scaled_and_reported() {
+    let signals = PlantSignals {
+        keyphasor_angle_deg: Some(123.0),
+        speed_topic_error: 0.03,
+        ..PlantSignals::default()
+    };
+    let (dir, truth) = plant_bag("speed3", 0.35, signals);
+    let report = replay_of(&dir, &builtin());
+    let kp = report.keyphasor.clone().expect("a keyphasor report");
+    eprintln!("{kp:?}; warnings of the replay: {:?}", report.notes);
+    assert_eq!(kp.speed_mismatches, 1, "{kp:?}");
+    assert_eq!(kp.relocks, 0, "{kp:?}");
+    let scale = kp.speed_topic_scale.expect("a scale");
+    assert!((scale - 1.0 / 1.03).abs() < 1e-5, "scale {scale}");
+    for (k, st) in report.stations.iter().enumerate() {
+        let t = truth.one_x_probe_axes[k].unwrap();
+        let m = st.one_x_probe_axes_measured.unwrap();
+        let p = st.one_x_probe_axes_predicted.unwrap();
+        for j in 0..2 {
+            let (dm, dp) = (
+                lag_gap(m[j].phase_lag_deg, t[j].phase_lag_deg),
+                lag_gap(p[j].phase_lag_deg, m[j].phase_lag_deg),
+            );
+            eprintln!(
+                "{} axis {j}: measured − truth {dm:.2}°, predicted − measured {dp:.2}°",
+                st.station
+            );
+            assert!(
+                dm.abs() < 5.0 && dp.abs() < 5.0,
+                "{}: {dm}°, {dp}°",
+                st.station
+            );
+        }
+    }
+}
+
 /// Without a keyphasor topic the phase outputs are null with the reason; amplitudes stay.
 #[test]
 fn without_a_keyphasor_phases_are_null_with_the_reason() {
     let (dir, truth) = plant_bag("nokp", 0.2, PlantSignals::default());
     assert!(truth.one_x_probe_axes.iter().all(Option::is_none));
     let report = replay_of(&dir, &builtin());
+    assert!(report.keyphasor.is_none(), "{:?}", report.keyphasor);
     for st in &report.stations {
         assert!(st.one_x_probe_axes_measured.is_none() && st.one_x_phase_error_deg.is_none());
         assert!(st.one_x_amplitude_measured_m.unwrap() > 1e-6);

@@ -74,6 +74,10 @@ pub struct SynthArgs {
     /// the journal's static position out), so no mean position. Needs --raw-probes.
     #[arg(long, requires = "raw_probes")]
     pub ac_coupled: bool,
+    /// The speed topic's error (%): it reports (1 + e/100) times the shaft's speed (a
+    /// tachometer's scale error; the keyphasor keeps the truth). Default 0; within ±50.
+    #[arg(long, default_value_t = 0.0, conflicts_with = "no_speed")]
+    pub speed_error_pct: f64,
 }
 
 /// Runs `rotor-twin synth-bag`: checks the arguments, writes the bag, prints what it holds.
@@ -121,8 +125,14 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
             runout_m: args.runout_um * 1e-6,
             no_speed_topic: args.no_speed,
             ac_coupled: args.ac_coupled,
+            speed_topic_error: args.speed_error_pct / 100.0,
         },
     };
+    anyhow::ensure!(
+        args.speed_error_pct.is_finite() && args.speed_error_pct.abs() <= 50.0,
+        "--speed-error-pct {}: must be within ±50",
+        args.speed_error_pct
+    );
     anyhow::ensure!(
         args.keyphasor_deg.is_finite(),
         "--keyphasor-deg {}: must be finite",

@@ -397,6 +397,11 @@ impl Driver {
         self.signals.expected = true;
     }
 
+    /// Whether a keyphasor is expected (a keyphasor topic with messages, or one seen).
+    pub fn expects_keyphasor(&self) -> bool {
+        self.signals.expected || self.signals.seen
+    }
+
     /// Starts the twin at the event at `t_ns` if the speed in force allows and none runs.
     fn start_at_event(&mut self, t_ns: i64, fed: Fed, emit: &mut impl FnMut(Outgoing)) -> Fed {
         let Some(w) = self.speed_rad_s() else {

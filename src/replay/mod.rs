@@ -14,7 +14,8 @@ mod report;
 pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
 
 pub use report::{
-    CenterlineStatic, OilReport, OnsetReport, ReplayReport, StateChange, StationReport,
+    CenterlineStatic, KeyphasorReport, OilReport, OnsetReport, ReplayReport, StateChange,
+    StationReport,
 };
 
 use crate::bag::{Bag, BagMessage};
@@ -346,6 +347,11 @@ impl Replaying {
             viscosity_scales: (driver.film_oil().into_iter())
                 .map(|f| (f.name, f.viscosity_scale))
                 .collect(),
+        });
+        report.keyphasor = driver.expects_keyphasor().then(|| report::KeyphasorReport {
+            relocks: driver.counts().relocks,
+            speed_mismatches: driver.counts().speed_mismatches,
+            speed_topic_scale: driver.speed_scale(),
         });
         report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
         if let Some(out) = out {

@@ -187,6 +187,21 @@ pub struct ReplayReport {
     /// accepted): the last supply temperature and each film bearing's viscosity scale.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub oil: Option<OilReport>,
+    /// What the keyphasor lock did (issue 12; absent without a keyphasor topic).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub keyphasor: Option<KeyphasorReport>,
+}
+
+/// What the keyphasor lock did over a replay (issue 12): relocks (the mark moved against the
+/// shaft and held) and steady speed mismatches (the speed topic scaled to the keyphasor's).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct KeyphasorReport {
+    /// Relocks: phases re-referenced to a moved mark.
+    pub relocks: u64,
+    /// Steady speed mismatches found between the keyphasor and the speed topic.
+    pub speed_mismatches: u64,
+    /// The factor every speed topic value was scaled by at the end (null: none found).
+    pub speed_topic_scale: Option<f64>,
 }
 
 /// The oil in force at the end of a replay (issue 12).
@@ -216,6 +231,7 @@ impl ReplayReport {
             forecast: None,
             heat_balance: None,
             oil: None,
+            keyphasor: None,
         }
     }
 

@@ -857,6 +857,14 @@ impl ModelLoop {
                 "keyphasor",
                 keyphasor_state(self.driver.phase_reference(now)).into(),
             ),
+            kv("keyphasor_relocks", counts.relocks.to_string()),
+            kv("speed_mismatches", counts.speed_mismatches.to_string()),
+            kv(
+                "speed_topic_scale",
+                self.driver
+                    .speed_scale()
+                    .map_or("none".into(), |s| format!("{s:.6}")),
+            ),
         ];
         let (values, lost_now) = self.loss_values(values);
         let timeout = self.driver.settings().input_timeout_s;
