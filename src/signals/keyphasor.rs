@@ -28,7 +28,12 @@
 //! ρ beyond 1 ± [`KeyphasorSettings::speed_mismatch`], agreeing within it, the event reports the
 //! mean ρ ([`KeyphasorEvent::speed_ratio`]: the driver scales the speed topic by it) and
 //! corrects the whole error, without a relock. Only with a speed topic: a speed from the
-//! keyphasor's own intervals has nothing to disagree with.
+//! keyphasor's own intervals has nothing to disagree with. A speed topic off by more than the
+//! interval tolerance (a wrong pulses-per-turn count, a tachometer scale far off) has every
+//! event refused by the interval check; there the events' own intervals, taken whatever the
+//! check said ([`RawIntervals`]), tell it: when the last `mismatch_revs` of them agree within
+//! `speed_mismatch` and all contradict the topic, the event is accepted with their mean speed
+//! over the topic's as the ratio, as above.
 
 use std::f64::consts::{PI, TAU};
 
@@ -366,6 +371,72 @@ pub struct KeyphasorLock {
     pending: Option<(f64, u32)>,
     /// the twin's speed against the plant's, revolution by revolution
     drift: DriftTrack,
+    /// the events' own intervals, accepted or not
+    raw: RawIntervals,
+    /// a gross speed mismatch found by the interval check at this event (plant over topic)
+    gross_ratio: Option<f64>,
+}
+
+/// The times of the last events, each after the one before, whatever the checks said, with
+/// the speed topic's value at each (0: none): their intervals are the shaft's own revolutions
+/// when the speed topic is far off.
+#[derive(Debug, Clone, Copy, Default)]
+struct RawIntervals {
+    times_ns: [i64; MISMATCH_REVS_MAX + 1],
+    topic_rad_s: [f64; MISMATCH_REVS_MAX + 1],
+    /// events recorded (at most `MISMATCH_REVS_MAX + 1`) and where the next goes
+    len: usize,
+    next: usize,
+}
+
+impl RawIntervals {
+    /// Records an event at `t_ns` (the speed topic then `topic`, rad/s) if it is after the
+    /// newest.
+    fn push(&mut self, t_ns: i64, topic: Option<f64>) {
+        let n = self.times_ns.len();
+        if self.len > 0 && t_ns <= self.times_ns[(self.next + n - 1) % n] {
+            return;
+        }
+        self.times_ns[self.next] = t_ns;
+        self.topic_rad_s[self.next] = topic.unwrap_or(0.0);
+        self.next = (self.next + 1) % n;
+        self.len = (self.len + 1).min(n);
+    }
+
+    /// The mean speed (rad/s) of the last `k` intervals if they agree within `tol` (relative
+    /// spread), the speed topic at each interval's end agreed with its value now (`topic`,
+    /// rad/s) within `tol` (a step of the topic is no mismatch: the intervals before it were
+    /// at the old speed), and each interval contradicts it by more than `interval_tol`.
+    fn steady_beyond(&self, k: usize, tol: f64, topic: f64, interval_tol: f64) -> Option<f64> {
+        let n = self.times_ns.len();
+        let k = k.clamp(2, MISMATCH_REVS_MAX);
+        if self.len < k + 1 {
+            return None;
+        }
+        let slot = |back: usize| (self.next + 2 * n - 1 - back) % n;
+        let at = |back: usize| self.times_ns[slot(back)];
+        let (mut lo, mut hi, mut sum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+        for j in 0..k {
+            if (self.topic_rad_s[slot(j)] / topic - 1.0).abs() > tol {
+                return None;
+            }
+            let w = TAU / ((at(j) - at(j + 1)) as f64 * 1e-9);
+            (lo, hi, sum) = (lo.min(w), hi.max(w), sum + w);
+        }
+        let mean = sum / k as f64;
+        let beyond = lo > topic * (1.0 + interval_tol) || hi < topic * (1.0 - interval_tol);
+        (beyond && hi - lo <= tol * mean).then_some(mean)
+    }
+
+    /// The newest interval's speed (rad/s), if two events are known.
+    fn last_speed(&self) -> Option<f64> {
+        let n = self.times_ns.len();
+        (self.len >= 2).then(|| {
+            let dt =
+                self.times_ns[(self.next + n - 1) % n] - self.times_ns[(self.next + n - 2) % n];
+            TAU / (dt as f64 * 1e-9)
+        })
+    }
 }
 
 /// `a` wrapped into (−π, π].
@@ -441,6 +512,17 @@ impl KeyphasorLock {
             relocked: false,
             speed_ratio: None,
         };
+        if let Some(rho) = self.gross_ratio.take() {
+            // the speed topic far off: the twin's angle is wrong by all of its error
+            ev.speed_ratio = Some(rho);
+            self.pending = None;
+            let e = twin_angle_rad.map(|theta| wrap_pi(-theta));
+            self.drift
+                .reset(twin_angle_rad.zip(e).map(|(theta, e)| theta + e));
+            ev.correction_rad = e;
+            self.locked |= e.is_some();
+            return Ok(ev);
+        }
         let Some(theta) = twin_angle_rad else {
             self.drift.reset(None);
             return Ok(ev);
@@ -478,6 +560,7 @@ impl KeyphasorLock {
         t_ns: i64,
         speed: Option<f64>,
     ) -> Result<Option<f64>, KeyphasorRefusal> {
+        self.raw.push(t_ns, speed.filter(|s| *s > 0.0));
         let Some(last) = self.last_event_ns else {
             self.last_event_ns = Some(t_ns);
             return Ok(None);
@@ -498,6 +581,13 @@ impl KeyphasorLock {
         let tol = self.settings.interval_tolerance;
         match topic.or(self.last_interval_speed) {
             Some(r) if (w / r - 1.0).abs() > tol => {
+                if let Some(rho) = topic.and_then(|t| self.gross_mismatch(t)) {
+                    self.gross_ratio = Some(rho);
+                    self.last_event_ns = Some(t_ns);
+                    self.last_interval_speed = self.raw.last_speed();
+                    self.interval_refusals = 0;
+                    return Ok(self.last_interval_speed);
+                }
                 Err(self.refuse_interval(t_ns, dt, w, r, topic))
             }
             _ => {
@@ -507,6 +597,17 @@ impl KeyphasorLock {
                 Ok(Some(w))
             }
         }
+    }
+
+    /// A speed topic `topic` (rad/s) off by more than the interval tolerance: the last
+    /// `mismatch_revs` intervals of the events themselves agree within `speed_mismatch` and
+    /// all contradict it. The plant's speed over the topic's, or None.
+    fn gross_mismatch(&self, topic: f64) -> Option<f64> {
+        let s = &self.settings;
+        let k = s.mismatch_revs as usize;
+        self.raw
+            .steady_beyond(k, s.speed_mismatch, topic, s.interval_tolerance)
+            .map(|w| w / topic)
     }
 
     /// Refuses an event whose interval `dt` (s, speed `w`) contradicts the reference `r`: too
