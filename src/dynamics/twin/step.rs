@@ -155,6 +155,10 @@ impl Twin {
             l.film.begin_step(nm.h);
         }
         let (iterations, fallback) = self.iterate_bearings(level, nm, speed, time)?;
+        // the films' outputs of the accepted iterate (the iterates took force and coefficients)
+        for l in &mut self.links {
+            l.complete_film();
+        }
         self.correct(level, nm, time, angle, speed)?;
         for l in &mut self.links {
             l.film.commit_step();
