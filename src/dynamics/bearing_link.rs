@@ -199,7 +199,9 @@ impl BearingLink {
 
     /// Film (and wall) force, stiffness and damping at relative position `d` (m), velocity `v`
     /// (m/s) and speed `speed` (rad/s). Without `with_coefficients` the film's coefficients are
-    /// not computed (left zero; the wall's still are). Allocates nothing.
+    /// not computed (left zero; the wall's still are). With them and without fluid inertia
+    /// the film's outputs in `film` may be left zero until [`complete_film`](Self::complete_film)
+    /// (force and coefficients are whole). Allocates nothing.
     pub fn evaluate(
         &mut self,
         d: [f64; 2],
@@ -222,7 +224,11 @@ impl BearingLink {
             velocity_m_s: v,
             speed_rad_s: speed,
         };
-        let (film, mut coef) = if with_coefficients {
+        let (film, mut coef) = if with_coefficients && self.inertia.is_none() {
+            // a Newton iterate needs the force and coefficients only: the film's outputs
+            // (p_max, ζ1, ζ2, friction) of the accepted iterate by `complete_film`
+            self.film.solve_lean(&kin)?
+        } else if with_coefficients {
             let (film, coef) = self.film.solve_with_coefficients(&kin)?;
             (film, self.with_temporal_mass(coef, d_film, &film))
         } else {
@@ -269,6 +275,14 @@ impl BearingLink {
         }
         self.last = out;
         Ok(out)
+    }
+
+    /// The film's outputs (p_max, ζ1, ζ2, friction, flows) in the last evaluation when that was
+    /// lean (`evaluate` leaves them for the accepted iterate): after the step's iteration, once.
+    pub fn complete_film(&mut self) {
+        if let Some(film) = self.film.completed_result() {
+            self.last.film = film;
+        }
     }
 
     /// The linear coupling's force law F = F₀ − K₀(d − d₀) − C₀ ḋ about the static equilibrium

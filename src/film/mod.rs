@@ -153,6 +153,24 @@ pub trait FilmModel {
         kin: &JournalKinematics,
     ) -> Result<(FilmResult, FilmCoefficients), FilmError>;
 
+    /// [`FilmModel::solve_with_coefficients`] for an iterate of a Newton iteration: the force
+    /// and the eight coefficients are the same, bit for bit; the result's other fields (the
+    /// outputs: p_max, ζ1, ζ2, friction, flows) may be left unset (zero) and are then given, for
+    /// the last solve, by [`FilmModel::completed_result`]. By default the whole solve.
+    fn solve_lean(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        self.solve_with_coefficients(kin)
+    }
+
+    /// The whole result of the last solve when that was a [`FilmModel::solve_lean`] that left
+    /// fields unset (as `solve_with_coefficients` would have given it, bit for bit); `None` when
+    /// the last solve's result was whole.
+    fn completed_result(&self) -> Option<FilmResult> {
+        None
+    }
+
     /// The eight coefficients for a constant-coefficient (linearised) analysis about `kin`: the
     /// seed's "classical" description, the stability threshold. By default those of
     /// [`FilmModel::solve_with_coefficients`]; a grid-based model may return a better estimate of

@@ -411,6 +411,18 @@ impl FilmModel for ViscosityScaledFilm {
         Ok((self.scaled(r), self.scaled_coefficients(c)))
     }
 
+    fn solve_lean(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let (r, c) = self.inner.solve_lean(kin)?;
+        Ok((self.scaled(r), self.scaled_coefficients(c)))
+    }
+
+    fn completed_result(&self) -> Option<FilmResult> {
+        self.inner.completed_result().map(|r| self.scaled(r))
+    }
+
     fn linearised_coefficients(
         &mut self,
         kin: &JournalKinematics,

@@ -155,6 +155,10 @@ impl Twin {
             l.film.begin_step(nm.h);
         }
         let (iterations, fallback) = self.iterate_bearings(level, nm, speed, time)?;
+        // the films' outputs of the accepted iterate (the iterates took force and coefficients)
+        for l in &mut self.links {
+            l.complete_film();
+        }
         self.correct(level, nm, time, angle, speed)?;
         for l in &mut self.links {
             l.film.commit_step();
@@ -172,16 +176,22 @@ impl Twin {
     /// r = F_ext + M(a0 q + a1 q̇ + q̈) + (C + Ω_f G)(a2 q + q̇) − (Ω − Ω_f) G q̇, on the
     /// condensed DOFs (`a_b`), and the predictor q* = q + h q̇ + h²/2 q̈ there (`qb`).
     fn linear_response(&mut self, level: usize, nm: Newmark, angle: f64, speed: f64, accel: f64) {
-        let n = self.state.q.len();
         let factored_speed = self.factors[level].speed_rad_s;
-        for i in 0..n {
-            self.rhs[i] = self.gravity[i] + self.external[i];
+        // element-wise loops over zipped slices (no index checks; vectorised): the same
+        // expressions element by element as indexed loops, so the same values
+        for (r, (g, e)) in self
+            .rhs
+            .iter_mut()
+            .zip(self.gravity.iter().zip(&self.external))
+        {
+            *r = g + e;
         }
         self.add_unbalance(angle, speed, accel);
         let s = &self.state;
-        for i in 0..n {
-            self.tmp[i] = nm.a0 * s.q[i] + nm.a1 * s.qd[i] + s.qdd[i];
-            self.tmp_c[i] = nm.a2 * s.q[i] + s.qd[i];
+        let state = s.q.iter().zip(s.qd.iter().zip(&s.qdd));
+        for ((t, tc), (q, (qd, qdd))) in self.tmp.iter_mut().zip(self.tmp_c.iter_mut()).zip(state) {
+            *t = nm.a0 * q + nm.a1 * qd + qdd;
+            *tc = nm.a2 * q + qd;
         }
         self.mcg_rows.add_step_products(
             [&self.tmp, &self.tmp_c, &s.qd],
@@ -450,17 +460,22 @@ impl Twin {
         next.q.copy_from_slice(&self.q_lin);
         f.add_bearing_response(&self.f_b, &mut next.q);
         let s = &self.state;
-        for i in 0..s.q.len() {
-            next.qdd[i] = nm.a0 * (next.q[i] - s.q[i]) - nm.a1 * s.qd[i] - s.qdd[i];
-            next.qd[i] = s.qd[i] + 0.5 * nm.h * (s.qdd[i] + next.qdd[i]);
-        }
-        if !next
+        // zipped (no index checks), and the finite check without an early exit: one flag
+        // or-ed over every entry (vectorised); the same values and the same verdict
+        let state = s.q.iter().zip(s.qd.iter().zip(&s.qdd));
+        let mut bad = false;
+        for (((q1, qd1), qdd1), (q, (qd, qdd))) in (next
             .q
             .iter()
-            .chain(&next.qd)
-            .chain(&next.qdd)
-            .all(|v| v.is_finite())
+            .zip(next.qd.iter_mut())
+            .zip(next.qdd.iter_mut()))
+        .zip(state)
         {
+            *qdd1 = nm.a0 * (q1 - q) - nm.a1 * qd - qdd;
+            *qd1 = qd + 0.5 * nm.h * (qdd + *qdd1);
+            bad |= !(q1.is_finite() & qd1.is_finite() & qdd1.is_finite());
+        }
+        if bad {
             return Err(None);
         }
         next.time_s = time;

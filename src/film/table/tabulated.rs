@@ -1,7 +1,7 @@
 //! The film model that reads a [`FilmTable`]: force, zone, friction and the mid-plane profile
 //! interpolated, the eight coefficients by the chain rule.
 
-use super::{FilmTable, LineOfCentres, Node};
+use super::{from_source_frame, FilmTable, ForceFrame, LineOfCentres, Node};
 use crate::film::{
     wrap_angle_rad, BearingGeometry, FilmCoefficients, FilmError, FilmModel, FilmResult,
     JournalKinematics,
@@ -14,6 +14,19 @@ use std::sync::Arc;
 pub struct TabulatedFilm {
     table: Arc<FilmTable>,
     last: JournalKinematics,
+    /// The last solve if it was lean ([`FilmModel::solve_lean`]): what its outputs need.
+    pending: Option<Lean>,
+}
+
+/// What a lean solve keeps for its outputs ([`FilmModel::completed_result`]): the state, the
+/// interpolated force per unit V in the line of centres, and the stencil's 16 nodes (table
+/// index, signs of angles and force, weight) in the order of the interpolation's sums.
+#[derive(Clone, Copy)]
+struct Lean {
+    s: LineOfCentres,
+    omega: f64,
+    force: [f64; 2],
+    nodes: [(usize, [f64; 2], f64); 16],
 }
 
 impl TabulatedFilm {
@@ -22,12 +35,17 @@ impl TabulatedFilm {
         Self {
             table,
             last: JournalKinematics::default(),
+            pending: None,
         }
     }
 
     /// A model reading `table` whose last state was `last` (for its mid-plane profile).
     pub(super) fn at(table: Arc<FilmTable>, last: JournalKinematics) -> Self {
-        Self { table, last }
+        Self {
+            table,
+            last,
+            pending: None,
+        }
     }
 }
 
@@ -44,6 +62,7 @@ impl FilmModel for TabulatedFilm {
         let c = self.table.geometry.radial_clearance_m;
         kin.validate(c)?;
         self.last = *kin;
+        self.pending = None;
         let s = self.table.line_of_centres(kin);
         let n = self.table.node_at(s.eps, s.psi);
         Ok(result_of(&s, &n, kin.speed_rad_s))
@@ -56,6 +75,7 @@ impl FilmModel for TabulatedFilm {
         let c = self.table.geometry.radial_clearance_m;
         kin.validate(c)?;
         self.last = *kin;
+        self.pending = None;
         let s = self.table.line_of_centres(kin);
         // one stencil pass gives the node and its force's slopes (the analytic coefficients)
         let (result, (k, d)) = if s.eps > 1e-3 && s.v > 0.0 {
@@ -77,6 +97,52 @@ impl FilmModel for TabulatedFilm {
                 ..FilmCoefficients::default()
             },
         ))
+    }
+
+    /// The force and its slopes from one stencil pass (the coefficients by the chain rule), the
+    /// other 12 node values left for [`completed_result`](FilmModel::completed_result): the same
+    /// sums in the same order as `solve_with_coefficients`, so the same force, coefficients and
+    /// (completed) result, bit for bit (`lean_solve_equals_the_whole_solve_exactly`). Near the
+    /// centre (ε ≤ 10⁻³) or without a source (V = 0) the whole solve.
+    fn solve_lean(
+        &mut self,
+        kin: &JournalKinematics,
+    ) -> Result<(FilmResult, FilmCoefficients), FilmError> {
+        let c = self.table.geometry.radial_clearance_m;
+        kin.validate(c)?;
+        let s = self.table.line_of_centres(kin);
+        if !(s.eps > 1e-3 && s.v > 0.0) {
+            return self.solve_with_coefficients(kin);
+        }
+        self.last = *kin;
+        let (lean, f_eps, f_psi) = self.lean_pass(&s, kin.speed_rad_s);
+        let f = lean.force;
+        let (k, d) = self
+            .table
+            .coefficients_from_slopes(kin, &s, [f, f_eps, f_psi]);
+        self.pending = Some(lean);
+        let result = FilmResult {
+            force_n: s.rotate_to_fixed([s.v * f[0], s.v * f[1]]),
+            ..FilmResult::default()
+        };
+        let coefficients = FilmCoefficients {
+            stiffness_n_per_m: k,
+            damping_n_s_per_m: d,
+            ..FilmCoefficients::default()
+        };
+        Ok((result, coefficients))
+    }
+
+    fn completed_result(&self) -> Option<FilmResult> {
+        let lean = self.pending.as_ref()?;
+        let mut n = Node {
+            force: lean.force,
+            ..Node::default()
+        };
+        for &(index, [sign, _], w) in &lean.nodes {
+            add_outputs(&mut n, w, sign, &self.table.nodes[index]);
+        }
+        Some(result_of(&lean.s, &n, lean.omega))
     }
 
     fn midplane_pressure(&self, out: &mut [f64]) {
@@ -133,6 +199,64 @@ impl FilmModel for TabulatedFilm {
             *p = (s.v * *p).max(0.0);
         }
     }
+}
+
+impl TabulatedFilm {
+    /// The stencil pass of [`solve_lean`](FilmModel::solve_lean) at state `s`, speed `omega`
+    /// (rad/s): the force per unit V and its slopes d/dε, d/dψ in the line of centres, summed as
+    /// `FilmTable::node_with_slopes` sums them, and the stencil's nodes for the outputs.
+    fn lean_pass(&self, s: &LineOfCentres, omega: f64) -> (Lean, [f64; 2], [f64; 2]) {
+        let t = &self.table;
+        let st = t.stencil_with_slopes(s.eps, s.psi);
+        let mut lean = Lean {
+            s: *s,
+            omega,
+            force: [0.0; 2],
+            nodes: [(0, [1.0, 1.0], 0.0); 16],
+        };
+        let (mut f, mut f_eps, mut f_psi) = ([0.0; 2], [0.0; 2], [0.0; 2]);
+        for a in 0..4 {
+            for b in 0..4 {
+                let (index, sign) = st.node(a, b);
+                let m = &t.nodes[index];
+                let w = st.wr[a] * st.wc[a][b];
+                // Node::add's force terms, then node_with_slopes' slope terms
+                f[0] += sign[1] * w * m.force[0];
+                f[1] += sign[1] * w * m.force[1];
+                let (w_eps, w_psi) = (
+                    sign[1] * st.dwr[a] * st.wc[a][b],
+                    sign[1] * st.wr[a] * st.dwc[a][b],
+                );
+                f_eps[0] += w_eps * m.force[0];
+                f_eps[1] += w_eps * m.force[1];
+                f_psi[0] += w_psi * m.force[0];
+                f_psi[1] += w_psi * m.force[1];
+                lean.nodes[4 * a + b] = (index, sign, w);
+            }
+        }
+        if t.res.frame == ForceFrame::Source {
+            (f, f_eps, f_psi) = from_source_frame(s.psi, f, f_eps, f_psi);
+        }
+        lean.force = f;
+        (lean, f_eps, f_psi)
+    }
+}
+
+/// `Node::add` without the force: adds `w` × `m`'s outputs to `n` (`sign` −1 for a mirrored
+/// row: its angles turn by π), the same products as `Node::add`.
+#[inline]
+fn add_outputs(n: &mut Node, w: f64, sign: f64, m: &Node) {
+    let ws = sign * w;
+    n.p_max += w * m.p_max;
+    for k in 0..3 {
+        n.angles[k][0] += ws * m.angles[k][0];
+        n.angles[k][1] += ws * m.angles[k][1];
+    }
+    n.torque_pressure += w * m.torque_pressure;
+    n.torque_couette += w * m.torque_couette;
+    n.side_flow += w * m.side_flow;
+    n.inflow_pressure += w * m.inflow_pressure;
+    n.inflow_couette += w * m.inflow_couette;
 }
 
 /// Column `i` of a grid of `n` columns around the circumference, wrapped into 0..n: equal to
@@ -231,6 +355,44 @@ mod tests {
             assert_eq!(coef.stiffness_n_per_m, k, "ε {eps}: stiffness");
             assert_eq!(coef.damping_n_s_per_m, d, "ε {eps}: damping");
         }
+    }
+
+    /// The lean solve (force and coefficients for a Newton iterate, issue 17) gives, bit for
+    /// bit, the force and coefficients of the whole solve, and its completed result is the whole
+    /// result (every output: p_max, ζ1, ζ2, friction, flows); a whole solve leaves nothing to
+    /// complete. States across the table: whip orbits near the wall, fast squeeze, the first
+    /// row interval (mirrored or extrapolated row), the centre's fallback, an attitude beyond π.
+    #[test]
+    fn lean_solve_equals_the_whole_solve_exactly() {
+        let (table, c, w) = (seed_table(), 40e-6, 942.0);
+        let (mut lean, mut whole) = (TabulatedFilm::new(table.clone()), TabulatedFilm::new(table));
+        let mut compared = 0;
+        for (eps, phi, vr, vt) in [
+            (0.3, 0.4, 0.01, -0.02),
+            (0.6, 2.0, -0.05, 0.1),
+            (0.85, 4.0, 0.2, 0.05),
+            (0.97, 5.5, -0.1, -0.2),
+            (0.5, -2.5, 0.3, 0.6),
+            (0.002, 1.0, 0.01, 0.0),
+            (0.02, 3.5, -0.02, 0.01),
+            (0.0005, 1.0, 0.0, 0.0),
+        ] {
+            let kin = kinematics(eps, phi, [vr, vt], c, w);
+            let (r, coef) = whole.solve_with_coefficients(&kin).unwrap();
+            assert_eq!(whole.completed_result(), None, "ε {eps}: whole solve");
+            let (rl, coef_l) = lean.solve_lean(&kin).unwrap();
+            assert_eq!(rl.force_n, r.force_n, "ε {eps}: force");
+            assert_eq!(coef_l, coef, "ε {eps}: coefficients");
+            let completed = lean.completed_result().unwrap_or(rl);
+            compared += usize::from(lean.completed_result().is_some());
+            assert_eq!(completed, r, "ε {eps}: completed result");
+            assert!(
+                r.max_pressure_pa > 0.0,
+                "ε {eps}: a pressure zone to compare"
+            );
+        }
+        // all but the centre's state (ε 5·10⁻⁴ ≤ 10⁻³: the whole solve) went the lean way
+        assert_eq!(compared, 7);
     }
 
     /// The chain-rule coefficients of the interpolant equal its central differences (steps
