@@ -133,7 +133,7 @@ impl ForecastLink {
 }
 
 /// Lowers the calling thread's scheduling priority by [`FORECAST_NICE`] below the process's
-/// (nice capped at 19) with `renice` on its thread id (no unsafe code in the crate); false where
+/// (nice capped at 19) with `renice` on its thread id (no unsafe system call); false where
 /// that is not possible.
 fn lower_priority() -> bool {
     let Ok(link) = std::fs::read_link("/proc/thread-self") else {
