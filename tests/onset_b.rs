@@ -102,7 +102,7 @@ fn run(
     let h = config.time_step_s;
     let mut twin = Twin::new(rotor, config, segments[0].0 * PI / 30.0).unwrap();
     let cls = ClassifierSettings::default();
-    let mut monitor = Monitor::new(&twin, 256, cls.clone());
+    let mut monitor = Monitor::new(&twin, 256, cls);
     let c = twin.bearing_clearances_m()[0];
     let mut applied = vec![false; kicks.len()];
     let mut per_rev = Vec::new();
