@@ -1,10 +1,13 @@
 //! The guide's rule "the time step allocates nothing", checked with a counting allocator: after
 //! the twin is built, a thousand steps of the microturbine (direct and tabulated film, in oil
 //! whip with wall contact for the tabulated one: checked, the steps are counted) make no heap
-//! allocation, a change of the films' viscosity (a live oil temperature) among them.
+//! allocation, a change of the films' viscosity (a live oil temperature) among them; nor does
+//! the monitor recording each of them (its per-revolution analysis included: it records from
+//! the first step, so the counted steps hold full spectrum windows and path distances).
 
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::film::FluidInertia;
+use rotor_twin::monitor::{ClassifierSettings, Monitor};
 use rotor_twin::rotor::{MachineDescription, Rotor};
 
 #[path = "common/counting_alloc.rs"]
@@ -50,6 +53,7 @@ fn allocations_in_steps(
         ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128)
     };
     let mut twin = Twin::new(&rotor, config, omega).unwrap();
+    let mut monitor = Monitor::new(&twin, 2 * 128, ClassifierSettings::default());
     let input = StepInput {
         speed_rad_s: omega,
         accel_rad_s2: 0.0,
@@ -58,15 +62,19 @@ fn allocations_in_steps(
         Warmup::Steps(n) => {
             for _ in 0..n {
                 twin.step(&input).unwrap();
+                monitor.record(&twin);
             }
         }
         Warmup::Contact(_, most) => {
-            let touches = |twin: &mut Twin| {
-                twin.step(&input)
+            let mut touches = |twin: &mut Twin| {
+                let touch = twin
+                    .step(&input)
                     .unwrap()
                     .bearings
                     .iter()
-                    .any(|b| b.contact)
+                    .any(|b| b.contact);
+                monitor.record(twin);
+                touch
             };
             assert!(
                 (0..most).any(|_| touches(&mut twin)),
@@ -89,6 +97,7 @@ fn allocations_in_steps(
         }
         let out = twin.step(&input).unwrap();
         contact_steps += usize::from(out.bearings.iter().any(|b| b.contact));
+        monitor.record(&twin);
     }
     (allocations() - before, contact_steps)
 }

@@ -4,7 +4,10 @@
 //! storage is reserved at construction and nothing is allocated per step.
 
 pub mod classify;
+mod pressure;
 pub mod spectrum;
+
+pub use pressure::PRESSURE_SAMPLES_PER_REV;
 
 pub use classify::{
     AlarmLevels, AlarmOverride, ClassifierSettings, Evidence, RotorState, API_617_CLEARANCE_SHARE,
@@ -15,6 +18,7 @@ pub use spectrum::{
 };
 
 use crate::dynamics::{StepOutput, Twin};
+use pressure::PressureRing;
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -22,7 +26,7 @@ use std::f64::consts::TAU;
 pub const SPECTRUM_REVOLUTIONS: usize = 16;
 /// Revolutions (of spectrum windows, one a revolution) the growth rate is fitted over.
 pub const GROWTH_REVOLUTIONS: usize = 16;
-/// Points of the mid-plane pressure profile kept per step.
+/// Points of the mid-plane pressure profile kept per sampled step ([`PRESSURE_SAMPLES_PER_REV`]).
 pub const PRESSURE_POINTS: usize = 60;
 
 /// One bearing over the last revolution (and the spectrum window).
@@ -231,8 +235,6 @@ struct BearingHistory {
     p_max: Vec<f64>,
     contact: Vec<bool>,
     rub_power: Vec<f64>,
-    /// mid-plane pressure profile per sample (PRESSURE_POINTS each)
-    pressure: Vec<f64>,
 }
 
 /// The per-revolution monitor (Clone: the forecast continues a copy of the live one).
@@ -254,17 +256,40 @@ pub struct Monitor {
     /// smallest film thickness of full-film lubrication (m), for `pressure_valid`
     full_film_min_thickness_m: f64,
     spectrum: Vec<OrderComponent>,
-    /// the spectrum's samples (x, y, angle), gathered from the ring (capacity reserved)
-    picked: Vec<[f64; 3]>,
-    profile: Vec<f64>,
+    /// the spectra's samples (angle, then x and y of each bearing), gathered from the ring
+    /// (capacity reserved)
+    picked: Vec<f64>,
+    /// the path distance's segments (capacity reserved)
+    segments: Vec<[f64; 8]>,
+    /// the mid-plane pressure profiles, at about PRESSURE_SAMPLES_PER_REV steps a revolution
+    pressure: PressureRing,
     report: RevolutionReport,
 }
 
 impl Monitor {
     /// A monitor for `twin`, keeping up to `max_steps_per_rev` samples per revolution.
     pub fn new(twin: &Twin, max_steps_per_rev: usize, settings: ClassifierSettings) -> Self {
+        let contact = &twin.config().contact;
+        Self::with_clearances(
+            &twin.bearing_clearances_m(),
+            [
+                contact.onset_eccentricity_ratio,
+                contact.full_film_min_thickness_m,
+            ],
+            max_steps_per_rev,
+            settings,
+        )
+    }
+
+    /// A monitor of bearings of clearances `clearances` (m), with the wall's `[onset
+    /// eccentricity ratio, full-film thickness (m)]`.
+    fn with_clearances(
+        clearances: &[f64],
+        [onset, full_film_m]: [f64; 2],
+        max_steps_per_rev: usize,
+        settings: ClassifierSettings,
+    ) -> Self {
         let capacity = SPECTRUM_REVOLUTIONS * max_steps_per_rev.max(8);
-        let clearances = twin.bearing_clearances_m();
         let bearings = clearances
             .iter()
             .map(|&c| BearingHistory {
@@ -277,7 +302,6 @@ impl Monitor {
                 p_max: vec![0.0; capacity],
                 contact: vec![false; capacity],
                 rub_power: vec![0.0; capacity],
-                pressure: vec![0.0; capacity * PRESSURE_POINTS],
             })
             .collect::<Vec<_>>();
         let n = bearings.len();
@@ -291,11 +315,12 @@ impl Monitor {
             rev_lengths: Vec::with_capacity(SPECTRUM_REVOLUTIONS + 1),
             current_rev_len: 0,
             revolutions: 0,
-            contact_onset_ratio: twin.config().contact.onset_eccentricity_ratio,
-            full_film_min_thickness_m: twin.config().contact.full_film_min_thickness_m,
-            spectrum: vec![OrderComponent::default(); SPECTRUM_REVOLUTIONS],
-            picked: Vec::with_capacity(capacity),
-            profile: vec![0.0; PRESSURE_POINTS],
+            contact_onset_ratio: onset,
+            full_film_min_thickness_m: full_film_m,
+            spectrum: vec![OrderComponent::default(); n * SPECTRUM_REVOLUTIONS],
+            picked: Vec::with_capacity(capacity * (1 + 2 * n)),
+            segments: Vec::with_capacity(capacity),
+            pressure: PressureRing::new(n, max_steps_per_rev),
             report: RevolutionReport {
                 bearings: vec![BearingRevolution::default(); n],
                 ..RevolutionReport::default()
@@ -333,17 +358,10 @@ impl Monitor {
     }
 
     /// The mid-plane pressure profiles (Pa, PRESSURE_POINTS angles each) of bearing `bearing`
-    /// over the last `revs` revolutions, oldest first (allocates).
+    /// over the last `revs` revolutions, oldest first, about [`PRESSURE_SAMPLES_PER_REV`] a
+    /// revolution (allocates).
     pub fn recent_pressure(&self, bearing: usize, revs: usize) -> Vec<Vec<f64>> {
-        let n = self.recent_samples(revs);
-        let h = &self.bearings[bearing];
-        (0..n)
-            .rev()
-            .map(|back| {
-                let i = self.idx(back);
-                h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS].to_vec()
-            })
-            .collect()
+        self.pressure.recent(bearing, revs)
     }
 
     /// The order spectrum of bearing `bearing` over the window, orders 1/16 … 2 (allocates).
@@ -371,16 +389,18 @@ impl Monitor {
         let slot = self.head;
         let previous_angle = self.previous_angle(out.angle_rad);
         self.angle[slot] = out.angle_rad;
-        for (k, (h, b)) in self.bearings.iter_mut().zip(&out.bearings).enumerate() {
+        for (h, b) in self.bearings.iter_mut().zip(&out.bearings) {
             h.x[slot] = b.position_m[0];
             h.y[slot] = b.position_m[1];
             h.ecc[slot] = b.eccentricity_ratio;
             h.p_max[slot] = b.max_pressure_pa;
             h.contact[slot] = b.contact;
             h.rub_power[slot] = b.rub_power_w;
-            twin.midplane_pressure(k, &mut self.profile);
-            h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS]
-                .copy_from_slice(&self.profile);
+        }
+        if self.pressure.due() {
+            for k in 0..out.bearings.len().min(self.bearings.len()) {
+                twin.midplane_pressure(k, self.pressure.slot_mut(k));
+            }
         }
         self.close_sample(previous_angle, out.angle_rad, out.time_s, out.speed_rad_s)
     }
@@ -407,7 +427,11 @@ impl Monitor {
             h.p_max[slot] = 0.0;
             h.contact[slot] = false;
             h.rub_power[slot] = 0.0;
-            h.pressure[slot * PRESSURE_POINTS..(slot + 1) * PRESSURE_POINTS].fill(0.0);
+        }
+        if self.pressure.due() {
+            for k in 0..positions_m.len().min(self.bearings.len()) {
+                self.pressure.slot_mut(k).fill(0.0);
+            }
         }
         self.close_sample(previous_angle, angle_rad, time_s, speed_rad_s)
     }
@@ -437,6 +461,7 @@ impl Monitor {
         };
         self.len = (self.len + 1).min(self.capacity);
         self.current_rev_len += 1;
+        self.pressure.close_step(angle_rad);
         let completed = (angle_rad / TAU).floor() > (previous_angle / TAU).floor();
         if !completed || self.len < 2 {
             return None;
@@ -445,6 +470,7 @@ impl Monitor {
             self.rev_lengths.remove(0);
         }
         self.rev_lengths.push(self.current_rev_len);
+        self.pressure.close_revolution(self.current_rev_len);
         self.current_rev_len = 0;
         self.revolutions += 1;
         self.analyse(time_s, speed_rad_s);
@@ -487,19 +513,20 @@ impl Monitor {
         r
     }
 
-    /// Rev-to-rev differences of bearing `bi` (orbit over the clearance, pressure relative):
-    /// each sample of the last revolution (`last` samples) against the state at the same shaft
-    /// angle one revolution earlier, interpolated by the cubic through the four samples of that
-    /// revolution around it (Lagrange, in the angle: a time step that is not a whole fraction of
-    /// the revolution, or a speed that changes, leaves no offset, and the interpolation error is
-    /// O(Δψ⁴)); NaN when not enough is stored.
-    fn rev_to_rev(&self, bi: usize, last: usize) -> (f64, f64) {
+    /// Rev-to-rev orbit difference of bearing `bi` (over the clearance): each sample of the
+    /// last revolution (`last` samples) against the position at the same shaft angle one
+    /// revolution earlier, interpolated by the cubic through the four samples of that
+    /// revolution around it (Lagrange, in the angle: a time step that is not a whole fraction
+    /// of the revolution, or a speed that changes, leaves no offset, and the interpolation error
+    /// is O(Δψ⁴)); NaN when not enough is stored. The pressure difference is the same
+    /// comparison on the sampled profiles ([`PressureRing::rev_to_rev`]).
+    fn rev_to_rev(&self, bi: usize, last: usize) -> f64 {
         let h = &self.bearings[bi];
         if last == 0 || self.len < last + 4 {
-            return (f64::NAN, f64::NAN);
+            return f64::NAN;
         }
         let angle = |back: usize| self.angle[self.idx(back)];
-        let (mut d2, mut pd2, mut p2) = (0.0, 0.0, 0.0);
+        let mut d2 = 0.0;
         // k: the newer of the two samples of the earlier revolution that bracket the target
         let mut k = last.saturating_sub(1).max(1);
         for back in 0..last {
@@ -508,80 +535,99 @@ impl Monitor {
                 k += 1;
             }
             if k + 2 >= self.len || angle(k) < target {
-                return (f64::NAN, f64::NAN);
+                return f64::NAN;
             }
             let nodes = [k - 1, k, k + 1, k + 2];
             let w = lagrange_weights(nodes.map(angle), target);
             let i = self.idx(back);
-            // the nodes' ring positions once (not once per pressure point: the same sums)
             let slots = nodes.map(|n| self.idx(n));
             let at = |v: &[f64]| slots.iter().zip(&w).map(|(&n, w)| w * v[n]).sum::<f64>();
             d2 += (h.x[i] - at(&h.x)).powi(2) + (h.y[i] - at(&h.y)).powi(2);
-            let a = &h.pressure[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS];
-            let profiles =
-                slots.map(|n| &h.pressure[n * PRESSURE_POINTS..(n + 1) * PRESSURE_POINTS]);
-            for (m, u) in a.iter().enumerate() {
-                let v: f64 = profiles.iter().zip(&w).map(|(p, w)| w * p[m]).sum();
-                pd2 += (u - v).powi(2);
-                p2 += u * u;
-            }
         }
-        let pressure = if p2 > 0.0 { (pd2 / p2).sqrt() } else { 0.0 };
-        ((d2 / last as f64).sqrt() / h.clearance_m, pressure)
+        (d2 / last as f64).sqrt() / h.clearance_m
     }
 
     /// Path distance of bearing `bi`: each point of the last revolution to the polyline of the
     /// two before, over the clearance; None if not enough is stored.
-    fn path_diff(&self, bi: usize, last: usize) -> Option<f64> {
-        let h = &self.bearings[bi];
+    fn path_diff(&mut self, bi: usize, last: usize) -> Option<f64> {
         if last <= 1 || self.len < 3 * last {
             return None;
         }
+        let h = &self.bearings[bi];
+        // the segments from `last` back to 3 last − 1 samples before the newest, gathered once
+        // with their bounding boxes: [a, b, x range, y range]
+        let segments = &mut self.segments;
+        segments.clear();
+        segments.extend((last..3 * last - 1).map(|j| {
+            let (a, b) = (
+                ring_index(self.head, self.capacity, j),
+                ring_index(self.head, self.capacity, j + 1),
+            );
+            let (xa, ya, xb, yb) = (h.x[a], h.y[a], h.x[b], h.y[b]);
+            let (x0, x1) = if xa < xb { (xa, xb) } else { (xb, xa) };
+            let (y0, y1) = if ya < yb { (ya, yb) } else { (yb, ya) };
+            [xa, ya, xb, yb, x0, x1, y0, y1]
+        }));
+        let distance2 = |px: f64, py: f64, s: &[f64; 8]| {
+            point_segment_distance2(px, py, s[0], s[1], s[2], s[3])
+        };
         // every point against every segment costs O(n²) a revolution: up to 32 points of the
         // revolution, evenly spread, are compared (all segments are searched)
         let stride = last.div_ceil(32);
         let (mut sum, mut points) = (0.0, 0usize);
         for back in (0..last).step_by(stride) {
             points += 1;
-            let p = self.idx(back);
+            let p = ring_index(self.head, self.capacity, back);
             let (px, py) = (h.x[p], h.y[p]);
-            let mut best = f64::MAX;
-            // the segments from `last` back to 3 last − 1 samples before the newest: the ring
-            // position one sample further back is one slot lower (wrapping)
-            let mut a = self.idx(last);
-            for _ in last..3 * last - 1 {
-                let b = if a == 0 { self.capacity - 1 } else { a - 1 };
-                best = best.min(point_segment_distance2(
-                    px, py, h.x[a], h.y[a], h.x[b], h.y[b],
-                ));
-                a = b;
+            // the minimum does not depend on the order: first the segments one and two
+            // revolutions back (near the point when the path repeats), so that the bounding-box
+            // test below skips most of the others
+            let mut best = distance2(px, py, &segments[back]).min(distance2(
+                px,
+                py,
+                &segments[(back + last).min(2 * last - 2)],
+            ));
+            for s in segments.iter() {
+                // the squared distance to the segment's bounding box is a lower bound of the
+                // distance to the segment: a segment whose box lies beyond the best (with a
+                // margin far above the rounding of either) cannot lower the minimum
+                let ox = larger(larger(s[4] - px, px - s[5]), 0.0);
+                let oy = larger(larger(s[6] - py, py - s[7]), 0.0);
+                if ox * ox + oy * oy <= best * (1.0 + 1e-9) {
+                    best = best.min(distance2(px, py, s));
+                }
             }
             sum += best;
         }
         Some((sum / points as f64).sqrt() / h.clearance_m)
     }
 
-    /// The order spectrum of bearing `bi` over the last `window` samples (oldest first) into
-    /// `self.spectrum`, from at most 32 samples a revolution: the orders resolved go up to 2,
-    /// far below that rate's Nyquist order of 16.
-    fn window_spectrum(&mut self, bi: usize, window: usize) {
-        let h = &self.bearings[bi];
+    /// The order spectra of all bearings over the last `window` samples (oldest first) into
+    /// `self.spectrum` (SPECTRUM_REVOLUTIONS components a bearing), from at most 32 samples a
+    /// revolution: the orders resolved go up to 2, far below that rate's Nyquist order of 16.
+    /// One pass for all bearings: they share the samples' angles, hence the window, the
+    /// phasors and their powers ([`spectrum::order_spectra`]; each bearing's figures are those
+    /// of [`order_spectrum`] on its own orbit, to the last bit).
+    fn window_spectra(&mut self, window: usize) {
         let idx = |back: usize| ring_index(self.head, self.capacity, back);
         let per_rev = window / self.rev_lengths.len().clamp(1, SPECTRUM_REVOLUTIONS);
         let stride = per_rev.div_ceil(32).max(1);
         let picks = window.div_ceil(stride);
-        // the picked samples gathered once, oldest first (the spectrum reads each twice)
+        // the picked samples gathered once, oldest first: the angle, then x and y of each
+        // bearing
         let picked = &mut self.picked;
         picked.clear();
-        picked.extend((0..picks).map(|k| {
+        for k in 0..picks {
             let i = idx(window - 1 - k * stride);
-            [h.x[i], h.y[i], self.angle[i]]
-        }));
-        order_spectrum(
-            picked.iter().map(|p| p[0]),
-            picked.iter().map(|p| p[1]),
-            picked.iter().map(|p| p[2]),
-            picks,
+            picked.push(self.angle[i]);
+            for h in &self.bearings {
+                picked.extend([h.x[i], h.y[i]]);
+            }
+        }
+        spectrum::order_spectra(
+            picked,
+            self.bearings.len(),
+            SPECTRUM_REVOLUTIONS,
             SPECTRUM_REVOLUTIONS,
             &mut self.spectrum,
         );
@@ -632,6 +678,7 @@ impl Monitor {
     fn analyse(&mut self, time_s: f64, speed_rad_s: f64) {
         let mut state = RotorState::Stable;
         let (mut od, mut pd) = (0.0_f64, 0.0_f64);
+        self.window_spectra(self.recent_samples(SPECTRUM_REVOLUTIONS));
         for bi in 0..self.bearings.len() {
             let (b, orbit_diff, pressure_diff) = self.analyse_bearing(bi, speed_rad_s);
             state = state.max(b.state);
@@ -689,14 +736,15 @@ impl Monitor {
         // sub-synchronous motion until it holds SPECTRUM_REVOLUTIONS revolutions
         let full_window = self.rev_lengths.len() >= SPECTRUM_REVOLUTIONS;
         let c = self.bearings[bi].clearance_m;
-        self.window_spectrum(bi, self.recent_samples(SPECTRUM_REVOLUTIONS));
-        let one_x = one_x_component(&self.spectrum, SPECTRUM_REVOLUTIONS);
-        let peak = subsynchronous_peak(&self.spectrum, SPECTRUM_REVOLUTIONS);
+        let spectrum = &self.spectrum[bi * SPECTRUM_REVOLUTIONS..(bi + 1) * SPECTRUM_REVOLUTIONS];
+        let one_x = one_x_component(spectrum, SPECTRUM_REVOLUTIONS);
+        let peak = subsynchronous_peak(spectrum, SPECTRUM_REVOLUTIONS);
         let subsync_m = peak.semi_major_m();
         let span = self.whirl_span(&peak, c);
         let r = self.last_revolution(bi, self.recent_samples(span));
         let rub = self.last_revolution(bi, last);
-        let (orbit_diff, pressure_diff) = self.rev_to_rev(bi, last);
+        let orbit_diff = self.rev_to_rev(bi, last);
+        let pressure_diff = self.pressure.rev_to_rev(bi);
         let old = self.report.bearings[bi];
         let path_diff = self.path_diff(bi, last).unwrap_or(old.orbit_path_diff);
         let s = self.settings;
@@ -807,6 +855,15 @@ fn lagrange_weights(x: [f64; 4], t: f64) -> [f64; 4] {
     w
 }
 
+/// The larger of `a` and `b` (either when equal; for finite values: no NaN handling).
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
 /// Squared distance from point (px, py) to the segment (ax, ay)–(bx, by).
 fn point_segment_distance2(px: f64, py: f64, ax: f64, ay: f64, bx: f64, by: f64) -> f64 {
     let (dx, dy) = (bx - ax, by - ay);
@@ -823,6 +880,131 @@ fn point_segment_distance2(px: f64, py: f64, ax: f64, ay: f64, bx: f64, by: f64)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A monitor of two bearings of 60 µm clearance fed `revs` revolutions of a synthetic
+    /// orbit at `per_rev` samples a revolution (a step a little off a whole fraction of the
+    /// revolution): a 1X ellipse, a half-speed forward whirl and a slow drift, different in
+    /// the two bearings; `check` is called after each completed revolution.
+    fn feed(per_rev: usize, revs: usize, mut check: impl FnMut(&Monitor)) {
+        let c = 60e-6;
+        let mut m = Monitor::with_clearances(
+            &[c, c],
+            [0.95, 1e-6],
+            2 * per_rev,
+            ClassifierSettings::default(),
+        );
+        let dpsi = TAU / (per_rev as f64 + 0.37);
+        for i in 0..(revs as f64 * (per_rev as f64 + 0.37)) as usize {
+            let psi = i as f64 * dpsi;
+            let orbit = |k: f64| {
+                let (one, half, drift) = (3e-6 * k, 12e-6 / k, 1.0 + 1e-3 * psi);
+                [
+                    one * psi.cos() + half * drift * (0.48 * psi).cos(),
+                    0.6 * one * psi.sin() + half * drift * (0.48 * psi).sin(),
+                ]
+            };
+            if m.record_orbit(psi / 942.5, 942.5, psi, &[orbit(1.0), orbit(1.7)])
+                .is_some()
+            {
+                check(&m);
+            }
+        }
+    }
+
+    /// Path distance of bearing `bi`, every point against every segment (the monitor's
+    /// computation before the bounding-box test).
+    fn path_diff_all_segments(m: &Monitor, bi: usize, last: usize) -> Option<f64> {
+        let h = &m.bearings[bi];
+        if last <= 1 || m.len < 3 * last {
+            return None;
+        }
+        let stride = last.div_ceil(32);
+        let (mut sum, mut points) = (0.0, 0usize);
+        for back in (0..last).step_by(stride) {
+            points += 1;
+            let p = m.idx(back);
+            let mut best = f64::MAX;
+            for j in last..3 * last - 1 {
+                let (a, b) = (m.idx(j), m.idx(j + 1));
+                best = best.min(point_segment_distance2(
+                    h.x[p], h.y[p], h.x[a], h.y[a], h.x[b], h.y[b],
+                ));
+            }
+            sum += best;
+        }
+        Some((sum / points as f64).sqrt() / h.clearance_m)
+    }
+
+    /// The path distance with the segments' bounding boxes skipped is the minimum over all
+    /// segments to the last bit (a minimum does not depend on the order, and the test skips
+    /// only segments that cannot lower it), for every revolution of a whirling orbit at 64 and
+    /// 128 samples a revolution, both bearings; and it is not trivially zero (the drift).
+    #[test]
+    fn path_distance_with_bounding_boxes_is_the_full_minimum() {
+        for per_rev in [64, 128] {
+            let mut compared = 0;
+            feed(per_rev, 40, |m| {
+                let last = *m.rev_lengths.last().unwrap_or(&0);
+                for bi in 0..2 {
+                    let all = path_diff_all_segments(m, bi, last);
+                    let pruned = m.clone().path_diff(bi, last);
+                    assert_eq!(pruned, all, "{per_rev} a revolution, bearing {bi}");
+                    if let Some(d) = all {
+                        assert!(d > 1e-6, "path distance {d}");
+                        compared += 1;
+                    }
+                }
+            });
+            // 40 revolutions, the first few without three stored
+            assert!(compared >= 2 * 36, "{compared} comparisons");
+        }
+    }
+
+    /// The joint spectra of the bearings equal each bearing's own [`order_spectrum`] to the
+    /// last bit (the same sums in the same order), over a full window of the synthetic orbit.
+    #[test]
+    fn joint_spectra_equal_each_bearings_spectrum() {
+        feed(64, 20, |m| {
+            let window = m.recent_samples(SPECTRUM_REVOLUTIONS);
+            for bi in 0..2 {
+                let own = m.full_spectrum(bi);
+                let picked = &m.picked;
+                let mut single = vec![OrderComponent::default(); SPECTRUM_REVOLUTIONS];
+                let rows = picked.len() / 5;
+                order_spectrum(
+                    (0..rows).map(|r| picked[5 * r + 1 + 2 * bi]),
+                    (0..rows).map(|r| picked[5 * r + 2 + 2 * bi]),
+                    (0..rows).map(|r| picked[5 * r]),
+                    rows,
+                    SPECTRUM_REVOLUTIONS,
+                    &mut single,
+                );
+                let joint = &m.spectrum[bi * SPECTRUM_REVOLUTIONS..(bi + 1) * SPECTRUM_REVOLUTIONS];
+                assert_eq!(joint, &single[..], "bearing {bi}, window {window}");
+                // and the 1X of the whole window is the 3 µm (× 1, 1.7) ellipse's, within 5 %
+                let one_x = one_x_component(&own, SPECTRUM_REVOLUTIONS).semi_major_m();
+                let expected = 3e-6 * [1.0, 1.7][bi];
+                if window >= SPECTRUM_REVOLUTIONS * 64 {
+                    assert!((one_x / expected - 1.0).abs() < 0.05, "1X {one_x}");
+                }
+            }
+        });
+    }
+
+    /// The profiles kept: 32 a revolution at 64 and 128 steps a revolution (every second or
+    /// fourth step), 31–33 at 100 (every third: 100.37/3), over the two revolutions a pressure
+    /// map shows.
+    #[test]
+    fn pressure_profiles_are_kept_32_a_revolution() {
+        for (per_rev, lo, hi) in [(64, 64, 66), (128, 64, 66), (100, 64, 68)] {
+            let mut last = 0;
+            feed(per_rev, 10, |m| last = m.recent_pressure(0, 2).len());
+            assert!(
+                (lo..=hi).contains(&last),
+                "{per_rev}: {last} profiles in two revolutions"
+            );
+        }
+    }
 
     /// The ring position by subtraction is the remainder the monitor took before, (head + 2
     /// capacity − 1 − back) mod capacity, for every head and every look-back it uses (under

@@ -90,6 +90,87 @@ pub fn order_spectrum(
     }
 }
 
+/// Signals one pass of [`order_spectra`] accumulates together (its accumulators are on the
+/// stack).
+const SIGNALS_A_PASS: usize = 4;
+
+/// [`order_spectrum`] of several orbits sampled at the same shaft angles, in one pass over the
+/// samples (a pass per [`SIGNALS_A_PASS`] orbits): the window, the sine and cosine of each
+/// sample's angle and the phasor's powers are computed once for all of them. `samples` holds
+/// rows of 1 + 2 `signals` values: the angle (rad), then x and y (m) of each orbit; `out`
+/// receives `max_k` components an orbit (orbit s at `s * max_k`). Each orbit's sums are the
+/// ones of [`order_spectrum`], in the same order: the results are equal to the last bit.
+/// Allocates nothing.
+pub fn order_spectra(
+    samples: &[f64],
+    signals: usize,
+    resolution: usize,
+    max_k: usize,
+    out: &mut [OrderComponent],
+) {
+    let row = 1 + 2 * signals;
+    let n = samples.len() / row;
+    for (i, o) in out.iter_mut().take(signals * max_k).enumerate() {
+        *o = OrderComponent {
+            order: (i % max_k + 1) as f64 / resolution as f64,
+            ..OrderComponent::default()
+        };
+    }
+    if n < 4 {
+        return;
+    }
+    for first in (0..signals).step_by(SIGNALS_A_PASS) {
+        let m = (signals - first).min(SIGNALS_A_PASS);
+        let column = |i: usize, c: usize| samples[i * row + c];
+        let mean = |c: usize| (0..n).map(|i| column(i, c)).sum::<f64>() / n as f64;
+        let means: [[f64; 2]; SIGNALS_A_PASS] = std::array::from_fn(|s| {
+            if s < m {
+                [mean(1 + 2 * (first + s)), mean(2 + 2 * (first + s))]
+            } else {
+                [0.0; 2]
+            }
+        });
+        let angle0 = (column(0, 0) / std::f64::consts::TAU).round() * std::f64::consts::TAU;
+        let mut acc = [[[0.0_f64; 4]; 64]; SIGNALS_A_PASS];
+        let kmax = max_k.min(64);
+        let mut wsum = 0.0;
+        for i in 0..n {
+            let w = 0.5 - 0.5 * (std::f64::consts::TAU * (i as f64 + 0.5) / n as f64).cos();
+            wsum += w;
+            let z: [[f64; 2]; SIGNALS_A_PASS] = std::array::from_fn(|s| {
+                let c = 1 + 2 * (first + s.min(m - 1));
+                [
+                    w * (column(i, c) - means[s][0]),
+                    w * (column(i, c + 1) - means[s][1]),
+                ]
+            });
+            let (sn, cs) = ((column(i, 0) - angle0) / resolution as f64).sin_cos();
+            let (br, bi) = (cs, -sn);
+            let (mut pr, mut pi) = (1.0, 0.0);
+            for k in 0..kmax {
+                let (nr, ni) = (pr * br - pi * bi, pr * bi + pi * br);
+                pr = nr;
+                pi = ni;
+                for (a, &[zr, zi]) in acc.iter_mut().zip(&z).take(m) {
+                    let r = &mut a[k];
+                    r[0] += zr * pr - zi * pi;
+                    r[1] += zr * pi + zi * pr;
+                    r[2] += zr * pr + zi * pi;
+                    r[3] += -zr * pi + zi * pr;
+                }
+            }
+        }
+        for (s, a) in acc.iter().enumerate().take(m) {
+            let o = &mut out[(first + s) * max_k..(first + s + 1) * max_k];
+            for (o, r) in o.iter_mut().zip(a).take(kmax) {
+                o.forward_m = r[0].hypot(r[1]) / wsum;
+                o.backward_m = r[2].hypot(r[3]) / wsum;
+                o.forward_phase_rad = r[1].atan2(r[0]);
+            }
+        }
+    }
+}
+
 /// The Hann window's amplitude response, normalised by its coherent gain, to a tone `delta`
 /// bins from a bin centre (|δ| < 2), in the limit of many samples:
 /// W(δ) = sin(πδ) / (πδ (1 − δ²)) (Harris, Proc. IEEE 66 (1978) 51, the Hann kernel).
