@@ -179,7 +179,7 @@ impl Driver {
         if self.keyphasor_stopped(t_ns) {
             return PhaseReference::Stopped;
         }
-        if s.keyphasor.is_locked() && self.session.is_some() {
+        if s.keyphasor.is_locked() && self.session.is_some() && !self.lock_lapsed(t_ns) {
             PhaseReference::Locked
         } else {
             PhaseReference::NotLocked
@@ -215,8 +215,19 @@ impl Driver {
     /// True if no event is stamped within [`KEYPHASOR_STOP_REVS`] revolutions at the speed in
     /// force plus [`KEYPHASOR_JITTER_S`] before `t_ns` (a stamp time).
     fn keyphasor_stopped(&self, t_ns: i64) -> bool {
-        let (Some(last), Some(w)) = (self.signals.keyphasor.last_event_ns(), self.speed_rad_s())
-        else {
+        self.beyond_stop_limit(self.signals.keyphasor.last_event_ns(), t_ns)
+    }
+
+    /// Events come but none has been accepted for as long as a stop takes (a keyphasor that
+    /// steadily contradicts the speed): the twin's angle is no longer held to the mark.
+    fn lock_lapsed(&self, t_ns: i64) -> bool {
+        self.beyond_stop_limit(self.signals.keyphasor.last_accepted_ns(), t_ns)
+    }
+
+    /// Whether `t_ns` is more than [`KEYPHASOR_STOP_REVS`] revolutions (at the speed in force)
+    /// plus [`KEYPHASOR_JITTER_S`] after `since_ns`.
+    fn beyond_stop_limit(&self, since_ns: Option<i64>, t_ns: i64) -> bool {
+        let (Some(last), Some(w)) = (since_ns, self.speed_rad_s()) else {
             return false;
         };
         let limit_s = KEYPHASOR_STOP_REVS * TAU / w.max(1e-3) + KEYPHASOR_JITTER_S;

@@ -28,12 +28,13 @@
 //! ρ beyond 1 ± [`KeyphasorSettings::speed_mismatch`], agreeing within it, the event reports the
 //! mean ρ ([`KeyphasorEvent::speed_ratio`]: the driver scales the speed topic by it) and
 //! corrects the whole error, without a relock. Only with a speed topic: a speed from the
-//! keyphasor's own intervals has nothing to disagree with. A speed topic off by more than the
-//! interval tolerance (a wrong pulses-per-turn count, a tachometer scale far off) has every
-//! event refused by the interval check; there the events' own intervals, taken whatever the
-//! check said ([`RawIntervals`]), tell it: when the last `mismatch_revs` of them agree within
-//! `speed_mismatch` and all contradict the topic, the event is accepted with their mean speed
-//! over the topic's as the ratio, as above.
+//! keyphasor's own intervals has nothing to disagree with. Beyond the interval tolerance the
+//! keyphasor contradicts the speed (issue 12: reported, the twin carries on with the speed):
+//! every such event is refused; when the events' own intervals, taken whatever the check said
+//! ([`RawIntervals`]), agree over the last `mismatch_revs` revolutions while the topic stayed
+//! steady, the refusal says so with both speeds and their ratio (a speed topic or a keyphasor
+//! set up wrong: a pulses-per-turn count, a mark on another shaft, two notches), since which
+//! of the two is right cannot be told from them.
 
 use std::f64::consts::{PI, TAU};
 
@@ -373,8 +374,8 @@ pub struct KeyphasorLock {
     drift: DriftTrack,
     /// the events' own intervals, accepted or not
     raw: RawIntervals,
-    /// a gross speed mismatch found by the interval check at this event (plant over topic)
-    gross_ratio: Option<f64>,
+    /// time of the last event whose interval was accepted (ns)
+    last_accepted_ns: Option<i64>,
 }
 
 /// The times of the last events, each after the one before, whatever the checks said, with
@@ -427,16 +428,6 @@ impl RawIntervals {
         let beyond = lo > topic * (1.0 + interval_tol) || hi < topic * (1.0 - interval_tol);
         (beyond && hi - lo <= tol * mean).then_some(mean)
     }
-
-    /// The newest interval's speed (rad/s), if two events are known.
-    fn last_speed(&self) -> Option<f64> {
-        let n = self.times_ns.len();
-        (self.len >= 2).then(|| {
-            let dt =
-                self.times_ns[(self.next + n - 1) % n] - self.times_ns[(self.next + n - 2) % n];
-            TAU / (dt as f64 * 1e-9)
-        })
-    }
 }
 
 /// `a` wrapped into (−π, π].
@@ -466,6 +457,12 @@ impl KeyphasorLock {
     /// True once an event has locked the twin running now.
     pub fn is_locked(&self) -> bool {
         self.locked
+    }
+
+    /// Time of the last event whose interval the check accepted (ns): a lock whose events are
+    /// all refused for revolutions no longer holds the twin's angle to the mark.
+    pub fn last_accepted_ns(&self) -> Option<i64> {
+        self.last_accepted_ns
     }
 
     /// Time of the last accepted (or interval-checked) event (ns).
@@ -512,17 +509,6 @@ impl KeyphasorLock {
             relocked: false,
             speed_ratio: None,
         };
-        if let Some(rho) = self.gross_ratio.take() {
-            // the speed topic far off: the twin's angle is wrong by all of its error
-            ev.speed_ratio = Some(rho);
-            self.pending = None;
-            let e = twin_angle_rad.map(|theta| wrap_pi(-theta));
-            self.drift
-                .reset(twin_angle_rad.zip(e).map(|(theta, e)| theta + e));
-            ev.correction_rad = e;
-            self.locked |= e.is_some();
-            return Ok(ev);
-        }
         let Some(theta) = twin_angle_rad else {
             self.drift.reset(None);
             return Ok(ev);
@@ -563,6 +549,7 @@ impl KeyphasorLock {
         self.raw.push(t_ns, speed.filter(|s| *s > 0.0));
         let Some(last) = self.last_event_ns else {
             self.last_event_ns = Some(t_ns);
+            self.last_accepted_ns = Some(t_ns);
             return Ok(None);
         };
         if t_ns <= last {
@@ -581,17 +568,21 @@ impl KeyphasorLock {
         let tol = self.settings.interval_tolerance;
         match topic.or(self.last_interval_speed) {
             Some(r) if (w / r - 1.0).abs() > tol => {
-                if let Some(rho) = topic.and_then(|t| self.gross_mismatch(t)) {
-                    self.gross_ratio = Some(rho);
-                    self.last_event_ns = Some(t_ns);
-                    self.last_interval_speed = self.raw.last_speed();
-                    self.interval_refusals = 0;
-                    return Ok(self.last_interval_speed);
+                let steady = topic.and_then(|t| self.steady_contradiction(t));
+                let mut refusal = self.refuse_interval(t_ns, dt, w, r, topic);
+                if let Some((w_raw, rho)) = steady {
+                    refusal.why = format!(
+                        "keyphasor contradicts the speed topic steadily: its last {} revolutions all turned at {:.1} rpm, {rho:.4} times the topic's {:.1} rpm (a speed topic or a keyphasor set up wrong: pulses per turn, a mark on another shaft, two notches); events refused, the twin carries on with the speed topic",
+                        self.settings.mismatch_revs,
+                        w_raw * 30.0 / PI,
+                        r * 30.0 / PI
+                    );
                 }
-                Err(self.refuse_interval(t_ns, dt, w, r, topic))
+                Err(refusal)
             }
             _ => {
                 self.last_event_ns = Some(t_ns);
+                self.last_accepted_ns = Some(t_ns);
                 self.last_interval_speed = Some(w);
                 self.interval_refusals = 0;
                 Ok(Some(w))
@@ -599,15 +590,16 @@ impl KeyphasorLock {
         }
     }
 
-    /// A speed topic `topic` (rad/s) off by more than the interval tolerance: the last
+    /// The keyphasor contradicting a steady speed topic `topic` (rad/s) steadily: the last
     /// `mismatch_revs` intervals of the events themselves agree within `speed_mismatch` and
-    /// all contradict it. The plant's speed over the topic's, or None.
-    fn gross_mismatch(&self, topic: f64) -> Option<f64> {
+    /// all contradict it by more than the interval tolerance. Their speed (rad/s) and its ratio
+    /// to the topic's, or None.
+    fn steady_contradiction(&self, topic: f64) -> Option<(f64, f64)> {
         let s = &self.settings;
         let k = s.mismatch_revs as usize;
         self.raw
             .steady_beyond(k, s.speed_mismatch, topic, s.interval_tolerance)
-            .map(|w| w / topic)
+            .map(|w| (w, w / topic))
     }
 
     /// Refuses an event whose interval `dt` (s, speed `w`) contradicts the reference `r`: too
