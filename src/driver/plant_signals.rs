@@ -218,10 +218,15 @@ impl Driver {
         self.beyond_stop_limit(self.signals.keyphasor.last_event_ns(), t_ns)
     }
 
-    /// Events come but none has been accepted for as long as a stop takes (a keyphasor that
-    /// steadily contradicts the speed): the twin's angle is no longer held to the mark.
+    /// Events come but none has been accepted whole for as long as a stop takes, or one
+    /// steadily contradicted the speed topic within that time (a keyphasor at a whole multiple
+    /// of the topic's speed has every n-th event accepted): the twin's angle is not held to
+    /// the mark.
     fn lock_lapsed(&self, t_ns: i64) -> bool {
-        self.beyond_stop_limit(self.signals.keyphasor.last_accepted_ns(), t_ns)
+        let lock = &self.signals.keyphasor;
+        let contradicted = lock.last_contradiction_ns().is_some();
+        self.beyond_stop_limit(lock.last_accepted_ns(), t_ns)
+            || (contradicted && !self.beyond_stop_limit(lock.last_contradiction_ns(), t_ns))
     }
 
     /// Whether `t_ns` is more than [`KEYPHASOR_STOP_REVS`] revolutions (at the speed in force)

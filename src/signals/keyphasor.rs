@@ -374,8 +374,10 @@ pub struct KeyphasorLock {
     drift: DriftTrack,
     /// the events' own intervals, accepted or not
     raw: RawIntervals,
-    /// time of the last event whose interval was accepted (ns)
+    /// time of the last event accepted whole (interval and angle) (ns)
     last_accepted_ns: Option<i64>,
+    /// time of the last event that steadily contradicted the speed topic (ns)
+    last_contradiction_ns: Option<i64>,
 }
 
 /// The times of the last events, each after the one before, whatever the checks said, with
@@ -459,10 +461,28 @@ impl KeyphasorLock {
         self.locked
     }
 
-    /// Time of the last event whose interval the check accepted (ns): a lock whose events are
+    /// Time of the last event accepted whole, interval and angle (ns): a lock whose events are
     /// all refused for revolutions no longer holds the twin's angle to the mark.
     pub fn last_accepted_ns(&self) -> Option<i64> {
         self.last_accepted_ns
+    }
+
+    /// Time of the last event that steadily contradicted the speed topic (ns): a keyphasor at
+    /// a whole multiple of the topic's speed has every n-th event accepted, on a twin turning
+    /// at the wrong speed, so no lock holds while they come.
+    pub fn last_contradiction_ns(&self) -> Option<i64> {
+        self.last_contradiction_ns
+    }
+
+    /// Whether, at `t_ns` and speed `w` (rad/s), no event has been accepted whole for as long
+    /// as a stop takes ([`KEYPHASOR_STOP_REVS`] revolutions and [`KEYPHASOR_JITTER_S`]).
+    fn lapsed(&self, t_ns: i64, w: Option<f64>) -> bool {
+        match (self.last_accepted_ns, w) {
+            (Some(a), Some(w)) if w > 0.0 => {
+                (t_ns - a) as f64 * 1e-9 > KEYPHASOR_STOP_REVS * TAU / w + KEYPHASOR_JITTER_S
+            }
+            _ => false,
+        }
     }
 
     /// Time of the last accepted (or interval-checked) event (ns).
@@ -503,6 +523,30 @@ impl KeyphasorLock {
                 return Err(r);
             }
         };
+        let w = speed_rad_s.filter(|s| *s > 0.0).or(interval_speed);
+        if self.locked && self.lapsed(t_ns, w) {
+            // every event refused for a stop's length (a keyphasor that contradicted the speed,
+            // or stopped): the angle is no longer held, so this event locks afresh (its whole
+            // error, as the first event did) rather than counting as a jump of the mark
+            self.locked = false;
+            self.pending = None;
+            self.drift.reset(None);
+        }
+        let out = self.angle_event(interval_speed, twin_angle_rad, speed_rad_s);
+        if out.is_ok() {
+            self.last_accepted_ns = Some(t_ns);
+        }
+        out
+    }
+
+    /// The angle part of an event whose interval was accepted (`interval_speed`, rad/s): the
+    /// twin's angle `twin_angle_rad` there against the mark, the speed topic `speed_rad_s`.
+    fn angle_event(
+        &mut self,
+        interval_speed: Option<f64>,
+        twin_angle_rad: Option<f64>,
+        speed_rad_s: Option<f64>,
+    ) -> Result<KeyphasorEvent, KeyphasorRefusal> {
         let mut ev = KeyphasorEvent {
             correction_rad: None,
             interval_speed_rad_s: interval_speed,
@@ -549,7 +593,6 @@ impl KeyphasorLock {
         self.raw.push(t_ns, speed.filter(|s| *s > 0.0));
         let Some(last) = self.last_event_ns else {
             self.last_event_ns = Some(t_ns);
-            self.last_accepted_ns = Some(t_ns);
             return Ok(None);
         };
         if t_ns <= last {
@@ -571,6 +614,7 @@ impl KeyphasorLock {
                 let steady = topic.and_then(|t| self.steady_contradiction(t));
                 let mut refusal = self.refuse_interval(t_ns, dt, w, r, topic);
                 if let Some((w_raw, rho)) = steady {
+                    self.last_contradiction_ns = Some(t_ns);
                     refusal.why = format!(
                         "keyphasor contradicts the speed topic steadily: its last {} revolutions all turned at {:.1} rpm, {rho:.4} times the topic's {:.1} rpm (a speed topic or a keyphasor set up wrong: pulses per turn, a mark on another shaft, two notches); events refused, the twin carries on with the speed topic",
                         self.settings.mismatch_revs,
@@ -582,7 +626,6 @@ impl KeyphasorLock {
             }
             _ => {
                 self.last_event_ns = Some(t_ns);
-                self.last_accepted_ns = Some(t_ns);
                 self.last_interval_speed = Some(w);
                 self.interval_refusals = 0;
                 Ok(Some(w))
@@ -815,6 +858,42 @@ mod tests {
     /// angle turned by each correction and its speed scaled by each reported ratio, as the
     /// driver does. (Reported ratios, relocks, refusals, the twin's angle error at the last
     /// event in degrees.)
+    /// A plant at 1.15 × the told speed for 20 revolutions (every event refused: it contradicts
+    /// the speed), then at the told speed again: the lock lapsed, so the first event accepted
+    /// after locks afresh with the twin's whole angle error (no relock, which would restate
+    /// every heavy spot as if the mark had moved), and the next events find the angle right.
+    /// Before session 16 the lapse was not seen: that event's error (the drift of 20
+    /// revolutions at 15 %) was refused as a jump and the third agreeing one relocked.
+    #[test]
+    fn after_a_lapse_the_next_accepted_event_locks_afresh_without_a_relock() {
+        let mut lock = KeyphasorLock::new(KeyphasorSettings::default());
+        let (mut theta, mut t, mut t_prev) = (0.0, 0.0f64, 0.0);
+        let (mut relocks, mut refusals, mut errors) = (0, 0, Vec::new());
+        for k in 0..40 {
+            let wp = if k < 20 { 1.15 * W } else { W };
+            t += if k == 0 { 0.0 } else { TAU / wp };
+            theta += W * (t - t_prev);
+            t_prev = t;
+            match lock.event((t * 1e9).round() as i64, Some(theta), Some(W)) {
+                Ok(ev) => {
+                    theta += ev.correction_rad.unwrap();
+                    relocks += u32::from(ev.relocked);
+                    // event 21 locks afresh with its whole error (3.0 rad here); after it
+                    if k > 21 {
+                        errors.push(wrap_pi(-(theta - ev.correction_rad.unwrap())).abs());
+                    }
+                }
+                Err(_) => refusals += 1,
+            }
+        }
+        assert_eq!(relocks, 0);
+        // events 1–19 contradict the speed; event 20 is the first at the told speed after a
+        // 15 % faster revolution's interval (refused too), 21 on are accepted
+        assert_eq!(refusals, 20, "{refusals}");
+        assert!(errors.iter().all(|e| *e < 1e-6), "{errors:?}");
+        assert!(lock.is_locked());
+    }
+
     fn follow(ratio: f64, mark_deg: f64, revs: usize) -> (Vec<f64>, u32, u32, f64) {
         let mut lock = KeyphasorLock::new(KeyphasorSettings::default());
         let (wp, mut w) = (W * ratio, W);
