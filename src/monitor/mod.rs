@@ -522,29 +522,18 @@ impl Monitor {
     /// comparison on the sampled profiles ([`PressureRing::rev_to_rev`]).
     fn rev_to_rev(&self, bi: usize, last: usize) -> f64 {
         let h = &self.bearings[bi];
-        if last == 0 || self.len < last + 4 {
-            return f64::NAN;
-        }
-        let angle = |back: usize| self.angle[self.idx(back)];
         let mut d2 = 0.0;
-        // k: the newer of the two samples of the earlier revolution that bracket the target
-        let mut k = last.saturating_sub(1).max(1);
-        for back in 0..last {
-            let target = angle(back) - TAU;
-            while k + 2 < self.len && angle(k + 1) > target {
-                k += 1;
-            }
-            if k + 2 >= self.len || angle(k) < target {
-                return f64::NAN;
-            }
-            let nodes = [k - 1, k, k + 1, k + 2];
-            let w = lagrange_weights(nodes.map(angle), target);
+        let angle = |back: usize| self.angle[self.idx(back)];
+        let complete = one_revolution_back(self.len, last, angle, |back, nodes, w| {
             let i = self.idx(back);
             let slots = nodes.map(|n| self.idx(n));
             let at = |v: &[f64]| slots.iter().zip(&w).map(|(&n, w)| w * v[n]).sum::<f64>();
             d2 += (h.x[i] - at(&h.x)).powi(2) + (h.y[i] - at(&h.y)).powi(2);
+        });
+        match complete {
+            true => (d2 / last as f64).sqrt() / h.clearance_m,
+            false => f64::NAN,
         }
-        (d2 / last as f64).sqrt() / h.clearance_m
     }
 
     /// Path distance of bearing `bi`: each point of the last revolution to the polyline of the
@@ -840,6 +829,36 @@ fn ring_index(head: usize, capacity: usize, back: usize) -> usize {
     } else {
         v
     }
+}
+
+/// Walks the last revolution of a ring of `len` samples (`last` of them, newest first, by
+/// look-back) against the same shaft angle one revolution earlier: for each, `visit(back,
+/// nodes, weights)` with the four look-backs of the earlier revolution around that angle and
+/// their cubic Lagrange weights in the angle (`angle(back)`, rad). False (and the walk stopped)
+/// when not enough is stored.
+fn one_revolution_back(
+    len: usize,
+    last: usize,
+    angle: impl Fn(usize) -> f64,
+    mut visit: impl FnMut(usize, [usize; 4], [f64; 4]),
+) -> bool {
+    if last == 0 || len < last + 4 {
+        return false;
+    }
+    // k: the newer of the two samples of the earlier revolution that bracket the target
+    let mut k = last.saturating_sub(1).max(1);
+    for back in 0..last {
+        let target = angle(back) - TAU;
+        while k + 2 < len && angle(k + 1) > target {
+            k += 1;
+        }
+        if k + 2 >= len || angle(k) < target {
+            return false;
+        }
+        let nodes = [k - 1, k, k + 1, k + 2];
+        visit(back, nodes, lagrange_weights(nodes.map(&angle), target));
+    }
+    true
 }
 
 /// Weights of the cubic Lagrange interpolant through nodes `x` (distinct) at `t`.

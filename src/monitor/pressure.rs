@@ -6,8 +6,7 @@
 //! serves only the revolution-to-revolution pressure difference (a published figure, not
 //! evidence of the classifier) and the pressure maps of the last two revolutions.
 
-use super::{lagrange_weights, ring_index, PRESSURE_POINTS};
-use std::f64::consts::TAU;
+use super::{one_revolution_back, ring_index, PRESSURE_POINTS};
 
 /// Pressure profiles kept a revolution (about: the stride is the nearest whole number of steps).
 pub const PRESSURE_SAMPLES_PER_REV: usize = 32;
@@ -125,23 +124,10 @@ impl PressureRing {
     /// it (Lagrange, in the angle, as the orbit difference); NaN when not enough is stored.
     pub(super) fn rev_to_rev(&self, bearing: usize) -> f64 {
         let last = self.rev_counts.last().map_or(0, |&n| n.min(self.len));
-        if last == 0 || self.len < last + 4 {
-            return f64::NAN;
-        }
         let h = &self.profiles[bearing];
         let angle = |back: usize| self.angle[self.idx(back)];
         let (mut pd2, mut p2) = (0.0, 0.0);
-        let mut k = last.saturating_sub(1).max(1);
-        for back in 0..last {
-            let target = angle(back) - TAU;
-            while k + 2 < self.len && angle(k + 1) > target {
-                k += 1;
-            }
-            if k + 2 >= self.len || angle(k) < target {
-                return f64::NAN;
-            }
-            let nodes = [k - 1, k, k + 1, k + 2];
-            let w = lagrange_weights(nodes.map(angle), target);
+        let complete = one_revolution_back(self.len, last, angle, |back, nodes, w| {
             let i = self.idx(back);
             let a = &h[i * PRESSURE_POINTS..(i + 1) * PRESSURE_POINTS];
             let profiles = nodes.map(|n| {
@@ -153,6 +139,9 @@ impl PressureRing {
                 pd2 += (u - v).powi(2);
                 p2 += u * u;
             }
+        });
+        if !complete {
+            return f64::NAN;
         }
         if p2 > 0.0 {
             (pd2 / p2).sqrt()

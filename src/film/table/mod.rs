@@ -289,9 +289,16 @@ impl Node {
     /// [`source_frame`], it stays the same, as do the scalars).
     #[inline]
     fn add(&mut self, w: f64, [sign, force_sign]: [f64; 2], m: &Node) {
-        let ws = sign * w;
         self.force[0] += force_sign * w * m.force[0];
         self.force[1] += force_sign * w * m.force[1];
+        self.add_outputs(w, sign, m);
+    }
+
+    /// [`add`](Self::add) without the force: `w` × `m`'s outputs (`sign` −1 for a mirrored
+    /// row: its angles turn by π). The lean evaluation's outputs of the accepted iterate.
+    #[inline]
+    pub(super) fn add_outputs(&mut self, w: f64, sign: f64, m: &Node) {
+        let ws = sign * w;
         self.p_max += w * m.p_max;
         for k in 0..3 {
             self.angles[k][0] += ws * m.angles[k][0];

@@ -140,7 +140,7 @@ impl FilmModel for TabulatedFilm {
             ..Node::default()
         };
         for &(index, [sign, _], w) in &lean.nodes {
-            add_outputs(&mut n, w, sign, &self.table.nodes[index]);
+            n.add_outputs(w, sign, &self.table.nodes[index]);
         }
         Some(result_of(&lean.s, &n, lean.omega))
     }
@@ -240,23 +240,6 @@ impl TabulatedFilm {
         lean.force = f;
         (lean, f_eps, f_psi)
     }
-}
-
-/// `Node::add` without the force: adds `w` × `m`'s outputs to `n` (`sign` −1 for a mirrored
-/// row: its angles turn by π), the same products as `Node::add`.
-#[inline]
-fn add_outputs(n: &mut Node, w: f64, sign: f64, m: &Node) {
-    let ws = sign * w;
-    n.p_max += w * m.p_max;
-    for k in 0..3 {
-        n.angles[k][0] += ws * m.angles[k][0];
-        n.angles[k][1] += ws * m.angles[k][1];
-    }
-    n.torque_pressure += w * m.torque_pressure;
-    n.torque_couette += w * m.torque_couette;
-    n.side_flow += w * m.side_flow;
-    n.inflow_pressure += w * m.inflow_pressure;
-    n.inflow_couette += w * m.inflow_couette;
 }
 
 /// Column `i` of a grid of `n` columns around the circumference, wrapped into 0..n: equal to
