@@ -18,6 +18,7 @@
 mod common;
 
 use common::calibration::{plant_rotor, twin_rotor};
+use common::onset::onset_by_rule;
 use rotor_twin::dynamics::{Coupling, FilmEvaluation, StepInput, Twin, TwinConfig};
 use rotor_twin::film::{set_disk_cache, TableCache};
 use rotor_twin::monitor::{ClassifierSettings, Monitor};
@@ -136,23 +137,6 @@ fn run(
 /// The first revolution from which 24 in a row count.
 fn onset_24(per_rev: &PerRev) -> Option<usize> {
     (0..per_rev.len()).find(|&k| k + 24 <= per_rev.len() && per_rev[k..k + 24].iter().all(|p| p.2))
-}
-
-/// The replay's onset rule on per-revolution bearing values (tests/onset_study.rs): blocks of
-/// 8 revolutions, the first 3 consecutive blocks that count (every revolution of each) whose
-/// amplitude (at the block's end) is ≥ e^(−0.002·8) × the block's before; the speed at the first
-/// block's end.
-fn onset_by_rule(per_rev: &PerRev) -> Option<f64> {
-    let least = (-0.002f64 * 8.0).exp();
-    let blocks: Vec<(f64, f64, bool)> = per_rev
-        .chunks_exact(8)
-        .map(|b| (b[7].0, b[7].1, b.iter().all(|p| p.2)))
-        .collect();
-    (0..blocks.len().saturating_sub(2)).find_map(|k| {
-        let w = &blocks[k..k + 3];
-        let ok = w.iter().all(|b| b.2) && (1..3).all(|j| w[j].1 >= least * w[j - 1].1);
-        ok.then_some(w[0].0)
-    })
 }
 
 #[test]

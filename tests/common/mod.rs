@@ -4,6 +4,7 @@
 pub mod calibration;
 pub mod model_loop;
 pub mod node;
+pub mod onset;
 
 use rotor_twin::film::{
     BearingGeometry, FilmCoefficients, FilmModel, JournalKinematics, Lubricant,
