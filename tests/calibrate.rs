@@ -134,7 +134,8 @@ fn the_sample_bag_gives_its_plant_viscosity_and_unbalance() {
     let bag = rotor_twin::bag::Bag::read(&dir).unwrap();
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, calibrated) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.0, 4.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.0, 4.5], None)
+            .unwrap();
     eprintln!("{cal:?}");
     assert!(
         (cal.viscosity.unwrap().scale / 1.05 - 1.0).abs() < 0.03,
@@ -163,7 +164,8 @@ fn with_a_keyphasor_the_unbalance_phase_is_measured_from_the_mark() {
     let (dir, bag, published) = bag_at_8000_rpm("kp", &[]);
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5], None)
+            .unwrap();
     let p = cal.unbalance.planes[0];
     assert!((p.magnitude_g_mm / 140.0 - 1.0).abs() < 0.10, "{p:?}");
     let dphi = (p.phase_deg - published.phase.to_degrees() + 180.0).rem_euclid(360.0) - 180.0;
@@ -189,7 +191,8 @@ fn replay_calibrate_takes_raw_probes_with_runout() {
     let (dir, bag, published) = bag_at_8000_rpm("raw", &["--raw-probes", "--runout-um", "5"]);
     let rotor = Rotor::from_description(&builtin_with_raw_probes(5e-6));
     let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5], None)
+            .unwrap();
     let p = cal.unbalance.planes[0];
     let v = cal.viscosity.as_ref().unwrap();
     println!(
@@ -212,9 +215,15 @@ fn replay_calibrate_takes_raw_probes_with_runout() {
     );
     // the runout left in: the fit reads the runout as unbalance
     let no_runout = Rotor::from_description(&builtin_with_raw_probes(0.0));
-    let (cal0, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &no_runout, &[], &[], [0.3, 1.5])
-            .unwrap();
+    let (cal0, _) = rotor_twin::replay::calibration::calibrate_bag(
+        &bag,
+        &no_runout,
+        &[],
+        &[],
+        [0.3, 1.5],
+        None,
+    )
+    .unwrap();
     let q = cal0.unbalance.planes[0];
     println!(
         "runout not subtracted: {:.1} g·mm at {:.1}°",
@@ -338,7 +347,7 @@ fn replay_calibrate_fits_the_viscosity_under_the_orbits() {
     let m = bag_measurements(&bag, &twin, &[], &[], window);
     let (means, vectors) = (m.means, m.vectors);
     let before = estimate_viscosity(&twin, &means).unwrap();
-    let (cal, calibrated) = calibrate_bag(&bag, &twin, &[], &[], window).unwrap();
+    let (cal, calibrated) = calibrate_bag(&bag, &twin, &[], &[], window, None).unwrap();
     let v = cal.viscosity.as_ref().unwrap();
     let p = cal.unbalance.planes[1];
     println!(
@@ -418,7 +427,8 @@ fn replay_calibrate_takes_the_speed_from_the_keyphasor() {
     );
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5], None)
+            .unwrap();
     let (p, v) = (cal.unbalance.planes[0], cal.viscosity.unwrap());
     println!(
         "keyphasor only: {} windows; viscosity × {:.4} ± {:.4}; unbalance {:.1} g·mm at {:.1}° (published 140 at {:.1}°)",
@@ -447,7 +457,8 @@ fn replay_calibrate_with_ac_coupled_probes_fits_the_unbalance_alone() {
     let (dir, bag, published) = bag_at_8000_rpm("ac", &["--raw-probes", "--ac-coupled"]);
     let rotor = raw_machine("ac", None);
     let (cal, calibrated) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5], None)
+            .unwrap();
     let p = cal.unbalance.planes[0];
     println!(
         "AC-coupled: {} windows; viscosity {:?}; unbalance {:.1} g·mm at {:.1}° (published 140 at {:.1}°)",
@@ -498,7 +509,8 @@ fn replay_calibrate_measures_the_runout_at_slow_roll() {
     );
     let rotor = raw_machine("dc, reference_gap: 7.87", Some(1500.0));
     let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.9, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.9, 1.5], None)
+            .unwrap();
     for (r, angle) in cal.runouts.iter().zip([45.0f64, 135.0, 45.0, 135.0]) {
         let truth = rotor_twin::plant::plant_runout(5e-6, angle.to_radians());
         let v = r.vector.unwrap_or_default();
@@ -536,7 +548,8 @@ fn replay_calibrate_measures_the_runout_at_slow_roll() {
     // fit reads it as unbalance and misses
     let blind = raw_machine("dc, reference_gap: 7.87", None);
     let (cal0, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &blind, &[], &[], [0.9, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &blind, &[], &[], [0.9, 1.5], None)
+            .unwrap();
     let q = cal0.unbalance.planes[0];
     println!(
         "runout left in: {:.1} g·mm at {:.1}° ({})",
@@ -559,7 +572,8 @@ fn without_a_keyphasor_the_unbalance_phase_is_null_with_the_reason() {
     let (dir, bag, _) = bag_at_8000_rpm("nokp", &["--no-keyphasor"]);
     let rotor = Rotor::from_description(&MachineDescription::builtin_default());
     let (cal, _) =
-        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5]).unwrap();
+        rotor_twin::replay::calibration::calibrate_bag(&bag, &rotor, &[], &[], [0.3, 1.5], None)
+            .unwrap();
     let json = serde_json::to_value(&cal).unwrap();
     let plane = &json["unbalance"]["planes"][0];
     println!("no keyphasor: {plane} ({})", json["phase_null_reason"]);

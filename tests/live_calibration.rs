@@ -8,8 +8,8 @@
 //! 0, and its probe pairs (DC: the static position included) get 0.3 µm of noise; the driver
 //! (linear twin) is fed the speed, the keyphasor and the probes in time order, as the node feeds
 //! it. Targets (the issue's): viscosity within 3 %, unbalance within 10 % and 10°; after the
-//! estimate is applied the predicted 1X within 5 % and 5° of the measured at 8,000 rpm (10 % on
-//! the built-in (B), the raw-probe test). The twin is reading (A) (config/orc_microturbine_100kw_d55.yaml,
+//! estimate is applied the predicted 1X within 5 % and 5° of the measured at 8,000 rpm (on the
+//! built-in (B), the raw-probe test, a nonlinear twin with the unbalance refined on it). The twin is reading (A) (config/orc_microturbine_100kw_d55.yaml,
 //! Ø55, the built-in machine until session 15) wherever an onset or a threshold is checked: those
 //! figures are (A)'s threshold crossing; the raw-probe calibration runs on the built-in (B).
 
@@ -18,7 +18,7 @@ mod common;
 use common::calibration::{plant_rotor, twin_rotor_d55, twin_rotor_with_raw_probes};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use rotor_twin::driver::calibration::estimate;
+use rotor_twin::driver::calibration::{estimate, CALIBRATION_BLEND_S};
 use rotor_twin::driver::{
     Applied, Driver, DriverSettings, Fed, Input, LiveCalibration, LiveEstimate, ModelKind,
     ObserverGains, OneXBlock, OneXBlocks, ProbeRef, StationRef,
@@ -348,8 +348,11 @@ fn calibrate(
     mark_deg: f64,
     probes: PlantProbes,
 ) -> (Rig, Vec<OneXBlock>, LiveEstimate) {
-    calibrate_with(twin, mark_deg, probes, Vec::new(), None)
+    calibrate_with(twin, mark_deg, probes, Vec::new(), None, LINEAR)
 }
+
+/// The linear twin on the direct film.
+const LINEAR: (ModelKind, FilmEvaluation) = (ModelKind::Linear, FilmEvaluation::Direct);
 
 /// [`calibrate`] with `more` drivers fed the same plant alongside; the plant's speed steps from
 /// one calibration speed to the next at once, or ramps at `ramp_rpm_s` (rpm/s).
@@ -359,16 +362,13 @@ fn calibrate_with(
     probes: PlantProbes,
     more: Vec<Driver>,
     ramp_rpm_s: Option<f64>,
+    (kind, film): (ModelKind, FilmEvaluation),
 ) -> (Rig, Vec<OneXBlock>, LiveEstimate) {
     let plant = plant_rotor(twin);
     let w8 = 8000.0 * PI / 30.0;
     let config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w8, 64);
     let w5 = 5000.0 * PI / 30.0;
-    let settings = DriverSettings::new(
-        ModelKind::Linear,
-        FilmEvaluation::Direct,
-        twin.rated_speed_rad_s,
-    );
+    let settings = DriverSettings::new(kind, film, twin.rated_speed_rad_s);
     let mut drivers = vec![Driver::new(twin.clone(), settings)];
     drivers.extend(more);
     let plant = Twin::new(&plant, config, w5).unwrap();
@@ -393,7 +393,7 @@ fn calibrate_with(
         measured.1.len(),
         rig.calibration.whirl_blocks
     );
-    let e = estimate(twin, &measured);
+    let e = estimate(twin, &measured, rig.drivers[0].calibration_refinement());
     (rig, before, e)
 }
 
@@ -442,7 +442,12 @@ fn check_and_apply(
     let said = rig.drivers[0].apply_calibration(applied.clone()).unwrap();
     println!("applied: {said}");
     assert_eq!(rig.drivers[0].viscosity_scale(), v.scale);
-    rig.run(8000.0, 8.0, false);
+    // a nonlinear twin takes the values over CALIBRATION_BLEND_S, then 8 revolutions to settle
+    let blend_revs = match rig.drivers[0].settings().twin.coupling {
+        Coupling::Linear => 0.0,
+        _ => CALIBRATION_BLEND_S * 8000.0 / 60.0,
+    };
+    rig.run(8000.0, blend_revs + 8.0, false);
     let after = rig.run(8000.0, 16.5, true);
     let (after_amp, after_lag) = prediction_error(&after);
     println!(
@@ -452,10 +457,11 @@ fn check_and_apply(
         100.0 * after_amp,
         after_lag
     );
-    // within 10 % and 5°: on the default (B) the worst probe axis reads 7.7–8.6 % after (from
-    // 65–69 % before), about twice the fit's own RMS 1X residual of 4.0 % (three speeds, two
-    // planes: the twin cannot meet every vector), the lag within 2°; (A) read under 5 %
-    assert!(after_amp < 0.10 && after_lag < 5.0);
+    // the 5 % and 5°. (A), linear twin: 3.0 % and 2.9°. (B), nonlinear twin with the
+    // unbalance refined on it (`calibrate::refine_unbalance`, session 17): 0.7 % and 0.7°; the
+    // linear fit alone left 7.7–8.9 % on (B) at 280 g·mm (linear or nonlinear twin), 2.9 % at
+    // 140 g·mm and 2.5 % at 70: the films' nonlinearity, not the noise or the grids
+    assert!(after_amp < 0.05 && after_lag < 5.0);
     applied
 }
 
@@ -513,11 +519,32 @@ fn the_live_estimate_recovers_the_plant_and_applying_it_moves_the_prediction_ont
 /// machine file gives the runout vectors, subtracted sample by sample) and 0.3 µm of noise, the
 /// keyphasor mark 123° round the plant's shaft from its angle zero. The unbalance phase is then
 /// read from the mark: 120° + 123° = 243° (the phase the plant publishes, `plant::write_bag`).
-/// Same targets as above.
+/// Same targets as above, on the built-in (B) with the node's default coupling (nonlinear; the
+/// direct film here, where the node runs the table: the table gives the same figures, 281.3 g·mm
+/// at 243.0°, 0.7 % and 0.7°, but is built afresh in a test process, 50 s), so the unbalance is
+/// refined on the nonlinear twin: measured 281.3 g·mm at 243.0° (plant 280 at 243°), 0.7 g·mm
+/// at stage 4, 1X residual 0.6 %.
 #[test]
 fn raw_probes_with_runout_calibrate_the_live_twin() {
     let twin = twin_rotor_with_raw_probes(5e-6);
-    let (mut rig, before, e) = calibrate(&twin, 123.0, PlantProbes::Raw { runout_m: 5e-6 });
+    let raw = PlantProbes::Raw { runout_m: 5e-6 };
+    let (mut rig, before, e) = calibrate_with(
+        &twin,
+        123.0,
+        raw,
+        Vec::new(),
+        None,
+        (ModelKind::Nonlinear, FilmEvaluation::Direct),
+    );
+    let u = e.unbalance.as_ref().unwrap();
+    println!("{} update(s) on the nonlinear twin", u.nonlinear_updates);
+    assert!(u.nonlinear_updates >= 1, "{u:?}");
+    // refined: within 2 % and 1° of the plant (the linear fit read 274.7 g·mm at 239.9°)
+    assert!(
+        (u.planes[1].magnitude_g_mm / 280.0 - 1.0).abs() < 0.02,
+        "{u:?}"
+    );
+    assert!(lag_gap(u.planes[1].phase_deg, 243.0).abs() < 1.0, "{u:?}");
     check_and_apply(&mut rig, &before, &e, 243.0);
 }
 
@@ -679,7 +706,8 @@ fn onset_after_live_calibration(
         nonlinear(&twin),
         nonlinear(&plant_rotor(&twin)),
     ];
-    let (mut rig, before, e) = calibrate_with(&twin, 0.0, PlantProbes::Pairs, more, ramp_rpm_s);
+    let (mut rig, before, e) =
+        calibrate_with(&twin, 0.0, PlantProbes::Pairs, more, ramp_rpm_s, LINEAR);
     rig.print_subsync("at the estimate");
     let (unbalance, viscosity_scale) = e.values();
     let applied = Applied {

@@ -218,7 +218,7 @@ fn offline_estimate(twin: &Rotor, csv: &str) -> (f64, f64, f64, usize) {
     }
     let measured = calibration.measurements();
     let vectors = measured.0.len();
-    let e = estimate(twin, &measured);
+    let e = estimate(twin, &measured, d.calibration_refinement());
     let u = e.unbalance.expect("an unbalance offline");
     let v = e.viscosity.expect("a viscosity offline");
     let p = u.planes[1];

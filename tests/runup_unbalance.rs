@@ -173,7 +173,7 @@ fn run_up(rate_rpm_s: f64) {
     let started = std::time::Instant::now();
     rig.ramp(3000.0, 6000.0, 3000.0 / rate_rpm_s, true);
     let measured = rig.calibration.measurements();
-    let e = estimate(&twin, &measured);
+    let e = estimate(&twin, &measured, rig.driver.calibration_refinement());
     let c = rig.driver.counts();
     println!(
         "run-up at {rate_rpm_s} rpm/s: {:.1} s of wall time; {} blocks, {} 1X vectors and {} mean positions kept ({} whirl blocks); refused {:?}; speed mismatches {}, relocks {}",

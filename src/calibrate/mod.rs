@@ -18,10 +18,15 @@
 //! correction masses that would balance it.
 
 mod linalg;
+mod nonlinear;
 mod one_x;
 mod unbalance;
 mod viscosity;
 
+pub use nonlinear::{
+    nonlinear_one_x, refine_unbalance, NonlinearRefinement, MAX_REFINEMENTS, MEASURED_REVOLUTIONS,
+    REFINEMENT_TOLERANCE, SETTLE_REVOLUTIONS,
+};
 pub use one_x::{fit_windows, AngleSample, WindowFit, WindowFits, MAX_WINDOW_SAMPLES};
 pub use unbalance::{
     estimate_unbalance, CorrectionMass, PlaneEstimate, UnbalanceEstimate,
@@ -142,11 +147,13 @@ pub fn journal_orbits(
 /// the viscosity again with the mean positions under the journal orbits that unbalance gives
 /// ([`journal_orbits`], [`estimate_viscosity_under_orbits`]) and the unbalance at that. Without
 /// an unbalance (no 1X vector) the static fit stands. `rotor` at the machine file's viscosity.
+/// With `refine`, the last unbalance is refined on the nonlinear twin ([`refine_unbalance`]).
 pub fn estimate_viscosity_and_unbalance(
     rotor: &crate::rotor::Rotor,
     means: &[MeanPosition],
     vectors: &[OneXVector],
     correction_radius_m: f64,
+    refine: Option<NonlinearRefinement>,
 ) -> (
     Result<ViscosityEstimate, CalibrationError>,
     Result<UnbalanceEstimate, CalibrationError>,
@@ -164,16 +171,22 @@ pub fn estimate_viscosity_and_unbalance(
         }
         Ok((estimate_unbalance(&at, vectors, correction_radius_m)?, at))
     };
+    let finish = |fit: Result<(UnbalanceEstimate, crate::rotor::Rotor), CalibrationError>| {
+        fit.and_then(|(u, at)| match refine {
+            Some(how) => refine_unbalance(&at, vectors, u, how, correction_radius_m),
+            None => Ok(u),
+        })
+    };
     let viscosity = estimate_viscosity(rotor, means);
     let (unbalance, at) = match (&viscosity, unbalance_at(&viscosity)) {
         (Ok(_), Ok(u)) => u,
-        (_, u) => return (viscosity, u.map(|u| u.0)),
+        (_, u) => return (viscosity, finish(u)),
     };
     let mut speeds: Vec<f64> = means.iter().map(|m| m.speed_rad_s).collect();
     speeds.sort_by(f64::total_cmp);
     speeds.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
     let refined = journal_orbits(&at, &unbalance, &speeds)
         .and_then(|orbits| estimate_viscosity_under_orbits(rotor, means, &orbits));
-    let unbalance = unbalance_at(&refined).map(|u| u.0);
+    let unbalance = finish(unbalance_at(&refined));
     (refined, unbalance)
 }

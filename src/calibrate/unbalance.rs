@@ -53,6 +53,8 @@ pub struct UnbalanceEstimate {
     pub vectors: usize,
     /// Distinct speeds (rpm).
     pub speeds_rpm: Vec<f64>,
+    /// Updates made on the nonlinear twin (`calibrate::refine_unbalance`; 0: the linear fit).
+    pub nonlinear_updates: usize,
 }
 
 /// Estimates the unbalance in `rotor`'s planes from `measured` 1X vectors (any stations, axes
@@ -184,11 +186,12 @@ fn solve(
         condition_number: cond,
         vectors: b.len(),
         speeds_rpm,
+        nonlinear_updates: 0,
     })
 }
 
 /// A plane's estimate from its complex m·e `u` (kg·m) and the correction at `radius_m` (m).
-fn plane_estimate(node: usize, u: [f64; 2], radius_m: f64) -> PlaneEstimate {
+pub(super) fn plane_estimate(node: usize, u: [f64; 2], radius_m: f64) -> PlaneEstimate {
     let me_g_mm = u[0].hypot(u[1]) * 1e6;
     let phase_deg = u[1].atan2(u[0]).to_degrees().rem_euclid(360.0);
     PlaneEstimate {

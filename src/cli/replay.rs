@@ -625,6 +625,7 @@ fn run_calibrated(
         &options.remaps,
         &options.probe_signals,
         window,
+        options.calibration_refinement(),
     )
     .context("calibration")?;
     let (before, _) = replay(bag, rotor, options, &mut |_| {})?;
@@ -703,8 +704,12 @@ fn calibration_summary(cal: &crate::replay::calibration::BagCalibration) -> Stri
             ),
         };
     }
+    let on = match u.nonlinear_updates {
+        0 => "the linear model".to_string(),
+        n => format!("the nonlinear twin, after {n} update(s) of the linear fit"),
+    };
     s += &format!(
-        "  1X residual {:.3} um RMS ({:.1} %), condition number {:.2}\n",
+        "  1X residual {:.3} um RMS ({:.1} %) on {on}, condition number {:.2}\n",
         u.residual_rms_m * 1e6,
         100.0 * u.relative_residual,
         u.condition_number

@@ -16,8 +16,8 @@
 
 use super::OneXBlock;
 use crate::calibrate::{
-    estimate_viscosity_and_unbalance, CalibrationError, MeanPosition, OneXVector,
-    UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
+    estimate_viscosity_and_unbalance, CalibrationError, MeanPosition, NonlinearRefinement,
+    OneXVector, UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
 };
 use crate::replay::calibration::MAX_WINDOW_RESIDUAL_SHARE;
 use crate::rotor::Rotor;
@@ -179,7 +179,15 @@ impl LiveCalibration {
 /// (when there are at least two), then the unbalance at that viscosity (at the file's when the
 /// viscosity cannot be fitted), then the viscosity again under the journal orbits of that
 /// unbalance and the unbalance at it (`calibrate::estimate_viscosity_and_unbalance`).
-pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
+///
+/// With `refine` (a nonlinear twin's: [`super::Driver::calibration_refinement`]) the unbalance is
+/// refined on the nonlinear twin (`calibrate::refine_unbalance`), so that the twin that runs it
+/// meets the measured 1X.
+pub fn estimate(
+    rotor: &Rotor,
+    measured: &MeasuredSet,
+    refine: Option<NonlinearRefinement>,
+) -> LiveEstimate {
     let (vectors, positions) = measured;
     let mut reference = rotor.clone();
     // the scale is fitted against the machine file's viscosity (1.0 is always valid: the
@@ -191,6 +199,7 @@ pub fn estimate(rotor: &Rotor, measured: &MeasuredSet) -> LiveEstimate {
         positions,
         vectors,
         DEFAULT_CORRECTION_RADIUS_M,
+        refine,
     );
     LiveEstimate {
         viscosity: viscosity.map_err(text),
@@ -279,6 +288,21 @@ pub struct Applied {
 }
 
 impl super::Driver {
+    /// How an estimate for this twin is refined: on its own film evaluation and steps a
+    /// revolution when it is nonlinear (or prehistory); None for a linear twin, whose best
+    /// unbalance is the linear fit itself.
+    pub fn calibration_refinement(&self) -> Option<NonlinearRefinement> {
+        let twin = &self.settings.twin;
+        if twin.coupling == crate::dynamics::Coupling::Linear {
+            return None;
+        }
+        let rev_s = std::f64::consts::TAU / self.rotor.rated_speed_rad_s;
+        Some(NonlinearRefinement {
+            film: twin.film,
+            steps_per_rev: (rev_s / twin.time_step_s).round().max(1.0) as usize,
+        })
+    }
+
     /// Applies a calibration to the running twin and to every later start: the unbalance per
     /// plane (m·e kg·m, phase rad from the mark) and the viscosity scale (over the machine
     /// file's). The viscosity is kept as a correction on the law, s_fit / s_law(T), T the oil

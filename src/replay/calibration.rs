@@ -17,8 +17,9 @@
 
 use crate::bag::Bag;
 use crate::calibrate::{
-    estimate_viscosity_and_unbalance, AngleSample, CalibrationError, MeanPosition, OneXVector,
-    UnbalanceEstimate, ViscosityEstimate, WindowFits, DEFAULT_CORRECTION_RADIUS_M,
+    estimate_viscosity_and_unbalance, AngleSample, CalibrationError, MeanPosition,
+    NonlinearRefinement, OneXVector, UnbalanceEstimate, ViscosityEstimate, WindowFits,
+    DEFAULT_CORRECTION_RADIUS_M,
 };
 use crate::driver::PAIR_TOLERANCE_REVS;
 use crate::messages::{self, from_cdr, RosMessage};
@@ -524,13 +525,15 @@ pub const PHASE_NULL_NO_KEYPHASOR: &str = "no keyphasor in the bag: a phase woul
 /// With AC-coupled probes only (no mean position) the unbalance alone is fitted, at the
 /// machine file's viscosity. Without a keyphasor the unbalance's phase is fitted from the bag's
 /// start (the calibrated machine carries it, for the replay after, which starts there too) but
-/// reported null ([`BagCalibration::phase_null_reason`]).
+/// reported null ([`BagCalibration::phase_null_reason`]). With `refine` the unbalance is refined
+/// on the nonlinear twin that replays the bag after (`calibrate::refine_unbalance`).
 pub fn calibrate_bag(
     bag: &Bag,
     rotor: &Rotor,
     remaps: &[(String, String)],
     probe_signals: &[(String, String)],
     window_s: [f64; 2],
+    refine: Option<NonlinearRefinement>,
 ) -> Result<(BagCalibration, Rotor), CalibrationError> {
     let m = bag_measurements(bag, rotor, remaps, probe_signals, window_s);
     let all_ac =
@@ -538,8 +541,13 @@ pub fn calibrate_bag(
     // the live calibration's fit: the viscosity under the journal orbits of the unbalance
     // fitted at the static fit's viscosity (`estimate_viscosity_and_unbalance`); with no mean
     // position it gives the unbalance at the machine file's viscosity
-    let (viscosity, unbalance) =
-        estimate_viscosity_and_unbalance(rotor, &m.means, &m.vectors, DEFAULT_CORRECTION_RADIUS_M);
+    let (viscosity, unbalance) = estimate_viscosity_and_unbalance(
+        rotor,
+        &m.means,
+        &m.vectors,
+        DEFAULT_CORRECTION_RADIUS_M,
+        refine,
+    );
     let unbalance = unbalance?;
     let (viscosity, viscosity_not_fitted) = match viscosity {
         Ok(v) => (Some(v), None),

@@ -68,6 +68,17 @@ pub struct ReplayOptions {
     pub forecast: Option<ReplayForecast>,
 }
 
+impl ReplayOptions {
+    /// How a calibration for this replay's twin is refined: on its film and steps a revolution
+    /// when it is nonlinear; None for a linear twin (the linear fit is its best).
+    pub fn calibration_refinement(&self) -> Option<crate::calibrate::NonlinearRefinement> {
+        (self.coupling != Coupling::Linear).then_some(crate::calibrate::NonlinearRefinement {
+            film: self.film,
+            steps_per_rev: self.steps_per_rev,
+        })
+    }
+}
+
 impl Default for ReplayOptions {
     fn default() -> Self {
         Self {

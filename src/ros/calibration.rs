@@ -6,6 +6,7 @@
 //! viscosity in force (oil temperature or calibration) has moved by more than
 //! [`THRESHOLD_RESCALE`].
 
+use crate::calibrate::NonlinearRefinement;
 use crate::driver::{LiveEstimate, MeasuredSet};
 use crate::rotor::Rotor;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,9 +18,12 @@ use std::sync::{Arc, Mutex};
 /// viscosity: the seed's ∂ln ω_th/∂ln µ is below 1).
 pub const THRESHOLD_RESCALE: f64 = 0.005;
 
+/// What the fitting thread is asked: the machine, the measurements, the nonlinear refinement.
+type Request = (Rotor, MeasuredSet, Option<NonlinearRefinement>);
+
 /// The fitting thread: one request at a time; a request while it is busy is not made.
 pub struct CalibrationWorker {
-    tx: SyncSender<(Rotor, MeasuredSet)>,
+    tx: SyncSender<Request>,
     busy: Arc<AtomicBool>,
     done: Arc<Mutex<Option<LiveEstimate>>>,
 }
@@ -27,15 +31,15 @@ pub struct CalibrationWorker {
 impl CalibrationWorker {
     /// Starts the thread.
     pub fn spawn() -> std::io::Result<Self> {
-        let (tx, rx) = mpsc::sync_channel::<(Rotor, MeasuredSet)>(1);
+        let (tx, rx) = mpsc::sync_channel::<Request>(1);
         let busy = Arc::new(AtomicBool::new(false));
         let done = Arc::new(Mutex::new(None));
         let (b, d) = (busy.clone(), done.clone());
         std::thread::Builder::new()
             .name("rotor_twin calibration".into())
             .spawn(move || {
-                for (rotor, measured) in rx {
-                    let e = crate::driver::calibration::estimate(&rotor, &measured);
+                for (rotor, measured, refine) in rx {
+                    let e = crate::driver::calibration::estimate(&rotor, &measured, refine);
                     *d.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
                     b.store(false, Ordering::Release);
                 }
@@ -43,12 +47,18 @@ impl CalibrationWorker {
         Ok(Self { tx, busy, done })
     }
 
-    /// Asks for a fit of `measured` on `rotor` unless one is running; true if asked.
-    pub fn request(&self, rotor: &Rotor, measured: MeasuredSet) -> bool {
+    /// Asks for a fit of `measured` on `rotor` (refined as `refine` says) unless one is
+    /// running; true if asked.
+    pub fn request(
+        &self,
+        rotor: &Rotor,
+        measured: MeasuredSet,
+        refine: Option<NonlinearRefinement>,
+    ) -> bool {
         if self.busy.swap(true, Ordering::AcqRel) {
             return false;
         }
-        if self.tx.try_send((rotor.clone(), measured)).is_err() {
+        if self.tx.try_send((rotor.clone(), measured, refine)).is_err() {
             self.busy.store(false, Ordering::Release);
             return false;
         }

@@ -565,10 +565,13 @@ impl ModelLoop {
         if measured.0.is_empty() && measured.1.len() < 2 {
             return;
         }
-        let asked = self
-            .calibration_worker
-            .as_ref()
-            .is_some_and(|w| w.request(self.driver.rotor(), measured));
+        let asked = self.calibration_worker.as_ref().is_some_and(|w| {
+            w.request(
+                self.driver.rotor(),
+                measured,
+                self.driver.calibration_refinement(),
+            )
+        });
         if asked {
             let period = crate::driver::seconds_to_ns(self.params.calibration_period_s);
             self.next_calibration_ns = now.saturating_add(period);
