@@ -22,7 +22,8 @@ use std::thread::JoinHandle;
 /// a wake-up of the writer) every few hundred messages, not at each.
 const BATCH_RECORDS: usize = 256;
 /// Batches the channel holds at most: the bound of the memory between the replay and the
-/// writer (≈ 2,000 messages, well under a megabyte).
+/// writer (≈ 2,000 messages; on the 10-minute bag the replay's peak RSS is 96.5 MB, main's
+/// 101–108 MB with the bag written on the replay's thread).
 const BATCHES_IN_FLIGHT: usize = 8;
 
 /// One message for the output bag.
