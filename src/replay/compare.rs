@@ -535,6 +535,14 @@ impl StationComparison {
             return Ok(None);
         }
         let mut reason = samples.iter().find_map(|s| s.phase_reference.null_reason());
+        // the closing event not yet in: the wait goes on before any feature is computed (they
+        // were computed, then dropped, at every sample of the wait, ≈ half a revolution)
+        if let (None, Some(ev), false) = (reason, events, no_more_events) {
+            let last = samples[samples.len() - 1].time_ns;
+            if ev.angle_at(last) == Err(Unbracketed::Pending) {
+                return Err(());
+            }
+        }
         let mut measured = self.features(samples, revs, |s| s.measured_m);
         let predicted = self.features(samples, revs, |s| s.predicted_m);
         let mut plant_speed = None;

@@ -9,6 +9,7 @@ pub mod calibration;
 pub mod compare;
 mod forecast;
 pub mod orbit_shape;
+mod output;
 mod report;
 
 pub use forecast::{observed_whip_s, ReplayForecast, DEFAULT_REPLAY_FORECAST_PERIOD_S};
@@ -22,10 +23,10 @@ use crate::bag::{Bag, BagMessage};
 use crate::driver::{settings, Driver, DriverSettings, Fed, Input, SpeedUnit};
 use crate::dynamics::{Coupling, FilmEvaluation, TwinConfig};
 use crate::messages::{self, from_cdr, RosMessage};
-use crate::record::Recorder;
 use crate::rotor::Rotor;
 use crate::session::{Outgoing, SessionSettings};
 use compare::{Sample, StationComparison};
+use output::{OutputBag, OutputWriter};
 use std::path::PathBuf;
 use thiserror::Error;
 
@@ -188,7 +189,10 @@ pub fn replay(
     let wall = std::time::Instant::now();
     let (roles, comparisons) = roles_and_comparisons(bag, rotor, options)?;
     let mut out = match &options.out_bag {
-        Some(dir) => Some(OutputBag::create(dir, bag, rotor, &roles, options)?),
+        Some(dir) => Some(OutputWriter::start(
+            OutputBag::create(dir, bag, rotor, &roles, options)?,
+            dir,
+        )?),
         None => None,
     };
     let Some((t0, t_last)) = bag.time_span_ns() else {
@@ -219,13 +223,14 @@ pub fn replay(
         }
         run.message(bag, &m, roles[m.topic], options.speed_unit);
         run.forecast();
-        run.write_out(&m, out.as_mut())?;
+        let since_t0_ns = m.log_time_ns.saturating_sub(t0);
+        run.write_out(m, out.as_mut())?;
         if let Some(rate) = options.rate {
-            pace(m.log_time_ns.saturating_sub(t0), rate, wall);
+            pace(since_t0_ns, rate, wall);
         }
         if last_progress.elapsed().as_millis() >= 200 {
             last_progress = std::time::Instant::now();
-            progress(m.log_time_ns.saturating_sub(t0) as f64 / (t_end - t0).max(1) as f64);
+            progress(since_t0_ns as f64 / (t_end - t0).max(1) as f64);
         }
     }
     progress(1.0);
@@ -317,28 +322,28 @@ impl Replaying {
     /// itself into the output bag.
     fn write_out(
         &mut self,
-        m: &BagMessage,
-        mut out: Option<&mut OutputBag>,
+        m: BagMessage,
+        mut out: Option<&mut OutputWriter>,
     ) -> Result<(), ReplayError> {
         // exact: t0_ns is the bag's u64 start time cast to i64
         let t0 = self.t0_ns as u64;
         for o in self.emitted.drain(..) {
             self.report.note_output(&o, t0, self.driver.session_slot());
             if let Some(out) = out.as_deref_mut() {
-                out.write_outgoing(&o)?;
+                out.outgoing(o)?;
             }
         }
         if let Some(out) = out {
-            out.write_input(m)?;
+            out.input(m)?;
         }
         Ok(())
     }
 
-    /// The finished report (wall time `wall`, the forecast's score, the output bag's count) and
-    /// the comparisons.
+    /// The finished report (wall time `wall`, up to the output bag closed; the forecast's score,
+    /// the output bag's count) and the comparisons.
     fn finish(
         self,
-        out: Option<OutputBag>,
+        out: Option<OutputWriter>,
         wall: std::time::Instant,
     ) -> Result<(ReplayReport, Vec<StationComparison>), ReplayError> {
         let Replaying {
@@ -350,6 +355,10 @@ impl Replaying {
         } = self;
         for c in &mut comparisons {
             c.finish(Some(driver.keyphasor_events()));
+        }
+        // the writer's backlog and the bag's summary count in the wall time
+        if let Some(out) = out {
+            report.messages_out = out.finish()?;
         }
         report.finish(&comparisons, wall.elapsed().as_secs_f64());
         report.heat_balance = driver.heat_balance_report();
@@ -365,9 +374,6 @@ impl Replaying {
             speed_topic_scale: driver.speed_scale(),
         });
         report.forecast = forecasting.map(|f| f.finish(report.onset.observed_time_s, &comparisons));
-        if let Some(out) = out {
-            report.messages_out = out.finish()?;
-        }
         Ok((report, comparisons))
     }
 
@@ -643,119 +649,4 @@ fn plant_signal_role(
         return Ok(Some(Role::ProbeValue(k)));
     }
     Ok(None)
-}
-
-/// The output bag: the inputs used (under the twin's topic names) and every prediction.
-struct OutputBag {
-    rec: Recorder,
-    inputs: Vec<Option<usize>>,
-    journal: usize,
-    film: usize,
-    orbit: usize,
-    /// each bearing's orbit topic for viewers, and the rule that fills them (as the node's)
-    bearing_orbits: Vec<usize>,
-    orbit_routes: crate::viewer::BearingOrbits,
-    warning: usize,
-    residual: usize,
-    margin: usize,
-    /// the forecast topic, when forecasting
-    forecast: Option<usize>,
-}
-
-impl OutputBag {
-    fn create(
-        dir: &std::path::Path,
-        bag: &Bag,
-        rotor: &Rotor,
-        roles: &[Role],
-        options: &ReplayOptions,
-    ) -> Result<Self, ReplayError> {
-        let mut rec = Recorder::create(dir)?;
-        let mut inputs = Vec::with_capacity(roles.len());
-        for (t, role) in bag.topics.iter().zip(roles) {
-            let name = options
-                .remaps
-                .iter()
-                .find(|(from, _)| *from == t.name)
-                .map_or(t.name.as_str(), |(_, to)| to.as_str());
-            inputs.push(if *role == Role::Other {
-                None
-            } else {
-                Some(rec.add_topic_raw(
-                    name,
-                    &t.type_name,
-                    &t.schema_encoding,
-                    &t.schema,
-                    crate::topics::INPUT_RECORDED,
-                )?)
-            });
-        }
-        use crate::topics;
-        let orbit_routes = crate::viewer::BearingOrbits::new(rotor);
-        let bearing_orbits = orbit_routes
-            .topics()
-            .iter()
-            .map(|t| rec.add_topic::<messages::Orbit>(t, topics::STATE))
-            .collect::<Result<_, _>>()?;
-        Ok(Self {
-            bearing_orbits,
-            orbit_routes,
-            journal: rec.add_topic::<messages::JournalState>(topics::JOURNAL, topics::STATE)?,
-            film: rec.add_topic::<messages::FilmState>(topics::FILM, topics::STATE)?,
-            orbit: rec.add_topic::<messages::Orbit>(topics::ORBIT, topics::STATE)?,
-            warning: rec
-                .add_topic::<messages::InstabilityWarning>(topics::WARNING, topics::WARNING_QOS)?,
-            residual: rec.add_topic::<messages::OrbitResidual>(topics::RESIDUAL, topics::STATE)?,
-            margin: rec
-                .add_topic::<messages::StabilityMargin>(topics::MARGIN, topics::MARGIN_QOS)?,
-            forecast: match options.forecast {
-                Some(_) => Some(
-                    rec.add_topic::<messages::Forecast>(topics::FORECAST, topics::FORECAST_QOS)?,
-                ),
-                None => None,
-            },
-            rec,
-            inputs,
-        })
-    }
-
-    fn write_input(&mut self, m: &BagMessage) -> Result<(), ReplayError> {
-        if let Some(h) = self.inputs[m.topic] {
-            self.rec
-                .write_cdr(h, m.payload(), m.log_time_ns, m.publish_time_ns)?;
-        }
-        Ok(())
-    }
-
-    fn write_outgoing(&mut self, o: &Outgoing) -> Result<(), ReplayError> {
-        let t = |h: &messages::Header| h.stamp.as_nanos().max(0) as u64;
-        if let Outgoing::Orbit(m) = o {
-            if let Some(k) = self.orbit_routes.route(m) {
-                let h = self.bearing_orbits[k];
-                self.rec.write(h, m, t(&m.header), t(&m.header))?;
-            }
-        }
-        match o {
-            Outgoing::Journal(m) => self.rec.write(self.journal, m, t(&m.header), t(&m.header)),
-            Outgoing::Film(m) => self.rec.write(self.film, m, t(&m.header), t(&m.header)),
-            Outgoing::Orbit(m) => self.rec.write(self.orbit, m, t(&m.header), t(&m.header)),
-            Outgoing::Warning(m) => self.rec.write(self.warning, m, t(&m.header), t(&m.header)),
-            Outgoing::Residual(m) => self.rec.write(self.residual, m, t(&m.header), t(&m.header)),
-            Outgoing::Margin(m) => self.rec.write(self.margin, m, t(&m.header), t(&m.header)),
-            Outgoing::Forecast(m) => match self.forecast {
-                Some(h) => self.rec.write(h, &**m, t(&m.header), t(&m.header)),
-                None => Ok(()),
-            },
-            // the replay has no diagnostics of its own
-            Outgoing::Diagnostics(_) => Ok(()),
-        }?;
-        Ok(())
-    }
-
-    /// Closes the bag; returns the number of messages written.
-    fn finish(self) -> Result<u64, ReplayError> {
-        let total = self.rec.counts().iter().map(|(_, c)| c).sum();
-        self.rec.finish()?;
-        Ok(total)
-    }
 }
