@@ -40,6 +40,10 @@ pub use viscosity::{
 use serde::Serialize;
 use thiserror::Error;
 
+/// A fit window (or a trial run) whose mean and 1X leave more than this share of its 1X
+/// semi-major axis, RMS (non-synchronous motion: a whirl), is not used.
+pub const MAX_WINDOW_RESIDUAL_SHARE: f64 = 0.3;
+
 /// A 1X vector of one probe station along one machine axis at one speed (module documentation
 /// for the convention).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -147,7 +151,8 @@ pub fn journal_orbits(
 /// the viscosity again with the mean positions under the journal orbits that unbalance gives
 /// ([`journal_orbits`], [`estimate_viscosity_under_orbits`]) and the unbalance at that. Without
 /// an unbalance (no 1X vector) the static fit stands. `rotor` at the machine file's viscosity.
-/// With `refine`, the last unbalance is refined on the nonlinear twin ([`refine_unbalance`]).
+/// With `refine`, the last unbalance is refined on the nonlinear twin ([`refine_unbalance`]);
+/// where that cannot be done the linear fit stands, saying why (`not_refined`).
 pub fn estimate_viscosity_and_unbalance(
     rotor: &crate::rotor::Rotor,
     means: &[MeanPosition],
@@ -172,9 +177,14 @@ pub fn estimate_viscosity_and_unbalance(
         Ok((estimate_unbalance(&at, vectors, correction_radius_m)?, at))
     };
     let finish = |fit: Result<(UnbalanceEstimate, crate::rotor::Rotor), CalibrationError>| {
-        fit.and_then(|(u, at)| match refine {
-            Some(how) => refine_unbalance(&at, vectors, u, how, correction_radius_m),
-            None => Ok(u),
+        fit.map(|(u, at)| match refine {
+            // a trial run that fails or whirls keeps the linear fit, with the reason
+            Some(how) => refine_unbalance(&at, vectors, u.clone(), how, correction_radius_m)
+                .unwrap_or_else(|e| UnbalanceEstimate {
+                    not_refined: Some(e.to_string()),
+                    ..u
+                }),
+            None => u,
         })
     };
     let viscosity = estimate_viscosity(rotor, means);

@@ -55,6 +55,9 @@ pub struct UnbalanceEstimate {
     pub speeds_rpm: Vec<f64>,
     /// Updates made on the nonlinear twin (`calibrate::refine_unbalance`; 0: the linear fit).
     pub nonlinear_updates: usize,
+    /// Why a refinement asked for was not made (a trial run failed or whirled): the linear fit
+    /// stands.
+    pub not_refined: Option<String>,
 }
 
 /// Estimates the unbalance in `rotor`'s planes from `measured` 1X vectors (any stations, axes
@@ -187,6 +190,7 @@ fn solve(
         vectors: b.len(),
         speeds_rpm,
         nonlinear_updates: 0,
+        not_refined: None,
     })
 }
 

@@ -704,9 +704,10 @@ fn calibration_summary(cal: &crate::replay::calibration::BagCalibration) -> Stri
             ),
         };
     }
-    let on = match u.nonlinear_updates {
-        0 => "the linear model".to_string(),
-        n => format!("the nonlinear twin, after {n} update(s) of the linear fit"),
+    let on = match (u.nonlinear_updates, &u.not_refined) {
+        (_, Some(why)) => format!("the linear model (not refined on the nonlinear twin: {why})"),
+        (0, None) => "the linear model".to_string(),
+        (n, None) => format!("the nonlinear twin, after {n} update(s) of the linear fit"),
     };
     s += &format!(
         "  1X residual {:.3} um RMS ({:.1} %) on {on}, condition number {:.2}\n",

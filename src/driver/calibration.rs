@@ -15,11 +15,11 @@
 //! two nearest in speed goes (the older), so a long run-up keeps its whole speed range.
 
 use super::OneXBlock;
+use crate::calibrate::MAX_WINDOW_RESIDUAL_SHARE;
 use crate::calibrate::{
     estimate_viscosity_and_unbalance, CalibrationError, MeanPosition, NonlinearRefinement,
     OneXVector, UnbalanceEstimate, ViscosityEstimate, DEFAULT_CORRECTION_RADIUS_M,
 };
-use crate::replay::calibration::MAX_WINDOW_RESIDUAL_SHARE;
 use crate::rotor::Rotor;
 
 /// Width of a speed bin (rpm): 10 rpm, 0.1 % of the rated speed. The influence coefficients

@@ -33,9 +33,7 @@ use std::f64::consts::TAU;
 /// Revolutions a fit window spans.
 pub const CALIBRATION_WINDOW_REVS: f64 = 16.0;
 
-/// A window whose fit leaves more than this share of its 1X semi-major axis (non-synchronous
-/// motion: a whirl) is not used.
-pub const MAX_WINDOW_RESIDUAL_SHARE: f64 = 0.3;
+pub use crate::calibrate::MAX_WINDOW_RESIDUAL_SHARE;
 
 /// What `--calibrate` found. Serialized with the unbalance phases (and the correction
 /// angles) null when `phase_null_reason` says why.
