@@ -169,7 +169,7 @@ pub fn refine_unbalance(
     let mut u: Vec<[f64; 2]> = linear.planes.iter().map(plane_complex).collect();
     let mut predicted = predict(rotor, &u, measured, how)?;
     let linear_left = misfit(measured, &predicted);
-    let mut best = (linear_left, u.clone(), predicted.clone(), 0);
+    let mut best = (linear_left, u.clone(), 0);
     for update in 1..=MAX_REFINEMENTS {
         let left: Vec<OneXVector> = measured
             .iter()
@@ -194,7 +194,7 @@ pub fn refine_unbalance(
         predicted = predict(rotor, &u, measured, how)?;
         let now = misfit(measured, &predicted);
         if now < best.0 {
-            best = (now, u.clone(), predicted.clone(), update);
+            best = (now, u.clone(), update);
         }
         if moved.sqrt() <= REFINEMENT_TOLERANCE * size.sqrt() {
             break;
@@ -207,13 +207,13 @@ pub fn refine_unbalance(
             )));
         }
     }
-    let (_, u, predicted, updates) = best;
+    let (left, u, updates) = best;
     if updates == 0 {
         return Err(CalibrationError::Model(
             "no update improved on the linear fit's misfit on the nonlinear twin".into(),
         ));
     }
-    let mut e = refined_estimate(rotor, measured, &predicted, &u, linear, correction_radius_m);
+    let mut e = refined_estimate(rotor, measured, left, &u, linear, correction_radius_m);
     e.nonlinear_updates = updates;
     Ok(e)
 }
@@ -280,21 +280,22 @@ fn same_speed(a_rad_s: f64, b_rad_s: f64) -> bool {
     (crate::units::rad_s_to_rpm(a_rad_s) - crate::units::rad_s_to_rpm(b_rad_s)).abs() <= 0.5
 }
 
-/// The estimate at `u` with the nonlinear twin's residual.
+/// The estimate at `u` with the nonlinear twin's residual, `left` its [`misfit`].
 fn refined_estimate(
     rotor: &Rotor,
     measured: &[OneXVector],
-    predicted: &[OneXVector],
+    left: f64,
     u: &[[f64; 2]],
     linear: UnbalanceEstimate,
     radius_m: f64,
 ) -> UnbalanceEstimate {
-    let (mut left, mut size) = (0.0, 0.0);
-    for (m, p) in measured.iter().zip(predicted) {
-        let (m, p) = (m.complex(), p.complex());
-        left += (m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2);
-        size += m[0] * m[0] + m[1] * m[1];
-    }
+    let size: f64 = measured
+        .iter()
+        .map(|m| {
+            let m = m.complex();
+            m[0] * m[0] + m[1] * m[1]
+        })
+        .sum();
     let n = measured.len().max(1) as f64;
     let planes = rotor
         .unbalance
