@@ -661,7 +661,7 @@ impl Monitor {
         let picked = &mut self.rev_picked;
         picked.clear();
         for back in (0..stored).rev() {
-            if (self.samples_total - 1 - back as u64) % stride as u64 != 0 {
+            if !(self.samples_total - 1 - back as u64).is_multiple_of(stride as u64) {
                 continue;
             }
             let i = ring_index(head, capacity, back);
@@ -1036,7 +1036,7 @@ mod tests {
     /// [`order_spectrum`] to the last bit (the same sums in the same order), over a full window
     /// of the synthetic orbit; the monitor's spectra from the per-revolution sums (from the
     /// 17th revolution on) agree with them within 2e-3 of the largest component (measured
-    /// 4.1e-4 at 64.37 samples a revolution; the picks differ: those of the sums continue
+    /// 7.4e-4 at 64.37 samples a revolution; the picks differ: those of the sums continue
     /// evenly across revolutions, the samples' start at the window's first sample, and the
     /// window is in angle instead of pick index over a window of 514–515 picks, not 512).
     #[test]

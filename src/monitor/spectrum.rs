@@ -303,7 +303,8 @@ impl WindowSums {
         }
         let (oldest, newest) = (&self.ring[self.head], &self.ring[(self.head + r - 1) % r]);
         let (k0, first, last) = (oldest.mark, oldest.first_rad, newest.last_rad);
-        if !(last - first <= std::f64::consts::TAU * r as f64) {
+        let fits = last - first <= std::f64::consts::TAU * r as f64;
+        if !fits {
             return None;
         }
         let orders = self.orders();
@@ -311,13 +312,24 @@ impl WindowSums {
         for j in 0..r {
             let e = &self.ring[(self.head + j) % r];
             let m = ((e.mark - k0) as i64).rem_euclid(r as i64) as usize;
-            for (i, (c, f)) in self.combined.iter_mut().zip(&e.rows).enumerate() {
-                // e^{−i2πkm/R} forward, its conjugate backward
-                let [rr, ri] = self.roots[(i % orders) * m % r];
-                c[0] += rr * f[0] - ri * f[1];
-                c[1] += rr * f[1] + ri * f[0];
-                c[2] += rr * f[2] + ri * f[3];
-                c[3] += rr * f[3] - ri * f[2];
+            let blocks = self
+                .combined
+                .chunks_exact_mut(orders)
+                .zip(e.rows.chunks_exact(orders));
+            for (c, f) in blocks {
+                // e^{−i2πkm/R} forward, its conjugate backward: root km mod R, stepped by m
+                let mut root = 0;
+                for (c, f) in c.iter_mut().zip(f) {
+                    let [rr, ri] = self.roots[root];
+                    c[0] += rr * f[0] - ri * f[1];
+                    c[1] += rr * f[1] + ri * f[0];
+                    c[2] += rr * f[2] + ri * f[3];
+                    c[3] += rr * f[3] - ri * f[2];
+                    root += m;
+                    if root >= r {
+                        root -= r;
+                    }
+                }
             }
         }
         Some((k0, 0.5 * (first + last)))
