@@ -653,10 +653,14 @@ impl Monitor {
     /// start is a multiple of `stride` (the picks continue evenly across revolutions), each
     /// weighted by the angle of its `stride` steps (an angle quadrature: revolutions of
     /// different lengths, or picked at different strides, weigh by their angle). Complete
-    /// unless it is the first (partial) revolution or not all of it is stored.
+    /// unless it is the first (partial) revolution, not all of it is stored, or a pick's angle
+    /// is not within a factor 2 of the revolution's mean (a shifted rotor angle, e.g. a
+    /// keyphasor lock's correction, or a jump: the window then comes from the samples).
     fn push_revolution_sums(&mut self, stride: usize) {
         let last = *self.rev_lengths.last().unwrap_or(&0);
         let stored = last.min(self.len.saturating_sub(stride));
+        let mean = TAU * stride as f64 / last.max(1) as f64;
+        let mut regular = true;
         let (head, capacity) = (self.head, self.capacity);
         let picked = &mut self.rev_picked;
         picked.clear();
@@ -666,12 +670,14 @@ impl Monitor {
             }
             let i = ring_index(head, capacity, back);
             let before = ring_index(head, capacity, back + stride);
-            picked.extend([self.angle[i], self.angle[i] - self.angle[before]]);
+            let weight = self.angle[i] - self.angle[before];
+            regular &= weight > 0.5 * mean && weight < 2.0 * mean;
+            picked.extend([self.angle[i], weight]);
             for h in &self.bearings {
                 picked.extend([h.x[i], h.y[i]]);
             }
         }
-        let complete = self.revolutions > 1 && stored == last;
+        let complete = self.revolutions > 1 && stored == last && regular;
         self.sums.push(picked, complete);
     }
 
@@ -1140,6 +1146,54 @@ mod tests {
         }
         eprintln!("run-up and step, 1X and sub-synchronous: sums {new:?}, samples {old:?}");
         assert!(new.iter().all(|&e| e < 0.01), "{new:?}");
+    }
+
+    /// A rotor angle shifted by −1 rad at the end of revolution 30 (a keyphasor correction):
+    /// the windows holding the revolution of the shift come from the samples (equal to the
+    /// samples' path to the bit), the ones after it from the sums again (within 2e-3 of the
+    /// largest radius of the samples' path, as in `joint_spectra_equal_each_bearings_spectrum`;
+    /// measured up to 1.04e-3 on this orbit).
+    #[test]
+    fn after_an_angle_shift_the_window_comes_from_the_samples() {
+        let c = 60e-6;
+        let mut m =
+            Monitor::with_clearances(&[c, c], [0.95, 1e-6], 128, ClassifierSettings::default());
+        let (dpsi, mut shift, mut checked) = (TAU / 64.37, 0.0, [0, 0]);
+        for i in 0..60 * 64 {
+            let psi = i as f64 * dpsi;
+            let orbit = [
+                3e-6 * psi.cos() + 5e-6 * (0.47 * psi).cos(),
+                3e-6 * psi.sin(),
+            ];
+            if m.record_orbit(psi / 900.0, 900.0, psi + shift, &[orbit, orbit])
+                .is_none()
+            {
+                continue;
+            }
+            if m.revolutions == 30 {
+                shift = -1.0;
+            }
+            let window = m.recent_samples(SPECTRUM_REVOLUTIONS);
+            let mut samples = m.clone();
+            samples.samples_spectra(window, m.spectrum_stride(window));
+            let largest = samples.spectrum.iter().map(OrderComponent::semi_major_m);
+            let largest = largest.fold(0.0, f64::max);
+            let apart = m.spectrum.iter().zip(&samples.spectrum).map(|(a, b)| {
+                (a.forward_m - b.forward_m)
+                    .abs()
+                    .max((a.backward_m - b.backward_m).abs())
+            });
+            let apart = apart.fold(0.0, f64::max) / largest;
+            let r = m.revolutions;
+            if (31..=46).contains(&r) {
+                assert_eq!(apart, 0.0, "revolution {r}: from the samples");
+                checked[0] += 1;
+            } else if r >= 47 {
+                assert!(apart > 0.0 && apart < 2e-3, "revolution {r}: {apart:e}");
+                checked[1] += 1;
+            }
+        }
+        assert!(checked[0] >= 16 && checked[1] >= 5, "{checked:?}");
     }
 
     /// The profiles kept: 32 a revolution at 64 and 128 steps a revolution (every second or
