@@ -171,6 +171,231 @@ pub fn order_spectra(
     }
 }
 
+/// The window spectrum of [`order_spectra`] assembled from per-revolution partial sums, each
+/// computed once, when its revolution completes, instead of over the whole window every
+/// revolution. The Hann window is taken in shaft angle, w(ψ) = ½ − ½ cos((ψ − ψ_s)/R) over the
+/// window's R = `resolution` revolutions, centred on the window's picked samples (for evenly
+/// spaced samples the window of [`order_spectrum`], which is in sample index: the same weights).
+/// With θ = ψ − 2πK₀ (K₀ the whole revolution nearest the first sample, the phase reference of
+/// [`order_spectrum`]) and b = e^{−iθ_s/R}, cos expanded in exponentials:
+///
+///   Σ w z e^{−ikθ/R} = ½ X_k − ¼ b X_{k−1} − ¼ b̄ X_{k+1},   X_k = Σ z e^{−ikθ/R}   (S1)
+///
+/// for every order k, backward ones at −k. X_k is the sum over the revolutions of their own sums
+/// F_k = Σ z e^{−ik(ψ − 2πK_j)/R} (K_j the revolution's own mark), re-phased by the exact root
+/// of unity e^{−i2πk(K_j − K₀)/R} (S2). The mean is removed as in [`order_spectrum`]:
+/// Σ w (z − m) e^{−ikθ/R} = S_k(z) − m S_k(1), m = Σz/Σ1, Σw = S₀(1), all from the same sums
+/// with z replaced by 1. Each sample carries a weight q, the steps since the previously picked
+/// one (the stride of the picks), so that revolutions picked at different strides weigh by
+/// their steps as the one stride of [`order_spectra`] does; for one stride q cancels.
+#[derive(Clone)]
+pub struct WindowSums {
+    resolution: usize,
+    signals: usize,
+    /// the last `resolution` revolutions, a ring; `head` the next written
+    ring: Vec<RevolutionSums>,
+    head: usize,
+    filled: usize,
+    /// e^{−i2πj/R}, j = 0 … R − 1
+    roots: Vec<[f64; 2]>,
+    /// the window's sums X_k (layout of `RevolutionSums::rows`)
+    combined: Vec<[f64; 4]>,
+}
+
+/// One revolution's sums F_k: rows of `[Re F_k, Im F_k, Re F_−k, Im F_−k]` for orders
+/// k = 0 … R + 1 of each signal, then of the constant 1.
+#[derive(Clone)]
+struct RevolutionSums {
+    /// whole turns of the phase mark: the revolution nearest its first sample
+    mark: f64,
+    /// angles of the first and last picked samples (rad)
+    first_rad: f64,
+    last_rad: f64,
+    /// a whole revolution, all of it picked (false: the window falls back to the samples)
+    complete: bool,
+    rows: Vec<[f64; 4]>,
+}
+
+impl WindowSums {
+    /// Sums of `signals` orbits at orders k/`resolution` over windows of `resolution`
+    /// revolutions (allocates: at construction only).
+    pub fn new(signals: usize, resolution: usize) -> Self {
+        let r = resolution.max(1);
+        let rows = (signals + 1) * (r + 2);
+        let entry = RevolutionSums {
+            mark: 0.0,
+            first_rad: 0.0,
+            last_rad: 0.0,
+            complete: false,
+            rows: vec![[0.0; 4]; rows],
+        };
+        Self {
+            resolution: r,
+            signals,
+            ring: vec![entry; r],
+            head: 0,
+            filled: 0,
+            roots: (0..r)
+                .map(|j| {
+                    let (s, c) = (std::f64::consts::TAU * j as f64 / r as f64).sin_cos();
+                    [c, -s]
+                })
+                .collect(),
+            combined: vec![[0.0; 4]; rows],
+        }
+    }
+
+    /// Orders a signal's rows hold: 0 … R + 1.
+    fn orders(&self) -> usize {
+        self.resolution + 2
+    }
+
+    /// Adds the revolution just completed: `picked` holds rows of 2 + 2 `signals` values, the
+    /// angle (rad), the weight q (steps since the previous pick), then x and y (m) of each
+    /// orbit. `complete`: a whole revolution (not the first, partial one), all of it stored.
+    /// Allocates nothing.
+    pub fn push(&mut self, picked: &[f64], complete: bool) {
+        let (row, orders, signals) = (2 + 2 * self.signals, self.orders(), self.signals);
+        let resolution = self.resolution as f64;
+        let e = &mut self.ring[self.head];
+        self.head = (self.head + 1) % self.resolution;
+        self.filled = (self.filled + 1).min(self.resolution);
+        e.rows.fill([0.0; 4]);
+        let n = picked.len() / row;
+        e.complete = complete && n > 0;
+        if n == 0 {
+            return;
+        }
+        e.mark = (picked[0] / std::f64::consts::TAU).round();
+        e.first_rad = picked[0];
+        e.last_rad = picked[(n - 1) * row];
+        let mark_rad = e.mark * std::f64::consts::TAU;
+        for p in picked.chunks_exact(row) {
+            let q = p[1];
+            let (sn, cs) = ((p[0] - mark_rad) / resolution).sin_cos();
+            let (br, bi) = (cs, -sn);
+            let (mut pr, mut pi) = (1.0, 0.0);
+            for k in 0..orders {
+                for s in 0..=signals {
+                    let (zr, zi) = if s < signals {
+                        (q * p[2 + 2 * s], q * p[3 + 2 * s])
+                    } else {
+                        (q, 0.0)
+                    };
+                    let r = &mut e.rows[s * orders + k];
+                    r[0] += zr * pr - zi * pi;
+                    r[1] += zr * pi + zi * pr;
+                    r[2] += zr * pr + zi * pi;
+                    r[3] += -zr * pi + zi * pr;
+                }
+                (pr, pi) = (pr * br - pi * bi, pr * bi + pi * br);
+            }
+        }
+    }
+
+    /// The window's sums X_k (S2) into `combined`; the oldest revolution's mark K₀ and the
+    /// window's centre (rad), or None unless the ring holds R complete revolutions whose picks
+    /// span at most R revolutions (a longer span would wrap the window).
+    fn combine(&mut self) -> Option<(f64, f64)> {
+        let r = self.resolution;
+        if self.filled < r || self.ring.iter().any(|e| !e.complete) {
+            return None;
+        }
+        let (oldest, newest) = (&self.ring[self.head], &self.ring[(self.head + r - 1) % r]);
+        let (k0, first, last) = (oldest.mark, oldest.first_rad, newest.last_rad);
+        let fits = last - first <= std::f64::consts::TAU * r as f64;
+        if !fits {
+            return None;
+        }
+        let orders = self.orders();
+        self.combined.fill([0.0; 4]);
+        for j in 0..r {
+            let e = &self.ring[(self.head + j) % r];
+            let m = ((e.mark - k0) as i64).rem_euclid(r as i64) as usize;
+            let blocks = self
+                .combined
+                .chunks_exact_mut(orders)
+                .zip(e.rows.chunks_exact(orders));
+            for (c, f) in blocks {
+                // e^{−i2πkm/R} forward, its conjugate backward: root km mod R, stepped by m
+                let mut root = 0;
+                for (c, f) in c.iter_mut().zip(f) {
+                    let [rr, ri] = self.roots[root];
+                    c[0] += rr * f[0] - ri * f[1];
+                    c[1] += rr * f[1] + ri * f[0];
+                    c[2] += rr * f[2] + ri * f[3];
+                    c[3] += rr * f[3] - ri * f[2];
+                    root += m;
+                    if root >= r {
+                        root -= r;
+                    }
+                }
+            }
+        }
+        Some((k0, 0.5 * (first + last)))
+    }
+
+    /// X_k of signal `s` (`signals`: the constant 1) at order `k` (|k| ≤ R + 1).
+    fn x(&self, s: usize, k: isize) -> [f64; 2] {
+        let c = self.combined[s * self.orders() + k.unsigned_abs()];
+        if k >= 0 {
+            [c[0], c[1]]
+        } else {
+            [c[2], c[3]]
+        }
+    }
+
+    /// The Hann-windowed sum (S1) of signal `s` at order `k` (|k| ≤ R), with b = e^{−iθ_s/R}.
+    fn windowed(&self, s: usize, k: isize, b: [f64; 2]) -> [f64; 2] {
+        let (x, lo, hi) = (self.x(s, k), self.x(s, k - 1), self.x(s, k + 1));
+        // b · X_{k−1} and b̄ · X_{k+1}
+        let blo = [b[0] * lo[0] - b[1] * lo[1], b[0] * lo[1] + b[1] * lo[0]];
+        let bhi = [b[0] * hi[0] + b[1] * hi[1], b[0] * hi[1] - b[1] * hi[0]];
+        [
+            0.5 * x[0] - 0.25 * (blo[0] + bhi[0]),
+            0.5 * x[1] - 0.25 * (blo[1] + bhi[1]),
+        ]
+    }
+
+    /// The components at orders k/R, k = 1 … R, of every signal into `out` (R a signal, as
+    /// [`order_spectra`] with `max_k` = R); false (and `out` untouched) when the ring does not
+    /// hold a whole window of complete revolutions: the caller computes it from the samples.
+    /// Allocates nothing.
+    pub fn spectra(&mut self, out: &mut [OrderComponent]) -> bool {
+        let Some((k0, centre)) = self.combine() else {
+            return false;
+        };
+        let r = self.resolution;
+        // the window's start ψ_s, half the window (πR) before the picks' centre, against 2πK₀
+        let start = centre - std::f64::consts::PI * r as f64 - k0 * std::f64::consts::TAU;
+        let (sn, cs) = (start / r as f64).sin_cos();
+        let b = [cs, -sn];
+        let one = self.signals;
+        let wsum = self.windowed(one, 0, b)[0];
+        let count = self.x(one, 0)[0];
+        for s in 0..self.signals {
+            let [mr, mi] = self.x(s, 0).map(|v| v / count);
+            for k in 1..=r {
+                let side = |k: isize| {
+                    let (v, u) = (self.windowed(s, k, b), self.windowed(one, k, b));
+                    [
+                        v[0] - (mr * u[0] - mi * u[1]),
+                        v[1] - (mr * u[1] + mi * u[0]),
+                    ]
+                };
+                let (f, bw) = (side(k as isize), side(-(k as isize)));
+                out[s * r + k - 1] = OrderComponent {
+                    order: k as f64 / r as f64,
+                    forward_m: f[0].hypot(f[1]) / wsum,
+                    backward_m: bw[0].hypot(bw[1]) / wsum,
+                    forward_phase_rad: f[1].atan2(f[0]),
+                };
+            }
+        }
+        true
+    }
+}
+
 /// The Hann window's amplitude response, normalised by its coherent gain, to a tone `delta`
 /// bins from a bin centre (|δ| < 2), in the limit of many samples:
 /// W(δ) = sin(πδ) / (πδ (1 − δ²)) (Harris, Proc. IEEE 66 (1978) 51, the Hann kernel).
@@ -375,5 +600,207 @@ mod tests {
             (half.backward_m - 1.0).abs() < 1e-6 && half.forward_m < 1e-6,
             "{half:?}"
         );
+    }
+
+    /// Feeds an orbit z(ψ) = `orbit(ψ)` sampled at shaft angles `angles` through the monitor's
+    /// split into revolutions (a revolution ends with the sample that passes a whole turn; the
+    /// first one is partial) and its picks (about 32 a revolution, every `stride`-th sample
+    /// counted from the start, each weighted by the angle of its `stride` steps) into
+    /// [`WindowSums`]; for each whole window, `check(sums, same, old)` with [`order_spectrum`]
+    /// of the same picks (`same`) and of the old monitor's picks (every `stride`-th sample from
+    /// the window's first: `old`). Returns the windows compared.
+    fn compare_windows(
+        angles: &[f64],
+        orbit: impl Fn(f64) -> [f64; 2],
+        mut check: impl FnMut(&[OrderComponent], &[OrderComponent], &[OrderComponent]),
+    ) -> usize {
+        const R: usize = 16;
+        let mut sums = WindowSums::new(1, R);
+        let (mut revs, mut starts): (Vec<Vec<[f64; 4]>>, Vec<usize>) = (vec![], vec![]);
+        let (mut start, mut windows) = (0, 0);
+        let mut out = vec![OrderComponent::default(); R];
+        let spectrum_of = |picks: &[[f64; 4]]| {
+            let mut spec = vec![OrderComponent::default(); R];
+            order_spectrum(
+                picks.iter().map(|p| p[2]),
+                picks.iter().map(|p| p[3]),
+                picks.iter().map(|p| p[0]),
+                picks.len(),
+                R,
+                &mut spec,
+            );
+            spec
+        };
+        let pick = |c: usize, stride: usize| {
+            let q = if c >= stride {
+                angles[c] - angles[c - stride]
+            } else {
+                0.0
+            };
+            let [x, y] = orbit(angles[c]);
+            [angles[c], q, x, y]
+        };
+        for i in 1..angles.len() {
+            if (angles[i] / std::f64::consts::TAU).floor()
+                <= (angles[i - 1] / std::f64::consts::TAU).floor()
+            {
+                continue;
+            }
+            starts.push(start);
+            let first = starts[starts.len().saturating_sub(R)];
+            let stride = ((i + 1 - first) / starts.len().min(R)).div_ceil(32);
+            let picks: Vec<[f64; 4]> = (start..=i)
+                .filter(|c| c % stride == 0)
+                .map(|c| pick(c, stride))
+                .collect();
+            let flat: Vec<f64> = picks.iter().flatten().copied().collect();
+            sums.push(&flat, !revs.is_empty());
+            revs.push(picks);
+            start = i + 1;
+            if sums.spectra(&mut out) {
+                let same = spectrum_of(&revs[revs.len() - R..].concat());
+                let old: Vec<[f64; 4]> = (first..=i)
+                    .step_by(stride)
+                    .map(|c| pick(c, stride))
+                    .collect();
+                check(&out, &same, &spectrum_of(&old));
+                windows += 1;
+            }
+        }
+        windows
+    }
+
+    /// Largest differences of two spectra: of the radii over the largest radius, and of the
+    /// forward phases (rad) of forward components above 1 % of it.
+    fn differences(a: &[OrderComponent], b: &[OrderComponent]) -> (f64, f64) {
+        let largest = b
+            .iter()
+            .map(|c| c.forward_m.max(c.backward_m))
+            .fold(0.0, f64::max);
+        let (mut radius, mut phase) = (0.0_f64, 0.0_f64);
+        for (a, b) in a.iter().zip(b) {
+            assert_eq!(a.order, b.order);
+            radius = radius
+                .max((a.forward_m - b.forward_m).abs() / largest)
+                .max((a.backward_m - b.backward_m).abs() / largest);
+            if b.forward_m > 0.01 * largest {
+                let d =
+                    (a.forward_phase_rad - b.forward_phase_rad).rem_euclid(std::f64::consts::TAU);
+                phase = phase.max(d.min(std::f64::consts::TAU - d));
+            }
+        }
+        (radius, phase)
+    }
+
+    /// Relative errors of a spectrum's 1X forward and backward radii and its sub-synchronous
+    /// peak's forward radius against the [`whirl`]'s 3, 1 and 5 µm.
+    fn whirl_errors(s: &[OrderComponent]) -> [f64; 3] {
+        let (one, sub) = (one_x_component(s, 16), subsynchronous_peak(s, 16));
+        [
+            (one.forward_m / 3e-6 - 1.0).abs(),
+            (one.backward_m / 1e-6 - 1.0).abs(),
+            (sub.forward_m / 5e-6 - 1.0).abs(),
+        ]
+    }
+
+    /// A steady whirl with a mean offset: 1X forward 3 µm and backward 1 µm, 0.47X forward
+    /// 5 µm, 0.25X backward 0.8 µm, about (10, −20) µm.
+    fn whirl(psi: f64) -> [f64; 2] {
+        let circle = |r: f64, order: f64| [r * (order * psi).cos(), r * (order * psi).sin()];
+        let parts = [
+            circle(3e-6, 1.0),
+            circle(1e-6, -1.0),
+            circle(5e-6, 0.47),
+            circle(0.8e-6, -0.25),
+        ];
+        parts
+            .iter()
+            .fold([10e-6, -20e-6], |s, p| [s[0] + p[0], s[1] + p[1]])
+    }
+
+    /// (a) The window spectrum from per-revolution sums equals [`order_spectrum`] of the same
+    /// picks, for a steady whirl at 64 samples a revolution, half a step off the whole turns:
+    /// 512 evenly spaced picks, on which the Hann window in angle, centred on the picks, has
+    /// the weights of the window in pick index, and the picks' weights (the angle of their two
+    /// steps) are equal: the same sums, differently grouped (radii within 1e-9 of the largest,
+    /// measured 4e-15; phases within 1e-9 rad, measured 1.7e-13). The old monitor's picks (every
+    /// second sample from the window's first, the others) give the same figures within 1e-4 of
+    /// the largest radius (measured 4.7e-5); 1X and 0.47X are the whirl's within 1 % (the reference's accuracy,
+    /// `amplitudes_are_right_on_and_between_bins`).
+    #[test]
+    fn window_sums_equal_the_spectrum_of_a_steady_whirl() {
+        let angles: Vec<f64> = (0..40 * 64)
+            .map(|i| std::f64::consts::TAU * ((i as f64 + 0.5) / 64.0 + 3.0))
+            .collect();
+        let (mut same, mut old, mut truth) = ([0.0_f64; 2], 0.0_f64, [0.0_f64; 3]);
+        let windows = compare_windows(&angles, whirl, |sums, reference, old_picks| {
+            let (r, p) = differences(sums, reference);
+            same = [same[0].max(r), same[1].max(p)];
+            old = old.max(differences(sums, old_picks).0);
+            for (t, e) in truth.iter_mut().zip(whirl_errors(sums)) {
+                *t = t.max(e);
+            }
+        });
+        eprintln!(
+            "steady: {windows} windows; against the same picks: radii {:.1e} of the largest, \
+             phases {:.1e} rad; against the old picks {old:.1e}; against the whirl: 1X forward \
+             {:.1e}, backward {:.1e}, 0.47X {:.1e}",
+            same[0], same[1], truth[0], truth[1], truth[2]
+        );
+        assert!(windows >= 20, "{windows} windows");
+        assert!(same[0] < 1e-9 && same[1] < 1e-9, "{same:?}");
+        assert!(old < 1e-4, "{old:e}");
+        assert!(truth.iter().all(|&e| e < 0.01), "{truth:?}");
+    }
+
+    /// (b) A speed ramp at a fixed time step: 80 samples a revolution falling to 48 over 40
+    /// revolutions (a run-up by 1.7 × in 40 revolutions; the picks' stride goes from 3 to 2 on
+    /// the way), then a step to 40 samples a revolution held for 40. The sums' window is in
+    /// angle and weighs each pick by its angle: the whirl's 1X forward, 1X backward and 0.47X
+    /// radii come out within 1 % in every window (measured 0.17 %, 0.71 %, 0.12 %).
+    /// [`order_spectrum`] of the old monitor's picks (one stride over the window, unweighted,
+    /// its window in pick index, hence uneven in angle) is off by up to 1.1 %, 1.2 % and 1.4 %,
+    /// and the two differ by up to 5.4e-2 of the largest radius (in the leakage bins between
+    /// the components); at a steady speed (the last windows) they agree within 1e-9 (3.9e-14).
+    #[test]
+    fn window_sums_follow_the_spectrum_in_a_ramp_and_a_step() {
+        let mut angles = vec![0.1];
+        // samples a revolution n(ψ): 80 → 48 linearly over the first 40 revolutions, then 40
+        while *angles.last().unwrap_or(&0.0) < 80.0 * std::f64::consts::TAU {
+            let psi = angles[angles.len() - 1];
+            let revs = psi / std::f64::consts::TAU;
+            let n = if revs < 40.0 {
+                80.0 - 32.0 * revs / 40.0
+            } else {
+                40.0
+            };
+            angles.push(psi + std::f64::consts::TAU / n);
+        }
+        let (mut new, mut old, mut apart, mut steady) =
+            ([0.0_f64; 3], [0.0_f64; 3], 0.0_f64, 0.0_f64);
+        let mut windows = 0;
+        compare_windows(&angles, whirl, |sums, _, old_picks| {
+            windows += 1;
+            for (t, e) in new.iter_mut().zip(whirl_errors(sums)) {
+                *t = t.max(e);
+            }
+            for (t, e) in old.iter_mut().zip(whirl_errors(old_picks)) {
+                *t = t.max(e);
+            }
+            let d = differences(sums, old_picks).0;
+            apart = apart.max(d);
+            // windows wholly at 40 samples a revolution (from revolution 57 on)
+            if windows > 57 - 17 {
+                steady = steady.max(d);
+            }
+        });
+        eprintln!(
+            "ramp and step: {windows} windows; against the whirl (1X forward, backward, 0.47X): \
+             sums {new:?}, old picks {old:?}; apart {apart:.1e} of the largest, at a \
+             steady speed {steady:.1e}"
+        );
+        assert!(windows >= 60, "{windows} windows");
+        assert!(new.iter().all(|&e| e < 0.01), "{new:?}");
+        assert!(steady < 1e-9, "{steady:e}");
     }
 }
