@@ -85,6 +85,10 @@ pub fn run(node: &str, call: ParamCall, timeout: Duration) -> anyhow::Result<()>
     })
 }
 
+/// How long a parameter request waits for its answer before it is sent again
+/// ([`Peer::call`]).
+const RESEND_PERIOD: Duration = Duration::from_secs(3);
+
 /// The node whose parameter services are called, and how long it may take to answer.
 struct Peer<'a> {
     node: &'a str,
@@ -123,7 +127,12 @@ impl Peer<'_> {
         Ok(client)
     }
 
-    /// One request and its response.
+    /// One request and its response. The request is sent again every [`RESEND_PERIOD`] until
+    /// an answer comes or the timeout ends: `wait_for_service` returns once *our* request
+    /// writer and response reader have matched the node's, but the node's response writer may
+    /// not yet have matched our reader, and a response sent then is lost (seen once in CI on a
+    /// loaded machine: the node logged no refusal, the client waited its 30 s). Each of the
+    /// node's parameter services is idempotent (a get; a set of the same values).
     async fn call<Req, Resp>(
         &self,
         client: &Client<Req, Resp>,
@@ -134,14 +143,20 @@ impl Peer<'_> {
         Req: ros2_client::Message + Clone + 'static,
         Resp: ros2_client::Message + 'static,
     {
-        let id = client
-            .async_send_request(request)
-            .await
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-        tokio::time::timeout(self.timeout, client.async_receive_response(id))
-            .await
-            .map_err(|_| self.late(service))?
-            .map_err(|e| anyhow::anyhow!("{e:?}"))
+        let deadline = tokio::time::Instant::now() + self.timeout;
+        loop {
+            let id = client
+                .async_send_request(request.clone())
+                .await
+                .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+            let left = deadline.saturating_duration_since(tokio::time::Instant::now());
+            let wait = RESEND_PERIOD.min(left);
+            match tokio::time::timeout(wait, client.async_receive_response(id)).await {
+                Ok(response) => return response.map_err(|e| anyhow::anyhow!("{e:?}")),
+                Err(_) if tokio::time::Instant::now() >= deadline => return Err(self.late(service)),
+                Err(_) => continue,
+            }
+        }
     }
 
     /// The values of parameters `names`.
