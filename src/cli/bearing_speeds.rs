@@ -187,23 +187,17 @@ fn equilibrium(
         let eq = equilibrium_under_load(b.film.as_mut(), b.viscosity_pa_s, b.load_n, omega)?;
         return Ok((eq, None));
     };
-    let (Some(heating), Some(law), Some(t_s)) =
-        (f.heating, f.viscosity_law, f.design_supply_temperature_k)
-    else {
+    let Some(t_s) = f.design_supply_temperature_k else {
         anyhow::bail!("oil_heating needs the lubricant's viscosity_temperature law");
     };
-    let mut film = f.scaled(f.reference_solver());
-    let e = crate::film::effective_temperature(
-        &mut film,
-        f.lubricant.viscosity_pa_s,
-        &law,
-        &heating,
-        f.lubricant.density_kg_m3,
-        t_s,
-        b.load_n,
-        omega,
-    )
-    .map_err(|e| anyhow::anyhow!(e))?;
+    let e = f
+        .effective_temperature(
+            t_s,
+            b.load_n,
+            omega,
+            crate::dynamics::FilmEvaluation::Direct,
+        )
+        .map_err(|e| anyhow::anyhow!(e))?;
     let t_c = e.effective_temperature_k - crate::film::ZERO_CELSIUS_K;
     let extra = (t_c, e.temperature_rise_k, e.viscosity_pa_s);
     Ok((e.equilibrium, Some(extra)))

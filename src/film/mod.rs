@@ -35,7 +35,9 @@ pub use equilibrium::{
 pub use error::FilmError;
 pub use finite::{Cavitation, FiniteFilm, FlowBalance};
 pub use geometry::{AxialGroove, BearingGeometry, FilmGrid, Lubricant};
-pub use heating::{effective_temperature, EffectiveTemperature, OilHeating};
+pub use heating::{
+    effective_temperature, thermal_film_temperature, EffectiveTemperature, HeatBalance, OilHeating,
+};
 pub use inertia::{equilibrium_with_inertia, FilmInertia, FluidInertia, InertiaForce};
 pub use short::ShortFilm;
 pub use table::{

@@ -167,6 +167,16 @@ impl ThermalFilm {
         &self.film
     }
 
+    /// The oil: law, specific heat, supply temperature.
+    pub fn oil(&self) -> &ThermalOil {
+        &self.oil
+    }
+
+    /// µ₀, the viscosity of the film's lubricant, by which µ(T) is scaled (Pa·s).
+    pub fn reference_viscosity_pa_s(&self) -> f64 {
+        self.reference_viscosity_pa_s
+    }
+
     /// µ(T)/µ₀ per column from the temperatures; Err names a temperature beyond the law's range.
     fn update_viscosity(&mut self) -> Result<(), FilmError> {
         for (r, &t) in self.ratio.iter_mut().zip(&self.temperature_k) {

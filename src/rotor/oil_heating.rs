@@ -1,10 +1,14 @@
 //! The film bearings at their effective temperatures (issue 12): each film bearing whose oil
 //! has `oil_heating` runs at µ(T_eff), T_eff the fixed point of Raimondi–Boyd's adiabatic heat
-//! balance under its static load ([`crate::film::effective_temperature`]).
+//! balance under its static load ([`crate::film::effective_temperature`]), or the
+//! flow-weighted mean temperature of its adiabatic thermal film there (issue 18,
+//! [`crate::film::thermal_film_temperature`]).
 
-use super::{static_solution, BearingModel, Rotor};
+use super::{static_solution, BearingModel, FilmBearing, Rotor};
 use crate::dynamics::FilmEvaluation;
-use crate::film::EffectiveTemperature;
+use crate::film::{
+    EffectiveTemperature, FilmError, FiniteFilm, HeatBalance, ThermalFilm, ThermalOil,
+};
 
 /// One film bearing's effective temperature.
 #[derive(Debug, Clone)]
@@ -62,31 +66,14 @@ impl Rotor {
             let BearingModel::Film(f) = &mut b.model else {
                 continue;
             };
-            let (Some(heating), Some(law)) = (f.heating, f.viscosity_law) else {
+            let (Some(_), Some(t_s)) = (f.heating, supply_k.or(f.design_supply_temperature_k))
+            else {
                 continue;
             };
-            let Some(t_s) = supply_k.or(f.design_supply_temperature_k) else {
-                continue;
-            };
-            let inner = match film {
-                FilmEvaluation::Direct => f.reference_solver(),
-                FilmEvaluation::Table => f
-                    .reference_tabulated_solver()
-                    .map_err(|e| format!("bearing {}: tabulated film: {e}", b.name))?,
-            };
-            let mut solver = f.scaled(inner);
+            let effective = f
+                .effective_temperature(t_s, loads[i], speed_rad_s, film)
+                .map_err(|e| format!("bearing {}: effective temperature: {e}", b.name))?;
             let mu_ref = f.lubricant.viscosity_pa_s;
-            let effective = crate::film::effective_temperature(
-                &mut solver,
-                mu_ref,
-                &law,
-                &heating,
-                f.lubricant.density_kg_m3,
-                t_s,
-                loads[i],
-                speed_rad_s,
-            )
-            .map_err(|e| format!("bearing {}: effective temperature: {e}", b.name))?;
             let scale =
                 crate::film::check_viscosity_scale(effective.viscosity_pa_s / mu_ref * correction)
                     .map_err(|e| format!("bearing {}: {e}", b.name))?;
@@ -99,5 +86,86 @@ impl Rotor {
             });
         }
         Ok(out)
+    }
+}
+
+impl FilmBearing {
+    /// Why this bearing cannot carry the thermal film of `src/film/thermal.rs`, or None: it is
+    /// the finite laminar film of a plain bearing with the Reynolds condition.
+    pub fn thermal_film_unsupported(&self) -> Option<&'static str> {
+        if self.short {
+            Some("the thermal film is built on the finite model (model: finite)")
+        } else if !self.geometry.grooves.is_empty() {
+            Some("the thermal film is built for a plain bearing (no grooves)")
+        } else if self.flow != crate::film::FlowRegime::Laminar {
+            Some("the thermal film is laminar (flow: laminar)")
+        } else if self.cavitation != crate::film::Cavitation::Reynolds {
+            Some("the thermal film uses the Reynolds condition (cavitation: reynolds)")
+        } else {
+            None
+        }
+    }
+
+    /// The thermal film of this bearing with `oil`, at the machine file's viscosity µ₀ (the
+    /// law sets the field); Err says why it cannot carry one.
+    pub fn thermal_film(&self, oil: ThermalOil) -> Result<ThermalFilm, FilmError> {
+        if let Some(rule) = self.thermal_film_unsupported() {
+            return Err(FilmError::InvalidParameter {
+                name: "thermal film",
+                value: 0.0,
+                rule,
+            });
+        }
+        let film = FiniteFilm::new(self.geometry.clone(), self.lubricant, self.grid)?;
+        ThermalFilm::new(film, oil)
+    }
+
+    /// This bearing's effective temperature by its `oil_heating` at oil supply temperature
+    /// `supply_k` (K), under `load_n` (N) at `speed_rad_s`, the isoviscous film evaluated as
+    /// `film` says (the thermal film itself is always the finite solver). Err says why (no
+    /// heating or law, a film that fails, a temperature beyond the law's range).
+    pub fn effective_temperature(
+        &self,
+        supply_k: f64,
+        load_n: [f64; 2],
+        speed_rad_s: f64,
+        film: FilmEvaluation,
+    ) -> Result<EffectiveTemperature, String> {
+        let (Some(heating), Some(law)) = (self.heating, self.viscosity_law) else {
+            return Err("oil_heating needs the lubricant's viscosity_temperature law".into());
+        };
+        let inner = match film {
+            FilmEvaluation::Direct => self.reference_solver(),
+            FilmEvaluation::Table => self
+                .reference_tabulated_solver()
+                .map_err(|e| format!("tabulated film: {e}"))?,
+        };
+        let mut scaled = self.scaled(inner);
+        match heating.balance {
+            HeatBalance::RaimondiBoyd { .. } => crate::film::effective_temperature(
+                &mut scaled,
+                self.lubricant.viscosity_pa_s,
+                &law,
+                &heating,
+                self.lubricant.density_kg_m3,
+                supply_k,
+                load_n,
+                speed_rad_s,
+            ),
+            HeatBalance::ThermalFilm => {
+                let oil = ThermalOil {
+                    law,
+                    specific_heat_j_per_kg_k: heating.specific_heat_j_per_kg_k,
+                    supply_temperature_k: supply_k,
+                };
+                let mut thermal = self.thermal_film(oil).map_err(|e| e.to_string())?;
+                crate::film::thermal_film_temperature(
+                    &mut thermal,
+                    &mut scaled,
+                    load_n,
+                    speed_rad_s,
+                )
+            }
+        }
     }
 }

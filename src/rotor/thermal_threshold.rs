@@ -10,7 +10,7 @@
 
 use super::modal::{threshold_with, BearingSolvers};
 use super::{BearingModel, BearingSite, FilmBearing, RotorError, StaticSolution, Threshold};
-use crate::film::{FilmError, FilmModel, FiniteFilm, ThermalFilm, ThermalOil, ThermalState};
+use crate::film::{FilmError, FilmModel, ThermalFilm, ThermalOil, ThermalState};
 use crate::rotor::Rotor;
 
 /// One film bearing's thermal film at its static equilibrium.
@@ -26,18 +26,12 @@ pub struct ThermalBearing {
     pub state: ThermalState,
 }
 
-/// Why a bearing cannot carry the thermal film, or None: the film of `src/film/thermal.rs` is
-/// the finite laminar film of a plain bearing with the Reynolds condition, at the machine
-/// file's viscosity (the law sets it), without fluid inertia.
+/// Why a bearing cannot carry the thermal film of the threshold, or None: the film's own
+/// rules ([`FilmBearing::thermal_film_unsupported`]), at the machine file's viscosity (the law
+/// sets it), without fluid inertia.
 fn unsupported(f: &FilmBearing) -> Option<&'static str> {
-    if f.short {
-        Some("the thermal film is built on the finite model (model: finite)")
-    } else if !f.geometry.grooves.is_empty() {
-        Some("the thermal film is built for a plain bearing (no grooves)")
-    } else if f.flow != crate::film::FlowRegime::Laminar {
-        Some("the thermal film is laminar (flow: laminar)")
-    } else if f.cavitation != crate::film::Cavitation::Reynolds {
-        Some("the thermal film uses the Reynolds condition (cavitation: reynolds)")
+    if let Some(rule) = f.thermal_film_unsupported() {
+        Some(rule)
     } else if f.inertia.is_some() {
         Some("the thermal threshold is built without the film's fluid inertia")
     } else if f.viscosity_scale != 1.0 {
@@ -87,8 +81,7 @@ fn thermal_film(
             rule,
         }));
     }
-    let film = FiniteFilm::new(f.geometry.clone(), f.lubricant, f.grid).map_err(fail)?;
-    ThermalFilm::new(film, oil.clone()).map_err(fail)
+    f.thermal_film(oil.clone()).map_err(fail)
 }
 
 /// The linear stability threshold over `[from, to, step]` (rpm) with every film bearing's

@@ -296,6 +296,9 @@ impl RawBearingSpec {
             Some((l, h)) => Some(h.checked(l, &format!("bearings[{i}].lubricant"), rules)?),
             None => None,
         };
+        if heating.is_some_and(|h| h.balance == crate::film::HeatBalance::ThermalFilm) {
+            self.check_thermal_film(i, rules)?;
+        }
         Ok(FilmSpec {
             geometry,
             lubricant,
@@ -308,6 +311,26 @@ impl RawBearingSpec {
             fluid_inertia: self.fluid_inertia,
             flow: self.flow.unwrap_or_default(),
         })
+    }
+
+    /// `oil_heating: {model: thermal_film}` needs the film `src/film/thermal.rs` solves: the
+    /// finite, laminar film of a plain bearing (`FilmBearing::thermal_film_unsupported`).
+    fn check_thermal_film(&self, i: usize, rules: &Rules) -> Result<(), ConfigError> {
+        let field = format!("bearings[{i}].lubricant.oil_heating.model");
+        let refuse = |rule: &str| Err(rules.error(&field, "thermal_film", rule));
+        if self.model != BearingModelName::Finite {
+            return refuse("the thermal film is built on the finite model (model: finite)");
+        }
+        if self.grooves != GroovesSpec::None {
+            return refuse("the thermal film is built for a plain bearing (grooves: none)");
+        }
+        if self
+            .flow
+            .is_some_and(|f| f != crate::film::FlowRegime::Laminar)
+        {
+            return refuse("the thermal film is laminar (flow: laminar)");
+        }
+        Ok(())
     }
 
     /// The lubricant of entry `i`, and its viscosity–temperature law if given.

@@ -35,9 +35,13 @@ pub struct LubricantSpec {
 pub enum OilHeatingModel {
     /// Raimondi–Boyd's adiabatic effective temperature (`crate::film::effective_temperature`).
     EffectiveTemperature,
+    /// The flow-weighted mean temperature of the adiabatic thermal film (issue 18,
+    /// `crate::film::thermal_film_temperature`).
+    ThermalFilm,
 }
 
-/// `oil_heating: {model: effective_temperature, specific_heat_j_per_kg_k: …, carry_over: …}`.
+/// `oil_heating: {model: effective_temperature, specific_heat_j_per_kg_k: …, carry_over: …}`
+/// or `{model: thermal_film, specific_heat_j_per_kg_k: …}`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OilHeatingSpec {
@@ -45,18 +49,15 @@ pub struct OilHeatingSpec {
     pub model: OilHeatingModel,
     /// Specific heat capacity c_p of the oil (J/(kg·K)).
     pub specific_heat_j_per_kg_k: f64,
-    /// Hot-oil carry-over factor k: T_eff = T_supply + k ΔT (0.5 when absent: the mean film
-    /// temperature of Raimondi–Boyd and Shigley).
-    #[serde(default = "default_carry_over")]
-    pub carry_over: f64,
+    /// Hot-oil carry-over factor k: T_eff = T_supply + k ΔT (`effective_temperature` only;
+    /// [`DEFAULT_CARRY_OVER`] when absent: the mean film temperature of Raimondi–Boyd and
+    /// Shigley). The thermal film mixes its own carry-over and refuses one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carry_over: Option<f64>,
 }
 
 /// k of T_eff = T_supply + k ΔT when the machine file gives none.
 pub const DEFAULT_CARRY_OVER: f64 = 0.5;
-
-fn default_carry_over() -> f64 {
-    DEFAULT_CARRY_OVER
-}
 
 impl OilHeatingSpec {
     /// The checked option of lubricant `lub` written at `prefix` (it needs a viscosity law).
@@ -73,18 +74,21 @@ impl OilHeatingSpec {
                 "needs lubricant.viscosity_temperature: the effective temperature acts through the viscosity law",
             ));
         }
-        crate::film::OilHeating::new(self.specific_heat_j_per_kg_k, self.carry_over).map_err(
-            |rule| {
-                rules.error(
-                    format!("{prefix}.oil_heating"),
-                    format!(
-                        "c_p {} J/(kg·K), carry_over {}",
-                        self.specific_heat_j_per_kg_k, self.carry_over
-                    ),
-                    rule,
-                )
-            },
-        )
+        let cp = self.specific_heat_j_per_kg_k;
+        let heating = match (self.model, self.carry_over) {
+            (OilHeatingModel::EffectiveTemperature, k) => {
+                let k = k.unwrap_or(DEFAULT_CARRY_OVER);
+                crate::film::OilHeating::new(cp, k)
+                    .map_err(|rule| (format!("c_p {cp} J/(kg·K), carry_over {k}"), rule))
+            }
+            (OilHeatingModel::ThermalFilm, None) => crate::film::OilHeating::thermal_film(cp)
+                .map_err(|rule| (format!("c_p {cp} J/(kg·K)"), rule)),
+            (OilHeatingModel::ThermalFilm, Some(k)) => Err((
+                format!("model thermal_film, carry_over {k}"),
+                "carry_over is Raimondi–Boyd's (model: effective_temperature); the thermal film mixes its own hot oil (E3)".into(),
+            )),
+        };
+        heating.map_err(|(value, rule)| rules.error(format!("{prefix}.oil_heating"), value, rule))
     }
 }
 
