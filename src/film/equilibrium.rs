@@ -86,6 +86,69 @@ pub fn equilibrium_under_load(
 ) -> Result<Equilibrium, FilmError> {
     let w = load_n[0].hypot(load_n[1]);
     positive("static load (N)", w)?;
+    check_speed(speed_rad_s)?;
+    let c = model.geometry().radial_clearance_m;
+    let s = sommerfeld_number(model, viscosity_pa_s, speed_rad_s, w);
+    let load_angle = load_n[1].atan2(load_n[0]);
+    let turn = speed_rad_s.signum();
+    let start = short_bearing_start(model, viscosity_pa_s, load_n, speed_rad_s);
+    let (q, film, it) = newton_position(model, load_n, speed_rad_s, start)?;
+    let kin = JournalKinematics::at_position(q, speed_rad_s);
+    let coef = model.linearised_coefficients(&kin)?;
+    let mut phi = turn * (q[1].atan2(q[0]) - load_angle);
+    phi = (phi + PI).rem_euclid(2.0 * PI) - PI;
+    Ok(Equilibrium {
+        position_m: q,
+        eccentricity_ratio: kin.eccentricity_ratio(c),
+        attitude_angle_rad: phi,
+        load_n,
+        sommerfeld_number: s,
+        film,
+        coefficients: coef,
+        iterations: it,
+    })
+}
+
+/// The journal position of the short-bearing (Ocvirk) solution at the film's Sommerfeld
+/// number, ε kept within 0.05–0.9: where [`equilibrium_under_load`] starts.
+fn short_bearing_start(
+    model: &dyn FilmModel,
+    viscosity_pa_s: f64,
+    load_n: [f64; 2],
+    speed_rad_s: f64,
+) -> [f64; 2] {
+    let c = model.geometry().radial_clearance_m;
+    let s = sommerfeld_number(
+        model,
+        viscosity_pa_s,
+        speed_rad_s,
+        load_n[0].hypot(load_n[1]),
+    );
+    let e0 = short_bearing_eccentricity(s, model.geometry().slenderness()).clamp(0.05, 0.9);
+    let psi = load_n[1].atan2(load_n[0]) + speed_rad_s.signum() * short_bearing_attitude(e0);
+    [e0 * c * psi.cos(), e0 * c * psi.sin()]
+}
+
+/// The position (m) where the film carries `load_n` (N) at `speed_rad_s`, and the film there,
+/// by the Newton iteration of [`equilibrium_under_load`] started at `start` (m; a warm start,
+/// e.g. the last position of a slowly changing film) or, without one, where it starts; without
+/// the equilibrium's linearised coefficients.
+pub fn equilibrium_position(
+    model: &mut dyn FilmModel,
+    viscosity_pa_s: f64,
+    load_n: [f64; 2],
+    speed_rad_s: f64,
+    start: Option<[f64; 2]>,
+) -> Result<([f64; 2], FilmResult), FilmError> {
+    positive("static load (N)", load_n[0].hypot(load_n[1]))?;
+    check_speed(speed_rad_s)?;
+    let start =
+        start.unwrap_or_else(|| short_bearing_start(model, viscosity_pa_s, load_n, speed_rad_s));
+    let (q, film, _) = newton_position(model, load_n, speed_rad_s, start)?;
+    Ok((q, film))
+}
+
+fn check_speed(speed_rad_s: f64) -> Result<(), FilmError> {
     if !(speed_rad_s.is_finite() && speed_rad_s != 0.0) {
         return Err(FilmError::InvalidParameter {
             name: "journal speed (rad/s)",
@@ -93,34 +156,29 @@ pub fn equilibrium_under_load(
             rule: "must be finite and not zero: a film at rest carries no static load",
         });
     }
+    Ok(())
+}
+
+/// Newton's method on the film force − load from `start`, the film stiffness as Jacobian and
+/// a halving line search on the residual; to 1e-9 of the load. The position, the film there
+/// and the iterations taken.
+fn newton_position(
+    model: &mut dyn FilmModel,
+    load_n: [f64; 2],
+    speed_rad_s: f64,
+    start: [f64; 2],
+) -> Result<([f64; 2], FilmResult, usize), FilmError> {
+    let w = load_n[0].hypot(load_n[1]);
     let c = model.geometry().radial_clearance_m;
-    let s = sommerfeld_number(model, viscosity_pa_s, speed_rad_s, w);
-    let e0 = short_bearing_eccentricity(s, model.geometry().slenderness()).clamp(0.05, 0.9);
-    let load_angle = load_n[1].atan2(load_n[0]);
-    let turn = speed_rad_s.signum();
-    let psi = load_angle + turn * short_bearing_attitude(e0);
-    let mut q = [e0 * c * psi.cos(), e0 * c * psi.sin()];
     let residual = |f: &FilmResult| [f.force_n[0] + load_n[0], f.force_n[1] + load_n[1]];
     let norm = |r: [f64; 2]| r[0].hypot(r[1]);
-    let mut kin = JournalKinematics::at_position(q, speed_rad_s);
+    let mut q = start;
+    let kin = JournalKinematics::at_position(q, speed_rad_s);
     let (mut film, mut coef) = model.solve_with_coefficients(&kin)?;
     let mut r = residual(&film);
     for it in 0..MAX_ITERATIONS {
         if norm(r) <= 1e-9 * w {
-            let eps = kin.eccentricity_ratio(c);
-            let coef = model.linearised_coefficients(&kin)?;
-            let mut phi = turn * (q[1].atan2(q[0]) - load_angle);
-            phi = (phi + PI).rem_euclid(2.0 * PI) - PI;
-            return Ok(Equilibrium {
-                position_m: q,
-                eccentricity_ratio: eps,
-                attitude_angle_rad: phi,
-                load_n,
-                sommerfeld_number: s,
-                film,
-                coefficients: coef,
-                iterations: it,
-            });
+            return Ok((q, film, it));
         }
         // −K Δq = −r  →  Δq = K⁻¹ r
         let newton = coef
@@ -139,7 +197,7 @@ pub fn equilibrium_under_load(
                 if let Ok((f, cf)) = model.solve_with_coefficients(&tk) {
                     let tr = residual(&f);
                     if norm(tr) < norm(r) {
-                        (q, kin, film, coef, r) = (trial, tk, f, cf, tr);
+                        (q, film, coef, r) = (trial, f, cf, tr);
                         accepted = true;
                         break;
                     }

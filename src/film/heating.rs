@@ -22,8 +22,8 @@
 //! into the solids, constant ρ and c_p.
 
 use super::{
-    equilibrium_under_load, Equilibrium, FilmModel, FilmResult, ThermalFilm, ViscosityLaw,
-    ViscosityScaledFilm,
+    equilibrium_position, equilibrium_under_load, Equilibrium, FilmModel, FilmResult, ThermalFilm,
+    ViscosityLaw, ViscosityScaledFilm,
 };
 
 /// The effective-temperature option of a film bearing's oil.
@@ -259,11 +259,13 @@ pub fn thermal_film_temperature(
     let mu0 = thermal.reference_viscosity_pa_s();
     // T̄ of the last two passes
     let (mut before, mut last) = (f64::NAN, f64::NAN);
+    let mut position = None;
     for pass in 1..=THERMAL_PASSES {
         let mut frozen = thermal.film().clone();
-        let eq = equilibrium_under_load(&mut frozen, mu0, load_n, speed_rad_s)
+        let (q, _) = equilibrium_position(&mut frozen, mu0, load_n, speed_rad_s, position)
             .map_err(|e| format!("film equilibrium with the thermal field held: {e}"))?;
-        let kin = super::JournalKinematics::at_position(eq.position_m, speed_rad_s);
+        position = Some(q);
+        let kin = super::JournalKinematics::at_position(q, speed_rad_s);
         thermal
             .solve(&kin)
             .map_err(|e| format!("thermal film at the equilibrium: {e}"))?;

@@ -29,8 +29,8 @@ mod viscosity;
 
 pub use coefficients::{matrix2, rows, rows2, solve2, FilmCoefficients};
 pub use equilibrium::{
-    equilibrium_at_eccentricity, equilibrium_under_load, short_bearing_eccentricity,
-    sommerfeld_number, Equilibrium, MAX_EQUILIBRIUM_ECCENTRICITY,
+    equilibrium_at_eccentricity, equilibrium_position, equilibrium_under_load,
+    short_bearing_eccentricity, sommerfeld_number, Equilibrium, MAX_EQUILIBRIUM_ECCENTRICITY,
 };
 pub use error::FilmError;
 pub use finite::{Cavitation, FiniteFilm, FlowBalance};
