@@ -597,3 +597,120 @@ fn fluid_fraction_map_svg(
     root.present()?;
     Ok(())
 }
+
+/// The growth rate (1/s) of a small free whirl of (A) at `rpm` with cavitation `cav`: no
+/// unbalance, a `kick` (N·s) at node 15 from the static equilibrium, then `revs` revolutions;
+/// the largest distance of the pulley-end journal from its equilibrium in each window of 4
+/// revolutions (the whirl near ½X takes 2), and the log-linear slope of those peaks over the
+/// windows after the first 2 (the kick's other modes decayed). Also the whirl's last peak (m)
+/// and the wall time (s).
+fn free_whirl_growth(
+    rpm: f64,
+    (cav, table): (Cavitation, bool),
+    kick: f64,
+    revs: usize,
+) -> (f64, f64, f64) {
+    let per_rev = 128;
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/config/orc_microturbine_100kw_d55.yaml"
+    );
+    let desc = MachineDescription::load(Some(std::path::Path::new(path))).unwrap();
+    let mut rotor = Rotor::from_description(&desc);
+    rotor.unbalance.clear();
+    rotor.set_cavitation(cav).unwrap();
+    let w = rpm * PI / 30.0;
+    let mut config = TwinConfig::with_steps_per_rev(Coupling::Nonlinear, w, per_rev);
+    if table {
+        rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
+            common::test_cache_dir(),
+        )));
+        config.film = rotor_twin::dynamics::FilmEvaluation::Table;
+    }
+    let mut twin = Twin::new(&rotor, config, w).unwrap();
+    let input = StepInput {
+        speed_rad_s: w,
+        accel_rad_s2: 0.0,
+    };
+    let h = twin.config().time_step_s;
+    let eq = twin.output().bearings[0].position_m;
+    let started = std::time::Instant::now();
+    let window = 4 * per_rev;
+    let mut peaks = Vec::new();
+    let mut peak = 0.0_f64;
+    for step in 0..revs * per_rev {
+        let f = if step == 0 { kick / h } else { 0.0 };
+        twin.set_external_force(15, [f, 0.0]).unwrap();
+        let p = twin.step(&input).unwrap().bearings[0].position_m;
+        peak = peak.max((p[0] - eq[0]).hypot(p[1] - eq[1]));
+        if (step + 1) % window == 0 {
+            peaks.push(peak);
+            peak = 0.0;
+        }
+    }
+    let skip = std::env::var("MCAV_ONSET_SKIP").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let fit: Vec<(f64, f64)> = (peaks.iter().enumerate().skip(skip))
+        .map(|(k, a)| ((k as f64 + 0.5) * window as f64 * h, a.ln()))
+        .collect();
+    let n = fit.len() as f64;
+    let (mt, my) = (
+        fit.iter().map(|p| p.0).sum::<f64>() / n,
+        fit.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let slope = fit.iter().map(|p| (p.0 - mt) * (p.1 - my)).sum::<f64>()
+        / fit.iter().map(|p| (p.0 - mt).powi(2)).sum::<f64>();
+    let last = *peaks.last().unwrap();
+    (slope, last, started.elapsed().as_secs_f64())
+}
+
+/// The onset speed with mass conservation (issue 18; a study, not run by `cargo test`: ≈ 1 s
+/// a revolution for the mass-conserving film). The growth rate of a small free whirl of
+/// reading (A) (no unbalance, a 0.05 N·s kick) at held speeds, both films; its zero by linear
+/// interpolation between the speeds that bracket it. Reference for the method: the Reynolds
+/// film's zero against its linear threshold (8,471.3 rpm, `modes` on 60 × 10); the
+/// mass-conserving film's zero is the figure sought.
+/// `MCAV_ONSET_SPEEDS=8300,8500,8700 MCAV_ONSET_REVS=40 cargo test --release --test
+/// twin_mass_conserving -- --ignored onset_speed --nocapture`
+#[test]
+#[ignore = "a study: minutes a speed with the mass-conserving film"]
+fn onset_speed_with_mass_conservation() {
+    let speeds: Vec<f64> = std::env::var("MCAV_ONSET_SPEEDS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|v| v.parse().ok()).collect())
+        .unwrap_or_else(|| vec![8300.0, 8500.0, 8700.0]);
+    let revs: usize = std::env::var("MCAV_ONSET_REVS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
+    let kick: f64 = std::env::var("MCAV_ONSET_KICK")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.05);
+    // (cavitation, tabulated film)
+    let films: Vec<(Cavitation, bool)> = match std::env::var("MCAV_ONSET_FILMS").as_deref() {
+        Ok("reynolds") => vec![(Cavitation::Reynolds, false)],
+        Ok("reynolds-table") => vec![(Cavitation::Reynolds, true)],
+        Ok("mass-conserving") => vec![(Cavitation::MassConserving, false)],
+        _ => vec![
+            (Cavitation::Reynolds, true),
+            (Cavitation::Reynolds, false),
+            (Cavitation::MassConserving, false),
+        ],
+    };
+    for film in films {
+        let mut rates = Vec::new();
+        for &rpm in &speeds {
+            let (sigma, last, wall) = free_whirl_growth(rpm, film, kick, revs);
+            println!(
+                "ONSET {film:?} {rpm:.0} rpm: growth {sigma:+.3} 1/s, last peak {:.4} µm ({revs} rev in {wall:.0} s)",
+                1e6 * last
+            );
+            rates.push((rpm, sigma));
+        }
+        let zero = rates
+            .windows(2)
+            .find(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
+            .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1));
+        println!("ONSET {film:?}: growth rate zero at {zero:?} rpm");
+    }
+}
