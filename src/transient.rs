@@ -40,6 +40,10 @@ pub struct TransientResult {
     pub orbits: Vec<Vec<[f64; 2]>>,
     /// Mid-plane pressure profiles of each bearing over the last two revolutions (Pa).
     pub pressure_maps: Vec<Vec<Vec<f64>>>,
+    /// Mid-plane fluid fraction φ of each bearing, one row a step over the last two
+    /// revolutions ([`FLUID_FRACTION_POINTS`] around the bearing): with mass-conserving
+    /// cavitation only (empty otherwise: a Reynolds film is full wherever it carries load).
+    pub fluid_fraction_maps: Vec<Vec<Vec<f64>>>,
     /// Order spectrum of each bearing over the last 16 revolutions.
     pub spectra: Vec<Vec<OrderComponent>>,
     /// Simulated time (s).
@@ -272,6 +276,66 @@ pub fn apply_kicks(
     Ok(any)
 }
 
+/// Points around the bearing of [`TransientResult::fluid_fraction_maps`] (4° apart; each the
+/// nearest grid column's φ).
+pub const FLUID_FRACTION_POINTS: usize = 90;
+
+/// The mid-plane fluid fraction of each bearing over the last steps of a run: a ring of rows
+/// (one a step), allocated once.
+struct FractionRing {
+    rows: Vec<std::collections::VecDeque<Vec<f64>>>,
+    capacity: usize,
+}
+
+impl FractionRing {
+    /// For `twin`'s bearings when one of `rotor`'s films is mass-conserving, keeping
+    /// `capacity` steps (None otherwise).
+    fn of(rotor: &Rotor, twin: &Twin, capacity: usize) -> Option<Self> {
+        let mass_conserving = rotor.bearings.iter().any(|b| {
+            matches!(&b.model, BearingModel::Film(f)
+                if f.cavitation == crate::film::Cavitation::MassConserving)
+        });
+        mass_conserving.then(|| Self {
+            rows: vec![
+                std::collections::VecDeque::with_capacity(capacity);
+                twin.output().bearings.len()
+            ],
+            capacity,
+        })
+    }
+
+    fn record(&mut self, twin: &Twin) {
+        for (b, ring) in self.rows.iter_mut().enumerate() {
+            let mut row = if ring.len() == self.capacity {
+                ring.pop_front().unwrap_or_default()
+            } else {
+                vec![0.0; FLUID_FRACTION_POINTS]
+            };
+            twin.midplane_fluid_fraction(b, &mut row);
+            ring.push_back(row);
+        }
+    }
+
+    /// The rows of the last two revolutions of each of `n` bearings, a step turning the shaft
+    /// by `step_angle_rad` at the end (empty rows without a ring).
+    fn last_two_revolutions(
+        ring: Option<Self>,
+        n: usize,
+        step_angle_rad: f64,
+    ) -> Vec<Vec<Vec<f64>>> {
+        let Some(me) = ring else {
+            return vec![Vec::new(); n];
+        };
+        let steps = (4.0 * std::f64::consts::PI / step_angle_rad).round() as usize;
+        (me.rows.into_iter())
+            .map(|ring| {
+                let skip = ring.len().saturating_sub(steps);
+                ring.into_iter().skip(skip).collect()
+            })
+            .collect()
+    }
+}
+
 /// Runs `spec` on `rotor` under `drive` (speed history, kicks), from `initial` if given.
 pub fn run_driven(
     rotor: &Rotor,
@@ -289,18 +353,11 @@ pub fn run_driven(
         Some(h) => h.at(t),
         None => (spec.speed_rpm, 0.0),
     };
-    // the time step gives `steps_per_rev` steps a revolution at the highest speed (more below)
-    let config = TwinConfig {
-        film: spec.film,
-        ..TwinConfig::with_steps_per_rev(spec.coupling, rpm_to_rad_s(hi_rpm), spec.steps_per_rev)
-    };
-    let h = config.time_step_s;
-    let mut twin = Twin::new(&rotor, config, rpm_to_rad_s(speed_at(0.0).0))?;
-    if let Some((q, qd, qdd)) = initial {
-        twin.set_state_vectors(q, qd, qdd)?;
-    }
+    let mut twin = start_twin(&rotor, spec, (hi_rpm, speed_at(0.0).0), initial)?;
+    let h = twin.config().time_step_s;
     let per_rev = (spec.steps_per_rev as f64 * hi_rpm / lo_rpm).ceil() as usize + 2;
     let mut monitor = Monitor::new(&twin, per_rev, ClassifierSettings::default());
+    let mut fractions = FractionRing::of(&rotor, &twin, 2 * per_rev);
     let mut history = Vec::with_capacity(spec.revolutions);
     let mut applied = vec![false; drive.kicks.len()];
     let duration = drive.speed.as_ref().map_or(0.0, SpeedHistory::duration_s);
@@ -320,6 +377,9 @@ pub fn run_driven(
         iterations += out.newton_iterations;
         max_substeps = max_substeps.max(out.substeps);
         fallbacks += out.prehistory_fallbacks;
+        if let Some(f) = fractions.as_mut() {
+            f.record(&twin);
+        }
         if let Some(r) = monitor.record(&twin) {
             history.push(r.clone());
         }
@@ -331,6 +391,8 @@ pub fn run_driven(
     let n = twin.output().bearings.len();
     let (q, qd, qdd) = twin.state_vectors();
     let final_state = (q.to_vec(), qd.to_vec(), qdd.to_vec());
+    let final_omega = rpm_to_rad_s(speed_at(twin.time_s()).0);
+    let fluid_fraction_maps = FractionRing::last_two_revolutions(fractions, n, final_omega * h);
     Ok(TransientResult {
         report: monitor.report().clone(),
         history,
@@ -338,6 +400,7 @@ pub fn run_driven(
         clearances_m: twin.bearing_clearances_m(),
         orbits: (0..n).map(|b| monitor.recent_orbit(b, 2)).collect(),
         pressure_maps: (0..n).map(|b| monitor.recent_pressure(b, 2)).collect(),
+        fluid_fraction_maps,
         spectra: (0..n).map(|b| monitor.full_spectrum(b)).collect(),
         simulated_s: twin.time_s(),
         wall_time_s,
@@ -347,6 +410,26 @@ pub fn run_driven(
         prehistory_fallbacks: fallbacks,
         final_state,
     })
+}
+
+/// The twin of a run of `spec` on `rotor` whose highest speed is `hi_rpm`, at `start_rpm`,
+/// from `initial` if given: the time step gives `steps_per_rev` steps a revolution at the
+/// highest speed (more below).
+fn start_twin(
+    rotor: &Rotor,
+    spec: &TransientSpec,
+    (hi_rpm, start_rpm): (f64, f64),
+    initial: Option<&StateVectors>,
+) -> Result<Twin, TwinError> {
+    let config = TwinConfig {
+        film: spec.film,
+        ..TwinConfig::with_steps_per_rev(spec.coupling, rpm_to_rad_s(hi_rpm), spec.steps_per_rev)
+    };
+    let mut twin = Twin::new(rotor, config, rpm_to_rad_s(start_rpm))?;
+    if let Some((q, qd, qdd)) = initial {
+        twin.set_state_vectors(q, qd, qdd)?;
+    }
+    Ok(twin)
 }
 
 /// The spec's own checks (speed, revolutions, steps a revolution).

@@ -202,6 +202,57 @@ fn a_fluid_fraction_disturbance_drifts_out_at_half_the_shaft_speed() {
     assert!(hundredth < 2.0, "99 % gone after {hundredth} rev");
 }
 
+/// The fluid-fraction map of a run (`TransientResult::fluid_fraction_maps`, drawn by
+/// `simulate --plot` as `fluid_fraction_<bearing>.svg`): with mass conservation one row a step
+/// over the last two revolutions at the final speed, every φ in [0, 1] (the complementarity
+/// bounds, M2), the ruptured zone's streamers below 0.9 (8,000 rpm: 0.27–0.28, README "In the
+/// rotor transient") and the pressure zone full; a Reynolds run has none. The plot is written
+/// and names φ's floor.
+#[test]
+fn a_run_keeps_its_fluid_fraction_map_and_plots_it() {
+    use rotor_twin::transient::{run_transient, TransientSpec, FLUID_FRACTION_POINTS};
+    let per_rev = 32;
+    let spec = TransientSpec {
+        speed_rpm: 8000.0,
+        revolutions: 3,
+        coupling: Coupling::Nonlinear,
+        steps_per_rev: per_rev,
+        grid: None,
+        film: rotor_twin::dynamics::FilmEvaluation::Direct,
+    };
+    let desc = MachineDescription::load(None).unwrap();
+    let mut rotor = Rotor::from_description(&desc);
+    let reynolds = run_transient(&rotor, &spec).unwrap();
+    assert!(reynolds.fluid_fraction_maps.iter().all(Vec::is_empty));
+    rotor.set_cavitation(Cavitation::MassConserving).unwrap();
+    let r = run_transient(&rotor, &spec).unwrap();
+    assert_eq!(r.fluid_fraction_maps.len(), 2);
+    for map in &r.fluid_fraction_maps {
+        assert_eq!(map.len(), 2 * per_rev, "rows: two revolutions of steps");
+        assert!(map.iter().all(|row| row.len() == FLUID_FRACTION_POINTS));
+        let all = || map.iter().flatten().copied();
+        assert!(all().all(|v| (0.0..=1.0).contains(&v)));
+        let lowest = all().fold(1.0_f64, f64::min);
+        let full =
+            all().filter(|&v| v == 1.0).count() as f64 / (map.len() * FLUID_FRACTION_POINTS) as f64;
+        println!(
+            "φ down to {lowest:.3}, {:.0} % of the cells full",
+            100.0 * full
+        );
+        assert!(
+            lowest < 0.9,
+            "the ruptured zone holds streamers: φ {lowest}"
+        );
+        assert!(full > 0.3, "the pressure zone is full: {full}");
+    }
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("fluid_fraction_plot");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("phi.svg");
+    rotor_twin::plot::fluid_fraction_map_svg(&path, "test", &r.fluid_fraction_maps[0]).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.contains("φ down to"), "the title names the floor");
+}
+
 /// `simulate` and `sweep` run the mass-conserving film (the JSON says so) and refuse it with the
 /// film table, naming the reason.
 #[test]
@@ -648,7 +699,10 @@ fn free_whirl_growth(
             peak = 0.0;
         }
     }
-    let skip = std::env::var("MCAV_ONSET_SKIP").ok().and_then(|s| s.parse().ok()).unwrap_or(2);
+    let skip = std::env::var("MCAV_ONSET_SKIP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
     let fit: Vec<(f64, f64)> = (peaks.iter().enumerate().skip(skip))
         .map(|(k, a)| ((k as f64 + 0.5) * window as f64 * h, a.ln()))
         .collect();

@@ -715,6 +715,13 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
             &r.pressure_maps[i],
             not_valid.as_deref(),
         )?;
+        if !r.fluid_fraction_maps[i].is_empty() {
+            crate::plot::fluid_fraction_map_svg(
+                &dir.join(format!("fluid_fraction_{name}.svg")),
+                &format!("mid-plane fluid fraction: {name}"),
+                &r.fluid_fraction_maps[i],
+            )?;
+        }
     }
     Ok(())
 }

@@ -23,7 +23,7 @@ pub use replay_views::{
 };
 pub use response::{bode_svg, polar_svg, ResponseCurve};
 pub use rotor::{rotor_svg, BearingGlyph, DiscGlyph, RotorDrawing, SectionGlyph};
-pub use transient::{orbit_svg, pressure_map_svg, spectrum_svg, sweep_svg};
+pub use transient::{fluid_fraction_map_svg, orbit_svg, pressure_map_svg, spectrum_svg, sweep_svg};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -1,5 +1,6 @@
-//! Plots of a transient run: orbit in the clearance circle, order spectrum, pressure map, and the
-//! amplitude–speed characteristic of a sweep.
+//! Plots of a transient run: orbit in the clearance circle, order spectrum, pressure map, the
+//! fluid-fraction map (mass-conserving cavitation), and the amplitude–speed characteristic of a
+//! sweep.
 
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::monitor::OrderComponent;
@@ -198,8 +199,6 @@ pub fn pressure_map_svg(
     map_pa: &[Vec<f64>],
     not_valid: Option<&str>,
 ) -> anyhow::Result<()> {
-    let steps = map_pa.len().max(1);
-    let points = map_pa.first().map_or(1, Vec::len).max(1);
     let mut sorted: Vec<f64> = map_pa
         .iter()
         .flatten()
@@ -231,7 +230,56 @@ pub fn pressure_map_svg(
     root.fill(&WHITE)?;
     let root = titled_with_validity(root, &caption, not_valid)?;
     let (map_area, bar_area) = root.split_horizontally(790);
-    let mut chart = ChartBuilder::on(&map_area)
+    draw_map(&map_area, map_pa, |p| {
+        if p > top {
+            ABOVE_SCALE
+        } else {
+            pressure_shade(p, top)
+        }
+    })?;
+    colour_bar(&bar_area, ("pressure (MPa)", top * 1e-6), |v| {
+        pressure_shade(v * 1e6, top)
+    })?;
+    root.present()?;
+    Ok(())
+}
+
+/// The grey of fluid fraction `phi`: white 0 (no oil) → black 1 (full film).
+fn fraction_shade(phi: f64) -> RGBColor {
+    pressure_shade(phi, 1.0)
+}
+
+/// Mid-plane fluid fraction φ over the last two revolutions (mass-conserving cavitation, issue
+/// 18): bearing angle against shaft rotation (degrees), grey = φ (black: full film, φ = 1;
+/// lighter: the ruptured zone's streamers), with a colour bar 0–1.
+pub fn fluid_fraction_map_svg(path: &Path, title: &str, map: &[Vec<f64>]) -> anyhow::Result<()> {
+    let lowest = (map.iter().flatten().copied())
+        .filter(|v| v.is_finite())
+        .fold(1.0_f64, f64::min);
+    let caption = format!("{title}: φ down to {lowest:.2}");
+    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(&caption, ("sans-serif", 18))?;
+    let (map_area, bar_area) = root.split_horizontally(790);
+    draw_map(&map_area, map, fraction_shade)?;
+    colour_bar(&bar_area, ("fluid fraction φ", 1.0), fraction_shade)?;
+    root.present()?;
+    Ok(())
+}
+
+/// A map of rows (one a time step, over 720° of shaft rotation) of values around the bearing
+/// (0–360° from +x), each cell filled with `shade(value)`.
+fn draw_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    map: &[Vec<f64>],
+    shade: impl Fn(f64) -> RGBColor,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let steps = map.len().max(1);
+    let points = map.first().map_or(1, Vec::len).max(1);
+    let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(60)
@@ -244,22 +292,16 @@ pub fn pressure_map_svg(
         .y_label_formatter(&|v| format!("{v:.0}"))
         .draw()?;
     let (dx, dy) = (720.0 / steps as f64, 360.0 / points as f64);
-    chart.draw_series(map_pa.iter().enumerate().flat_map(|(t, row)| {
-        row.iter().enumerate().map(move |(k, &p)| {
-            let colour = if p > top {
-                ABOVE_SCALE
-            } else {
-                pressure_shade(p, top)
-            };
+    let shade = &shade;
+    chart.draw_series(map.iter().enumerate().flat_map(|(t, row)| {
+        row.iter().enumerate().map(move |(k, &v)| {
             let x = t as f64 * dx;
             Rectangle::new(
                 [(x, k as f64 * dy), (x + dx, (k + 1) as f64 * dy)],
-                colour.filled(),
+                shade(v).filled(),
             )
         })
     }))?;
-    colour_bar(&bar_area, top)?;
-    root.present()?;
     Ok(())
 }
 
@@ -286,38 +328,33 @@ fn titled_with_validity<'a>(
     Ok(rest)
 }
 
-/// The pressure scale beside the map: grey 0 → `top` (MPa).
+/// The scale beside a map: `label`, from 0 to `top` (in the label's unit), each value's grey
+/// by `shade`.
 fn colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
-    top: f64,
+    (label, top): (&str, f64),
+    shade: impl Fn(f64) -> RGBColor,
 ) -> anyhow::Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let top_mpa = top * 1e-6;
     let mut bar = ChartBuilder::on(area)
         .margin_top(15)
         .margin_bottom(55)
         .margin_right(10)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.0..1.0, 0.0..top_mpa)?;
+        .build_cartesian_2d(0.0..1.0, 0.0..top)?;
     bar.configure_mesh()
         .disable_x_mesh()
         .disable_x_axis()
-        .y_desc("pressure (MPa)")
+        .y_desc(label)
         .y_label_style(("sans-serif", 12))
         .axis_desc_style(("sans-serif", 13))
         .draw()?;
     let n = 100;
     bar.draw_series((0..n).map(|i| {
-        let (p0, p1) = (
-            top_mpa * i as f64 / n as f64,
-            top_mpa * (i + 1) as f64 / n as f64,
-        );
-        Rectangle::new(
-            [(0.0, p0), (1.0, p1)],
-            pressure_shade(p0 * 1e6, top).filled(),
-        )
+        let (v0, v1) = (top * i as f64 / n as f64, top * (i + 1) as f64 / n as f64);
+        Rectangle::new([(0.0, v0), (1.0, v1)], shade(v0).filled())
     }))?;
     Ok(())
 }
