@@ -766,5 +766,21 @@ fn onset_speed_with_mass_conservation() {
             .find(|p| p[0].1 < 0.0 && p[1].1 >= 0.0)
             .map(|p| p[0].0 + (p[1].0 - p[0].0) * (-p[0].1) / (p[1].1 - p[0].1));
         println!("ONSET {film:?}: growth rate zero at {zero:?} rpm");
+        if !film.1 {
+            // the linear threshold with this film's steady eight coefficients (the
+            // mass-conserving film's: central differences of its force with ∂φ/∂t = 0, no memory)
+            let path = concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/config/orc_microturbine_100kw_d55.yaml"
+            );
+            let desc = MachineDescription::load(Some(std::path::Path::new(path))).unwrap();
+            let mut rotor = Rotor::from_description(&desc);
+            rotor.set_cavitation(film.0).unwrap();
+            let statics = rotor_twin::rotor::static_solution(&rotor).unwrap();
+            let t = rotor_twin::rotor::stability_threshold(&rotor, &statics, 8000.0, 9200.0, 200.0)
+                .unwrap()
+                .map(|t| t.speed_rpm);
+            println!("ONSET {film:?}: linear threshold with the steady coefficients {t:?} rpm");
+        }
     }
 }
