@@ -58,6 +58,9 @@ pub struct TransientResult {
     pub max_substeps: usize,
     /// Prehistory: substeps that fell back to Newton.
     pub prehistory_fallbacks: usize,
+    /// With `oil_heating`: heat balances redone as the speed moved (the first, at the start,
+    /// not counted); 0 without.
+    pub heat_balances: usize,
     /// The state vectors at the end (q, q̇, q̈ on the twin's reduced DOFs).
     pub final_state: StateVectors,
 }
@@ -276,6 +279,94 @@ pub fn apply_kicks(
     Ok(any)
 }
 
+/// With `oil_heating` in the machine file, the films' heat balance as the live twin's driver
+/// keeps it (`driver::oil`): taken at the start, redone when the speed has moved past
+/// [`crate::driver::HEAT_BALANCE_SPEED_STEP`], its viscosity scales set on the twin. Used by
+/// the offline runs (`simulate`, `sweep`) and the bench, so that they heat as the node does.
+pub struct HeatFollower {
+    rotor: Rotor,
+    film: FilmEvaluation,
+    at_speed_rad_s: f64,
+    scales: Vec<f64>,
+    /// Balances after the first, their slowest and summed times (µs).
+    balances: usize,
+    slowest_us: f64,
+    total_us: f64,
+}
+
+impl HeatFollower {
+    /// The first balance, at `speed_rad_s`, left on `rotor` (None without `oil_heating`).
+    /// Err says why it failed.
+    pub fn of(
+        rotor: &mut Rotor,
+        film: FilmEvaluation,
+        speed_rad_s: f64,
+    ) -> Result<Option<Self>, TwinError> {
+        if !rotor.has_oil_heating() {
+            return Ok(None);
+        }
+        let mut me = Self {
+            rotor: rotor.clone(),
+            film,
+            at_speed_rad_s: speed_rad_s,
+            scales: vec![1.0; rotor.film_bearing_count()],
+            balances: 0,
+            slowest_us: 0.0,
+            total_us: 0.0,
+        };
+        me.balance(speed_rad_s)?;
+        (me.balances, me.slowest_us, me.total_us) = (0, 0.0, 0.0);
+        *rotor = me.rotor.clone();
+        Ok(Some(me))
+    }
+
+    fn balance(&mut self, speed_rad_s: f64) -> Result<(), TwinError> {
+        let t = Instant::now();
+        (self.rotor)
+            .heat_films_with(None, speed_rad_s, 1.0, self.film)
+            .map_err(|e| TwinError::Setup(format!("oil_heating: {e}")))?;
+        let us = t.elapsed().as_secs_f64() * 1e6;
+        self.slowest_us = self.slowest_us.max(us);
+        self.total_us += us;
+        self.balances += 1;
+        self.at_speed_rad_s = speed_rad_s;
+        let films = self.rotor.bearings.iter().filter_map(|b| match &b.model {
+            BearingModel::Film(f) => Some(f.viscosity_scale),
+            _ => None,
+        });
+        for (s, f) in self.scales.iter_mut().zip(films) {
+            *s = f;
+        }
+        Ok(())
+    }
+
+    /// Redoes the balance if the speed has moved past the driver's step, and sets the scales
+    /// on `twin`.
+    pub fn follow(&mut self, twin: &mut Twin, speed_rad_s: f64) -> Result<(), TwinError> {
+        let moved = (speed_rad_s / self.at_speed_rad_s - 1.0).abs();
+        if moved <= crate::driver::HEAT_BALANCE_SPEED_STEP {
+            return Ok(());
+        }
+        self.balance(speed_rad_s)?;
+        twin.set_viscosity_scales(&self.scales)
+    }
+
+    /// Balances after the first.
+    pub fn balances(&self) -> usize {
+        self.balances
+    }
+
+    /// The slowest of them (µs).
+    pub fn slowest_us(&self) -> f64 {
+        self.slowest_us
+    }
+
+    /// Their mean (µs).
+    pub fn mean_us(&self) -> f64 {
+        self.total_us / self.balances.max(1) as f64
+    }
+}
+
 /// Points around the bearing of [`TransientResult::fluid_fraction_maps`] (4° apart; each the
 /// nearest grid column's φ).
 pub const FLUID_FRACTION_POINTS: usize = 90;
@@ -344,7 +435,7 @@ pub fn run_driven(
     drive: &Drive,
 ) -> Result<TransientResult, TwinError> {
     check_spec(spec)?;
-    let rotor = with_grid(rotor, spec.grid);
+    let mut rotor = with_grid(rotor, spec.grid);
     let (lo_rpm, hi_rpm) = drive
         .speed
         .as_ref()
@@ -353,6 +444,7 @@ pub fn run_driven(
         Some(h) => h.at(t),
         None => (spec.speed_rpm, 0.0),
     };
+    let mut heat = HeatFollower::of(&mut rotor, spec.film, rpm_to_rad_s(speed_at(0.0).0))?;
     let mut twin = start_twin(&rotor, spec, (hi_rpm, speed_at(0.0).0), initial)?;
     let h = twin.config().time_step_s;
     let per_rev = (spec.steps_per_rev as f64 * hi_rpm / lo_rpm).ceil() as usize + 2;
@@ -372,6 +464,9 @@ pub fn run_driven(
             accel_rad_s2: rpm_to_rad_s(rate),
         };
         apply_kicks(&mut twin, &drive.kicks, &mut applied, t, h)?;
+        if let Some(f) = heat.as_mut() {
+            f.follow(&mut twin, input.speed_rad_s)?;
+        }
         let out = twin.step(&input)?;
         steps += 1;
         iterations += out.newton_iterations;
@@ -408,6 +503,7 @@ pub fn run_driven(
         newton_iterations: iterations,
         max_substeps,
         prehistory_fallbacks: fallbacks,
+        heat_balances: heat.as_ref().map_or(0, HeatFollower::balances),
         final_state,
     })
 }

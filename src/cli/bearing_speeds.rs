@@ -173,10 +173,27 @@ pub(crate) struct SpeedRow {
     pub temperature_rise_k: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub effective_viscosity_pa_s: Option<f64>,
+    /// How the temperature was found: `raimondi_boyd` or `thermal_film` (then
+    /// `temperature_rise_k` is the peak rise over the supply).
+    #[serde(
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "heat_balance_name"
+    )]
+    pub heat_balance: Option<crate::film::HeatBalance>,
 }
 
-/// A heated bearing's (T_eff °C, ΔT K, µ_eff Pa·s).
-type Heat = (f64, f64, f64);
+fn heat_balance_name<S: serde::Serializer>(
+    b: &Option<crate::film::HeatBalance>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    match b {
+        Some(b) => s.serialize_str(b.name()),
+        None => s.serialize_none(),
+    }
+}
+
+/// A heated bearing's (T_eff °C, ΔT K, µ_eff Pa·s) and how they were found.
+type Heat = (f64, f64, f64, crate::film::HeatBalance);
 
 /// The equilibrium of `b` at `omega`, at its effective temperature when its oil heats.
 fn equilibrium(
@@ -199,7 +216,7 @@ fn equilibrium(
         )
         .map_err(|e| anyhow::anyhow!(e))?;
     let t_c = e.effective_temperature_k - crate::film::ZERO_CELSIUS_K;
-    let extra = (t_c, e.temperature_rise_k, e.viscosity_pa_s);
+    let extra = (t_c, e.temperature_rise_k, e.viscosity_pa_s, e.balance);
     Ok((e.equilibrium, Some(extra)))
 }
 
@@ -274,6 +291,7 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
             effective_temperature_c: heat.map(|h| h.0),
             temperature_rise_k: heat.map(|h| h.1),
             effective_viscosity_pa_s: heat.map(|h| h.2),
+            heat_balance: heat.map(|h| h.3),
         };
         anyhow::ensure!(
             row_is_finite(&row),
@@ -372,13 +390,16 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
             c[2],
             c[3]
         );
-        if let (Some(t), Some(dt), Some(mu)) = (
+        if let (Some(t), Some(dt), Some(mu), Some(b)) = (
             s.effective_temperature_c,
             s.temperature_rise_k,
             s.effective_viscosity_pa_s,
+            s.heat_balance,
         ) {
             outln!(
-                "          effective temperature {t:.2} °C (ΔT {dt:.2} K), µ_eff {:.4} mPa·s",
+                "          {} {t:.2} °C ({} {dt:.2} K), µ_eff {:.4} mPa·s",
+                b.temperature_label(),
+                b.rise_label(),
                 mu * 1e3
             );
         }

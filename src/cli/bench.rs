@@ -150,77 +150,6 @@ struct TwinFigures {
     mean_heat_balance_us: f64,
 }
 
-/// With `oil_heating` in the machine file, the films' heat balance as the live twin's driver
-/// keeps it (`driver::oil`): taken at the start, redone when the speed has moved past
-/// [`crate::driver::HEAT_BALANCE_SPEED_STEP`], its viscosity scales set on the twin.
-struct HeatFollower {
-    rotor: crate::rotor::Rotor,
-    film: crate::dynamics::FilmEvaluation,
-    at_speed_rad_s: f64,
-    scales: Vec<f64>,
-    /// Balances inside the measured steps, their slowest and summed times (µs).
-    balances: usize,
-    slowest_us: f64,
-    total_us: f64,
-}
-
-impl HeatFollower {
-    /// The first balance, at `speed_rad_s`, left on `rotor` (None without `oil_heating`).
-    fn of(
-        rotor: &mut crate::rotor::Rotor,
-        film: crate::dynamics::FilmEvaluation,
-        speed_rad_s: f64,
-    ) -> anyhow::Result<Option<Self>> {
-        if !rotor.has_oil_heating() {
-            return Ok(None);
-        }
-        let mut me = Self {
-            rotor: rotor.clone(),
-            film,
-            at_speed_rad_s: speed_rad_s,
-            scales: vec![1.0; rotor.film_bearing_count()],
-            balances: 0,
-            slowest_us: 0.0,
-            total_us: 0.0,
-        };
-        me.balance(speed_rad_s)?;
-        (me.balances, me.slowest_us, me.total_us) = (0, 0.0, 0.0);
-        *rotor = me.rotor.clone();
-        Ok(Some(me))
-    }
-
-    fn balance(&mut self, speed_rad_s: f64) -> anyhow::Result<()> {
-        let t = Instant::now();
-        (self.rotor)
-            .heat_films_with(None, speed_rad_s, 1.0, self.film)
-            .map_err(anyhow::Error::msg)?;
-        let us = t.elapsed().as_secs_f64() * 1e6;
-        self.slowest_us = self.slowest_us.max(us);
-        self.total_us += us;
-        self.balances += 1;
-        self.at_speed_rad_s = speed_rad_s;
-        let films = self.rotor.bearings.iter().filter_map(|b| match &b.model {
-            crate::rotor::BearingModel::Film(f) => Some(f.viscosity_scale),
-            _ => None,
-        });
-        for (s, f) in self.scales.iter_mut().zip(films) {
-            *s = f;
-        }
-        Ok(())
-    }
-
-    /// Redoes the balance if the speed has moved past the driver's step, and sets the scales.
-    fn follow(&mut self, twin: &mut crate::dynamics::Twin, speed_rad_s: f64) -> anyhow::Result<()> {
-        if (speed_rad_s / self.at_speed_rad_s - 1.0).abs() <= crate::driver::HEAT_BALANCE_SPEED_STEP
-        {
-            return Ok(());
-        }
-        self.balance(speed_rad_s)?;
-        twin.set_viscosity_scales(&self.scales)?;
-        Ok(())
-    }
-}
-
 /// The microturbine (built-in, or `--config`) on the bench's film grid and flow regime.
 fn orc_9000_rotor(args: &BenchArgs) -> anyhow::Result<crate::rotor::Rotor> {
     use crate::rotor::{MachineDescription, Rotor};
@@ -242,7 +171,7 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         film: args.film.into(),
         ..TwinConfig::with_steps_per_rev(Coupling::Nonlinear, omega, 128)
     };
-    let mut heat = HeatFollower::of(&mut rotor, config.film, omega)?;
+    let mut heat = crate::transient::HeatFollower::of(&mut rotor, config.film, omega)?;
     let mut twin = Twin::new(&rotor, config, omega)?;
     let mut input = StepInput {
         speed_rad_s: omega,
@@ -298,11 +227,9 @@ fn orc_9000(args: &BenchArgs) -> anyhow::Result<()> {
         newton_iterations_per_step: iterations as f64 / n as f64,
         contact_step_fraction: contact_steps as f64 / n as f64,
         max_eccentricity_ratio: max_eps,
-        heat_balances: heat.as_ref().map_or(0, |h| h.balances),
-        slowest_heat_balance_us: heat.as_ref().map_or(0.0, |h| h.slowest_us),
-        mean_heat_balance_us: heat
-            .as_ref()
-            .map_or(0.0, |h| h.total_us / h.balances.max(1) as f64),
+        heat_balances: heat.as_ref().map_or(0, |h| h.balances()),
+        slowest_heat_balance_us: heat.as_ref().map_or(0.0, |h| h.slowest_us()),
+        mean_heat_balance_us: heat.as_ref().map_or(0.0, |h| h.mean_us()),
     };
     print_twin_figures(args, &fig)
 }
@@ -324,7 +251,7 @@ fn measure_window(
     twin: &mut crate::dynamics::Twin,
     args: &BenchArgs,
     (input, ramp): (&mut crate::dynamics::StepInput, f64),
-    heat: &mut Option<HeatFollower>,
+    heat: &mut Option<crate::transient::HeatFollower>,
     trace: &mut Option<std::io::BufWriter<std::fs::File>>,
 ) -> anyhow::Result<Window> {
     let budget = Duration::from_secs_f64(args.seconds);

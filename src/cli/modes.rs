@@ -176,6 +176,10 @@ struct ModesReport {
 #[derive(Debug, Serialize)]
 struct EffectiveTemperatureRow {
     bearing: String,
+    /// `raimondi_boyd` or `thermal_film` (then `temperature_rise_k` is the peak rise).
+    heat_balance: &'static str,
+    #[serde(skip)]
+    balance: crate::film::HeatBalance,
     at_speed_rpm: f64,
     supply_temperature_c: f64,
     effective_temperature_c: f64,
@@ -189,11 +193,13 @@ struct EffectiveTemperatureRow {
 fn print_effective_temperatures(rows: &[EffectiveTemperatureRow]) {
     for t in rows {
         println!(
-            "  {} at {:.0} rpm: effective temperature {:.2} °C (supply {:.1} °C, ΔT {:.2} K), µ_eff {:.4} mPa·s, ε {:.3}, friction {:.1} W",
+            "  {} at {:.0} rpm: {} {:.2} °C (supply {:.1} °C, {} {:.2} K), µ_eff {:.4} mPa·s, ε {:.3}, friction {:.1} W",
             t.bearing,
             t.at_speed_rpm,
+            t.balance.temperature_label(),
             t.effective_temperature_c,
             t.supply_temperature_c,
+            t.balance.rise_label(),
             t.temperature_rise_k,
             t.viscosity_pa_s * 1e3,
             t.eccentricity_ratio,
@@ -226,6 +232,8 @@ fn heat_for_threshold(
                 .into_iter()
                 .map(|t| EffectiveTemperatureRow {
                     bearing: t.name,
+                    heat_balance: t.effective.balance.name(),
+                    balance: t.effective.balance,
                     at_speed_rpm: rpm,
                     supply_temperature_c: c(t.effective.supply_temperature_k),
                     effective_temperature_c: c(t.effective.effective_temperature_k),
@@ -373,7 +381,8 @@ fn thermal_oils(
     anyhow::ensure!(
         !rotor.has_oil_heating(),
         "--thermal sets each film's viscosity from its own temperature field: the machine \
-         file's oil_heating (an effective temperature) cannot be used with it"
+         file's oil_heating (Raimondi–Boyd's effective temperature or the thermal film's mean) \
+         cannot be used with it"
     );
     super::bearing_thermal::rotor_oils(
         rotor,

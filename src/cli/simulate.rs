@@ -188,7 +188,8 @@ pub struct SimulateArgs {
     history_csv: Option<PathBuf>,
     #[command(flatten)]
     options: RunOptions,
-    /// Write orbit, spectrum and pressure-map SVGs of each bearing into this directory.
+    /// Write orbit, spectrum and pressure-map SVGs of each bearing into this directory (with
+    /// `--cavitation mass-conserving` also the fluid-fraction map, `fluid_fraction_<bearing>.svg`).
     #[arg(long)]
     plot: Option<PathBuf>,
     /// Print one JSON object instead of a table.
@@ -588,6 +589,7 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.history_csv {
         super::check_output("--history-csv", path, super::Output::File)?;
     }
+    note_heating(&rotor);
     let result = run_driven(&rotor, &spec, None, &drive).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
@@ -680,6 +682,17 @@ fn write_history_csv(path: &Path, r: &TransientResult) -> anyhow::Result<()> {
     }
     std::fs::write(path, csv)?;
     Ok(())
+}
+
+/// With `oil_heating`, says (on stderr) that the run heats its films as the node does.
+fn note_heating(rotor: &Rotor) {
+    if rotor.has_oil_heating() {
+        eprintln!(
+            "oil_heating: each film runs at its heat balance's viscosity (the machine file's supply \
+             temperature), redone past {} % of speed, as the node does",
+            100.0 * crate::driver::HEAT_BALANCE_SPEED_STEP
+        );
+    }
 }
 
 fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
@@ -807,6 +820,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let speeds = sweep_speeds(args)?;
     let (desc, rotor) = args.options.machine()?;
     check_sweep_first(args, &rotor)?;
+    note_heating(&rotor);
     let specs = speeds
         .iter()
         .map(|&s| args.options.spec(s, &rotor))

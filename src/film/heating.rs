@@ -50,6 +50,32 @@ pub enum HeatBalance {
     ThermalFilm,
 }
 
+impl HeatBalance {
+    /// The name a report gives it (`raimondi_boyd`, `thermal_film`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::RaimondiBoyd { .. } => "raimondi_boyd",
+            Self::ThermalFilm => "thermal_film",
+        }
+    }
+
+    /// What [`EffectiveTemperature::effective_temperature_k`] is, for a printed line.
+    pub fn temperature_label(&self) -> &'static str {
+        match self {
+            Self::RaimondiBoyd { .. } => "effective temperature",
+            Self::ThermalFilm => "thermal film's mean temperature",
+        }
+    }
+
+    /// What [`EffectiveTemperature::temperature_rise_k`] is, for a printed line.
+    pub fn rise_label(&self) -> &'static str {
+        match self {
+            Self::RaimondiBoyd { .. } => "ΔT",
+            Self::ThermalFilm => "peak rise",
+        }
+    }
+}
+
 /// Specific heats accepted (J/(kg·K)): mineral and synthetic oils are 1,700–2,300, refrigerants
 /// and water up to 4,200; outside this range it is a unit error.
 pub const SPECIFIC_HEAT_RANGE_J_PER_KG_K: std::ops::RangeInclusive<f64> = 500.0..=10_000.0;
@@ -106,19 +132,25 @@ impl OilHeating {
 /// film's mean temperature ([`HeatBalance::ThermalFilm`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EffectiveTemperature {
+    /// How it was found.
+    pub balance: HeatBalance,
     /// Oil supply temperature T_s (K).
     pub supply_temperature_k: f64,
-    /// Effective temperature T_eff (K).
+    /// Effective temperature T_eff (K): Raimondi–Boyd's, or the thermal film's flow-weighted
+    /// mean temperature.
     pub effective_temperature_k: f64,
     /// Temperature rise ΔT through the film (K): (T_eff − T_s)/k (Raimondi–Boyd); the thermal
     /// film's peak rise T_max − T_s.
     pub temperature_rise_k: f64,
     /// Viscosity µ(T_eff) (Pa·s).
     pub viscosity_pa_s: f64,
-    /// Friction power P_f at T_eff (W).
+    /// Friction power P_f at T_eff (W): the film's `power_loss_w` at µ(T_eff), Couette shear
+    /// over the full film (Raimondi–Boyd's friction variable), for either balance.
     pub friction_power_w: f64,
-    /// Heat the oil carries away at the temperature found, ρ c_p ((T_eff − T_s)/k) (Q − Q_s/2)
-    /// (W): equal to `friction_power_w` at the fixed point (H1).
+    /// Heat the oil carries away at the temperature found (W): Raimondi–Boyd's
+    /// ρ c_p ((T_eff − T_s)/k) (Q − Q_s/2), equal to `friction_power_w` at the fixed point (H1);
+    /// the thermal film's, equal to its own dissipation (shear in the ruptured zone in its
+    /// streamers only, E2), below the full-film friction.
     pub heat_carried_w: f64,
     /// The static equilibrium at µ(T_eff) (the isoviscous film, as the twin runs it).
     pub equilibrium: Equilibrium,
@@ -306,11 +338,12 @@ fn isoviscous_at(
     let equilibrium = equilibrium_under_load(film, mu, load_n, speed_rad_s)
         .map_err(|e| format!("film equilibrium at the thermal film's mean {t_k:.2} K: {e}"))?;
     Ok(EffectiveTemperature {
+        balance: HeatBalance::ThermalFilm,
         supply_temperature_k: supply_k,
         effective_temperature_k: t_k,
         temperature_rise_k: s.max_temperature_k - supply_k,
         viscosity_pa_s: mu,
-        friction_power_w: s.dissipation_w,
+        friction_power_w: equilibrium.film.power_loss_w.abs(),
         heat_carried_w: s.heat_carried_w,
         equilibrium,
         evaluations: passes + 1,
@@ -330,6 +363,7 @@ fn done(
     let f = &equilibrium.film;
     let rise_k = (t_k - supply_k) / carry_over;
     EffectiveTemperature {
+        balance: heating.balance,
         supply_temperature_k: supply_k,
         effective_temperature_k: t_k,
         temperature_rise_k: rise_k,

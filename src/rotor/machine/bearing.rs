@@ -317,18 +317,26 @@ impl RawBearingSpec {
     /// finite, laminar film of a plain bearing (`FilmBearing::thermal_film_unsupported`).
     fn check_thermal_film(&self, i: usize, rules: &Rules) -> Result<(), ConfigError> {
         let field = format!("bearings[{i}].lubricant.oil_heating.model");
-        let refuse = |rule: &str| Err(rules.error(&field, "thermal_film", rule));
+        let refuse = |given: String, rule: &str| {
+            Err(rules.error(&field, format!("thermal_film with {given}"), rule))
+        };
         if self.model != BearingModelName::Finite {
-            return refuse("the thermal film is built on the finite model (model: finite)");
+            return refuse(
+                format!("model {:?}", self.model).to_lowercase(),
+                "the thermal film is built on the finite model (model: finite)",
+            );
         }
         if self.grooves != GroovesSpec::None {
-            return refuse("the thermal film is built for a plain bearing (grooves: none)");
+            return refuse(
+                "grooves two-axial".into(),
+                "the thermal film is built for a plain bearing (grooves: none)",
+            );
         }
-        if self
-            .flow
-            .is_some_and(|f| f != crate::film::FlowRegime::Laminar)
-        {
-            return refuse("the thermal film is laminar (flow: laminar)");
+        if let Some(f) = self.flow.filter(|f| *f != crate::film::FlowRegime::Laminar) {
+            return refuse(
+                format!("flow {f:?}").to_lowercase(),
+                "the thermal film is laminar (flow: laminar)",
+            );
         }
         Ok(())
     }
