@@ -229,6 +229,16 @@ fn the_live_twin_on_the_table_heats_with_its_thermal_film() {
         Fed::Taken
     );
     assert_eq!(d.heat_balances().0, 2);
+    // the replay's report carries each film's temperature and scale in force
+    let report = d.heat_balance_report().unwrap();
+    assert_eq!(report.films.len(), 2);
+    for (f, t) in report.films.iter().zip(&cooler) {
+        assert!(
+            (f.temperature_c - (t - ZERO_CELSIUS_K)).abs() < 1e-9,
+            "{}",
+            f.bearing
+        );
+    }
     d.advance_to(t0 + 20 * ms, usize::MAX, &mut emit);
     let e = d.session().unwrap().twin().output().bearings[0].eccentricity_ratio;
     assert!(e.is_finite() && e < 1.0, "ε {e}");

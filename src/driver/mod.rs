@@ -23,7 +23,7 @@ pub use inputs::{
 };
 pub use observer::ObserverGains;
 pub use oil::{
-    FilmOil, HeatBalanceReport, OilDiagnostics, HEAT_BALANCE_SPEED_STEP,
+    FilmOil, HeatBalanceReport, HeatedFilm, OilDiagnostics, HEAT_BALANCE_SPEED_STEP,
     HEAT_BALANCE_TEMPERATURE_STEP_K,
 };
 pub use one_x::{OneXBlock, OneXBlocks};

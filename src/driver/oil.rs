@@ -90,6 +90,20 @@ pub struct HeatBalanceReport {
     pub failures: u64,
     /// Why the last failure failed (None without one).
     pub last_failure: Option<String>,
+    /// Each heated film bearing at the end: its temperature (°C) and viscosity scale in force.
+    pub films: Vec<HeatedFilm>,
+}
+
+/// A heated film bearing in [`HeatBalanceReport`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct HeatedFilm {
+    /// The bearing's name.
+    pub bearing: String,
+    /// Its temperature at the last good balance (°C): Raimondi–Boyd's effective temperature or
+    /// the thermal film's mean.
+    pub temperature_c: f64,
+    /// Its viscosity scale in force (µ / µ_reference, with any calibration's factor).
+    pub viscosity_scale: f64,
 }
 
 /// The oil's diagnostic values ([`Driver::oil_diagnostics`]).
@@ -255,10 +269,20 @@ impl Driver {
 
     /// The heat balances as a replay reports them: None when no film bearing is heated.
     pub fn heat_balance_report(&self) -> Option<HeatBalanceReport> {
+        let films = (self.film_oil().into_iter())
+            .filter_map(|f| {
+                f.effective_temperature_k.map(|t| HeatedFilm {
+                    bearing: f.name,
+                    temperature_c: t - crate::film::ZERO_CELSIUS_K,
+                    viscosity_scale: f.viscosity_scale,
+                })
+            })
+            .collect();
         self.oil.heating.then(|| HeatBalanceReport {
             balances: self.oil.balances,
             failures: self.oil.failures,
             last_failure: self.oil.last_failure.clone(),
+            films,
         })
     }
 

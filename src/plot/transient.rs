@@ -292,16 +292,23 @@ where
         .y_label_formatter(&|v| format!("{v:.0}"))
         .draw()?;
     let (dx, dy) = (720.0 / steps as f64, 360.0 / points as f64);
-    let shade = &shade;
-    chart.draw_series(map.iter().enumerate().flat_map(|(t, row)| {
-        row.iter().enumerate().map(move |(k, &v)| {
-            let x = t as f64 * dx;
-            Rectangle::new(
-                [(x, k as f64 * dy), (x + dx, (k + 1) as f64 * dy)],
-                shade(v).filled(),
-            )
-        })
-    }))?;
+    // one rectangle for each run of cells of one grey along the bearing (a film full over half
+    // the bearing is one cell, not 45: the SVG stays small)
+    let mut cells = Vec::new();
+    for (t, row) in map.iter().enumerate() {
+        let x = t as f64 * dx;
+        let mut k = 0;
+        while k < row.len() {
+            let colour = shade(row[k]);
+            let run = row[k..].iter().take_while(|&&v| shade(v) == colour).count();
+            cells.push(Rectangle::new(
+                [(x, k as f64 * dy), (x + dx, (k + run) as f64 * dy)],
+                colour.filled(),
+            ));
+            k += run;
+        }
+    }
+    chart.draw_series(cells)?;
     Ok(())
 }
 

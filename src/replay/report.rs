@@ -356,6 +356,16 @@ impl ReplayReport {
                 h.last_failure.as_deref().unwrap_or("")
             );
         }
+        if let Some(h) = &self.heat_balance {
+            s += &format!("oil heating: {} heat balance(s);", h.balances);
+            for f in &h.films {
+                s += &format!(
+                    " {} {:.2} degC x{:.5}",
+                    f.bearing, f.temperature_c, f.viscosity_scale
+                );
+            }
+            s += "\n";
+        }
         if let Some(oil) = &self.oil {
             s += &format!("oil supply {:.2} degC: viscosity", oil.supply_temperature_c);
             for (name, k) in &oil.viscosity_scales {
