@@ -329,6 +329,31 @@ impl ReplayReport {
             .extend(comparisons.iter().filter_map(decimation_note));
     }
 
+    /// The oil heating's lines of the summary: a failed balance's warning, the balances and each
+    /// film's temperature and scale.
+    fn heat_lines(&self) -> String {
+        let mut s = String::new();
+        if let Some(h) = self.heat_balance.as_ref().filter(|h| h.failures > 0) {
+            s += &format!(
+                "WARNING: {} of {} heat balance(s) failed, the last good viscosity kept; last: {}\n",
+                h.failures,
+                h.balances,
+                h.last_failure.as_deref().unwrap_or("")
+            );
+        }
+        if let Some(h) = &self.heat_balance {
+            s += &format!("oil heating: {} heat balance(s);", h.balances);
+            for f in &h.films {
+                s += &format!(
+                    " {} {:.2} degC x{:.5}",
+                    f.bearing, f.temperature_c, f.viscosity_scale
+                );
+            }
+            s += "\n";
+        }
+        s
+    }
+
     /// A few lines for the terminal.
     pub fn summary(&self) -> String {
         let mut s = format!(
@@ -348,24 +373,7 @@ impl ReplayReport {
                 r.count, r.topic, r.last_reason
             );
         }
-        if let Some(h) = self.heat_balance.as_ref().filter(|h| h.failures > 0) {
-            s += &format!(
-                "WARNING: {} of {} heat balance(s) failed, the last good viscosity kept; last: {}\n",
-                h.failures,
-                h.balances,
-                h.last_failure.as_deref().unwrap_or("")
-            );
-        }
-        if let Some(h) = &self.heat_balance {
-            s += &format!("oil heating: {} heat balance(s);", h.balances);
-            for f in &h.films {
-                s += &format!(
-                    " {} {:.2} degC x{:.5}",
-                    f.bearing, f.temperature_c, f.viscosity_scale
-                );
-            }
-            s += "\n";
-        }
+        s += &self.heat_lines();
         if let Some(oil) = &self.oil {
             s += &format!("oil supply {:.2} degC: viscosity", oil.supply_temperature_c);
             for (name, k) in &oil.viscosity_scales {
