@@ -350,3 +350,25 @@ fn offline_runs_heat_as_the_node_does() {
     println!("ramp 8,000 → 8,400 rpm: {} balances", ramp.heat_balances);
     assert_eq!(ramp.heat_balances, 4);
 }
+
+/// A supply near the top of the law (115 °C on the 10–120 °C table; the file's viscosity the
+/// law's there): the thermal film's hottest column passes 120 °C though its mean does not, and
+/// the balance is refused naming the temperature in °C and the machine file's `valid_range_c`
+/// (the live twin then keeps the last good viscosity with a warning: `driver::oil`).
+#[test]
+fn a_film_hotter_than_the_law_is_refused_naming_the_range() {
+    let yaml = THERMAL_YAML
+        .replace(
+            "design_supply_temperature_c: 40.0",
+            "design_supply_temperature_c: 115.0",
+        )
+        .replace("viscosity_pa_s: 0.0008\n", "viscosity_pa_s: 0.000375\n");
+    let mut rotor =
+        Rotor::from_description(&MachineDescription::from_yaml(&yaml, "hot supply").unwrap());
+    let err = rotor.heat_films(None, rad_s(9000.0), 1.0).unwrap_err();
+    println!("{err}");
+    assert!(
+        err.contains("valid_range_c") && err.contains("°C") && err.contains("120.0"),
+        "{err}"
+    );
+}

@@ -182,9 +182,9 @@ impl ThermalFilm {
         for (r, &t) in self.ratio.iter_mut().zip(&self.temperature_k) {
             let mu = self.oil.law.checked_viscosity_pa_s(t).map_err(|_| {
                 FilmError::InvalidParameter {
-                    name: "thermal film temperature (K)",
-                    value: t,
-                    rule: "must lie within the viscosity law's range",
+                    name: "thermal film temperature (°C) of a column (the hottest, not the mean)",
+                    value: t - super::ZERO_CELSIUS_K,
+                    rule: "must lie within the viscosity law's range: the machine file's valid_range_c, within the table's span",
                 }
             })?;
             *r = mu / self.reference_viscosity_pa_s;
