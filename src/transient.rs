@@ -343,8 +343,7 @@ impl HeatFollower {
     /// Redoes the balance if the speed has moved past the driver's step, and sets the scales
     /// on `twin`.
     pub fn follow(&mut self, twin: &mut Twin, speed_rad_s: f64) -> Result<(), TwinError> {
-        let moved = (speed_rad_s / self.at_speed_rad_s - 1.0).abs();
-        if moved <= crate::driver::HEAT_BALANCE_SPEED_STEP {
+        if !crate::driver::speed_moved_past_balance(self.at_speed_rad_s, speed_rad_s) {
             return Ok(());
         }
         self.balance(speed_rad_s)?;

@@ -23,8 +23,8 @@ pub use inputs::{
 };
 pub use observer::ObserverGains;
 pub use oil::{
-    FilmOil, HeatBalanceReport, HeatedFilm, OilDiagnostics, HEAT_BALANCE_SPEED_STEP,
-    HEAT_BALANCE_TEMPERATURE_STEP_K,
+    speed_moved_past_balance, FilmOil, HeatBalanceReport, HeatedFilm, OilDiagnostics,
+    HEAT_BALANCE_SPEED_STEP, HEAT_BALANCE_TEMPERATURE_STEP_K,
 };
 pub use one_x::{OneXBlock, OneXBlocks};
 pub use plant_signals::{SignalState, StationSource, PAIR_TOLERANCE_REVS};

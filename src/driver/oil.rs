@@ -15,6 +15,13 @@ use super::{inputs, Driver, Fed};
 /// 0.36 K from 8,000 to 9,000 rpm, T_eff by half of it), µ by 0.02 %.
 pub const HEAT_BALANCE_SPEED_STEP: f64 = 0.01;
 
+/// Whether a speed `speed_rad_s` has moved past [`HEAT_BALANCE_SPEED_STEP`] from the speed of
+/// the last balance, `balanced_rad_s`: the rule the live twin and the offline runs
+/// (`transient::HeatFollower`) both redo a balance by.
+pub fn speed_moved_past_balance(balanced_rad_s: f64, speed_rad_s: f64) -> bool {
+    (speed_rad_s / balanced_rad_s - 1.0).abs() > HEAT_BALANCE_SPEED_STEP
+}
+
 /// … or when the supply temperature has moved by more than this (K): 0.05 K is 0.05 % of µ on
 /// the built-in law (about −1 %/K).
 pub const HEAT_BALANCE_TEMPERATURE_STEP_K: f64 = 0.05;
@@ -175,7 +182,7 @@ impl Driver {
                 (None, None) => false,
                 _ => true,
             };
-            if (speed / w0 - 1.0).abs() <= HEAT_BALANCE_SPEED_STEP && !moved_t {
+            if !speed_moved_past_balance(w0, speed) && !moved_t {
                 return false;
             }
         }
