@@ -26,6 +26,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
+from peer_common import wait_matched
 
 
 @dataclass
@@ -162,11 +163,16 @@ def main():
     residuals = DataReader(dp, Topic(dp, t("residual"), OrbitResidual), qos=reliable)
     margins = DataReader(dp, Topic(dp, t("stability_margin"), StabilityMargin), qos=latched)
     plant_probe = DataWriter(dp, Topic(dp, "rt/plant/probe_b", PointStamped), qos=reliable)
+    listen_only = "--warnings-only" in sys.argv
+    if not listen_only and "--best-effort" not in sys.argv:
+        # a reliable, volatile writer drops what it writes before the node's reader matches (seen
+        # in CI under load: the first of 10,653 speeds lost), then 0.5 s for the node's side
+        wait_matched([w, probe], timeout_s=30.0, who="peer")
+        time.sleep(0.5)
     out = {"sent": 0, "residuals": 0, "residual_ok": True, "journal": 0, "stations": [], "margin": None, "warnings": [], "first_journal_after_s": None, "nonfinite": 0, "speeds": []}
     start = time.time()
     last = None
     bad = [float("nan"), float("inf"), -100.0, 1e9] if "--bad" in sys.argv else []
-    listen_only = "--warnings-only" in sys.argv
     if "--burst" in sys.argv:
         # wait until the node answers, then a burst: every 100th value NaN, one stamp 10 s stale
         deadline = time.time() + 10

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 from peer import Header, InstabilityWarning, RotorSpeed, Time  # noqa: E402
+from peer_common import wait_matched  # noqa: E402
 from cyclonedds.core import Qos, Policy
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
@@ -141,7 +142,7 @@ def main():
     # can drop discovery datagrams too, and a loaded machine starts the node late), then 0.5 s for
     # the node's side of the match
     wait_matched([kp_w, speed_w] + [w for w, _, _ in probe_w] + ([oil_w] if oil_w else []),
-                 timeout_s=60.0)
+                 timeout_s=60.0, who="signal_peer")
     time.sleep(0.5)
     segments = [{"t_s": 0.0, "rpm": rpm, "dc_um": [0.0, 0.0]}]
     if "--plant" in sys.argv:
@@ -188,14 +189,6 @@ def main():
     read(one_x, warnings, out, t0)
     print(json.dumps(out))
 
-
-def wait_matched(writers, timeout_s):
-    """Waits until each writer has a matched subscription; exits with a message after timeout_s."""
-    deadline = time.time() + timeout_s
-    while any(w.get_publication_matched_status().current_count == 0 for w in writers):
-        if time.time() > deadline:
-            sys.exit(f"signal_peer: no subscriber matched within {timeout_s} s")
-        time.sleep(0.05)
 
 
 def read(one_x, warnings, out, t0):

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 sys.path.insert(0, __file__.rsplit("/", 1)[0])
 from peer import Clock, Header, RotorSpeed, Time  # noqa: E402
 from signal_peer import OneXVectors  # noqa: E402
+from peer_common import wait_matched  # noqa: E402
 from cyclonedds.core import Qos, Policy
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
@@ -110,7 +111,7 @@ def main():
     estimates = DataReader(dp, Topic(dp, "rt/rotor_twin/calibration", CalibrationEstimate),
                            qos=latched)
     one_x = DataReader(dp, Topic(dp, "rt/rotor_twin/one_x", OneXVectors), qos=reliable)
-    wait_matched([clock_w, speed_w, kp_w, probe_w], timeout_s=60.0)
+    wait_matched([clock_w, speed_w, kp_w, probe_w], timeout_s=60.0, who="stamped_plant_peer")
     time.sleep(0.5)
     sent = {"/clock": 0, "/rotor_twin/speed": 0, "/rotor_twin/keyphasor": 0,
             "/rotor_twin/probe_signal": 0}
@@ -194,14 +195,6 @@ def read_one_x(reader, out):
             "station": s.station, "speed": s.speed, "revolutions": s.revolutions,
             "samples": s.samples, "reason": s.phase_null_reason})
 
-
-def wait_matched(writers, timeout_s):
-    """Waits until each writer has a matched subscription; exits with a message after timeout_s."""
-    deadline = time.time() + timeout_s
-    while any(w.get_publication_matched_status().current_count == 0 for w in writers):
-        if time.time() > deadline:
-            sys.exit(f"stamped_plant_peer: no subscriber matched within {timeout_s} s")
-        time.sleep(0.05)
 
 
 if __name__ == "__main__":
