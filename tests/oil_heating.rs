@@ -395,3 +395,51 @@ fn a_failed_heat_balance_warns_and_the_last_good_viscosity_stays() {
     assert_eq!((report.balances, report.failures), (3, 1));
     assert!(report.last_failure.unwrap().contains("law's range"));
 }
+
+/// The node's balances run on a worker thread: a failed one there is counted and warned of as
+/// on the driver's own thread, and the last good viscosity stays in force (to 1e-12) in the
+/// running twin.
+#[test]
+fn a_failed_heat_balance_off_the_model_thread_keeps_the_last_good_viscosity() {
+    use rotor_twin::driver::{Driver, DriverSettings, ModelKind};
+    use rotor_twin::dynamics::FilmEvaluation;
+    let w = 9000.0 * std::f64::consts::PI / 30.0;
+    let settings = DriverSettings {
+        heat_balance_off_thread: true,
+        ..DriverSettings::new(ModelKind::Nonlinear, FilmEvaluation::Direct, w)
+    };
+    let mut d = Driver::new(heated_rotor(MDM_CP, 1.0), settings);
+    let mut emit = |_: rotor_twin::session::Outgoing| {};
+    let (mut t, ms) = (1_767_225_600_000_000_000_i64, 1_000_000);
+    // wakes of 1 ms until the worker is done (bounded: 600 s of waiting)
+    let mut settle = |d: &mut Driver, t: &mut i64| {
+        for _ in 0..600_000 {
+            *t += ms;
+            d.advance_to(*t, 4, &mut emit);
+            if !d.heat_balance_pending() {
+                return;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        panic!("the worker never finished");
+    };
+    d.feed(t, speed_rpm(9000.0), &mut |_| {});
+    settle(&mut d, &mut t);
+    assert_eq!(d.heat_balances(), (1, None));
+    let twin_scale = |d: &Driver| d.session().unwrap().twin().film_viscosity_scale(0).unwrap();
+    let good = twin_scale(&d);
+    assert!((good / d.film_oil()[0].viscosity_scale - 1.0).abs() < 1e-12);
+    d.feed(t, supply(119.8), &mut |_| {});
+    settle(&mut d, &mut t);
+    let (balances, why) = d.heat_balances();
+    println!("off the model thread at 119.8 °C: {balances} balances, {why:?}");
+    assert_eq!(balances, 2);
+    assert!(why.unwrap().contains("beyond the viscosity law's range"));
+    assert_eq!(d.heat_balance_failures(), 1);
+    assert!(d
+        .oil_diagnostics()
+        .warning
+        .unwrap()
+        .contains("heat balance failed"));
+    assert!((twin_scale(&d) / good - 1.0).abs() < 1e-12);
+}

@@ -244,6 +244,69 @@ fn the_live_twin_on_the_table_heats_with_its_thermal_film() {
     assert!(e.is_finite() && e < 1.0, "ε {e}");
 }
 
+/// The node's heat balances run on a worker thread (`heat_balance_off_thread`): the twin
+/// keeps stepping at the scales in force while a balance runs; three speeds fed while the first
+/// balance runs are coalesced (the stale middle one is skipped or run, never queued behind the
+/// newest); the scales taken at a later wake are those of the last speed, equal to 1e-12 of the
+/// same speeds balanced on the driver's own thread.
+#[test]
+fn balances_off_the_model_thread_give_the_inline_scales() {
+    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
+        common::test_cache_dir(),
+    )));
+    let settings = |off_thread: bool| DriverSettings {
+        heat_balance_off_thread: off_thread,
+        ..DriverSettings::new(
+            ModelKind::Nonlinear,
+            FilmEvaluation::Table,
+            thermal_rotor().rated_speed_rad_s,
+        )
+    };
+    let mut emit = |_: rotor_twin::session::Outgoing| {};
+    let t0 = 1_767_225_600_000_000_000_i64;
+    let ms = 1_000_000;
+    let mut inline = Driver::new(thermal_rotor(), settings(false));
+    let mut live = Driver::new(thermal_rotor(), settings(true));
+    for (k, rpm) in [8000.0, 8500.0, 9000.0].into_iter().enumerate() {
+        let t = t0 + k as i64 * ms;
+        inline.feed(t, speed_rpm(rpm), &mut emit);
+        live.feed(t, speed_rpm(rpm), &mut emit);
+    }
+    assert_eq!(inline.heat_balances(), (3, None));
+    // wakes every 1 ms of driver time until the worker is done (bounded: 600 s of waiting)
+    let mut wakes = 0;
+    let mut t = t0 + 3 * ms;
+    while live.heat_balance_pending() && wakes < 600_000 {
+        std::thread::sleep(std::time::Duration::from_millis(1));
+        t += ms;
+        live.advance_to(t, 8, &mut emit);
+        wakes += 1;
+    }
+    live.advance_to(t + ms, 8, &mut emit);
+    assert!(!live.heat_balance_pending(), "the worker never finished");
+    let (balances, failure) = live.heat_balances();
+    println!("off the model thread: {balances} balances for 3 speeds, {wakes} wakes of 1 ms");
+    assert_eq!(failure, None);
+    assert!((2..=3).contains(&balances), "{balances}");
+    for (a, b) in live.film_oil().iter().zip(inline.film_oil()) {
+        let (ta, tb) = (
+            a.effective_temperature_k.unwrap(),
+            b.effective_temperature_k.unwrap(),
+        );
+        println!(
+            "{}: T̄ {:.6} vs inline {:.6} °C",
+            a.name,
+            ta - ZERO_CELSIUS_K,
+            tb - ZERO_CELSIUS_K
+        );
+        assert!((ta / tb - 1.0).abs() < 1e-12, "{}", a.name);
+        assert!((a.viscosity_scale / b.viscosity_scale - 1.0).abs() < 1e-12);
+    }
+    let twin = live.session().unwrap().twin();
+    let scale = twin.film_viscosity_scale(0).unwrap();
+    assert!((scale / live.film_oil()[0].viscosity_scale - 1.0).abs() < 1e-12);
+}
+
 /// The thermal film is the finite laminar film of a plain bearing and mixes its own hot oil:
 /// a `carry_over`, a turbulent or grooved bearing with it are refused, naming the field.
 #[test]
@@ -371,4 +434,42 @@ fn a_film_hotter_than_the_law_is_refused_naming_the_range() {
         err.contains("valid_range_c") && err.contains("°C") && err.contains("120.0"),
         "{err}"
     );
+}
+
+/// `rotor-twin bench wakes` runs the node's wakes through a ramp with the balances on the model
+/// thread and off it, and both do every balance (its times are figures for the README, not
+/// asserted here).
+#[test]
+fn bench_wakes_runs_both_ways() {
+    let cache = test_cache_dir();
+    let config = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/config/orc_microturbine_100kw_thermal.yaml"
+    );
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+        .args([
+            "--film-cache-dir",
+            cache.to_str().unwrap(),
+            "bench",
+            "wakes",
+        ])
+        .args(["--config", config, "--seconds", "0.5", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    println!("{v}");
+    let runs = v.as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for (run, place) in runs.iter().zip(["model thread", "worker thread"]) {
+        assert_eq!(run["heat_balance"], place);
+        assert_eq!(run["failures"], 0);
+        // the first speed, then one a 1 % step of the 200 rpm ramp: at least 2
+        assert!(run["balances"].as_u64().unwrap() >= 2, "{run}");
+        assert_eq!(run["wakes"], 250);
+    }
 }

@@ -27,9 +27,15 @@ enum Workload {
     /// woken as the node is; CPU seconds per simulated second (`--seconds`: simulated seconds
     /// measured), split into the step, the monitor, the session's outputs and the driver.
     Node,
+    /// The node's model thread through a speed ramp (from 8,000 rpm at `--ramp-rpm-s`, default
+    /// 400, for `--seconds`), paced in real time with wakes every 2 ms, on the machine of
+    /// `--config` (e.g. `config/orc_microturbine_100kw_thermal.yaml`): each wake's wall time with
+    /// the heat balances on the model thread and off it (the node's choice).
+    Wakes,
 }
 
 mod node;
+mod wakes;
 
 /// Measure the cost of the hot paths.
 #[derive(Debug, Clone, Args)]
@@ -99,6 +105,7 @@ pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Workload::Orc9000 => return orc_9000(args),
         Workload::Factor => factor_cases(args)?,
         Workload::Node => return node_case(args),
+        Workload::Wakes => return wakes_case(args),
     };
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&figures)?);
@@ -358,6 +365,42 @@ fn node_case(args: &BenchArgs) -> anyhow::Result<()> {
         f.messages,
         f.messages_published
     );
+    Ok(())
+}
+
+/// The ramp's first speed for `bench wakes` (rpm): below the built-in machine's whip.
+const WAKES_FROM_RPM: f64 = 8000.0;
+
+fn wakes_case(args: &BenchArgs) -> anyhow::Result<()> {
+    let rotor = crate::rotor::Rotor::from_description(&crate::rotor::MachineDescription::load(
+        args.config.as_deref(),
+    )?);
+    let ramp = wakes::Ramp {
+        from_rpm: WAKES_FROM_RPM,
+        rpm_per_s: args.ramp_rpm_s.unwrap_or(400.0),
+        seconds: args.seconds,
+    };
+    let figures = [false, true]
+        .into_iter()
+        .map(|off| wakes::run(&rotor, ramp, off))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&figures)?);
+        return Ok(());
+    }
+    outln!(
+        "node's wakes (every 2 ms, real time) through a ramp {:.0} → {:.0} rpm at {} rpm/s, tabulated film, {}:",
+        ramp.from_rpm,
+        ramp.from_rpm + ramp.rpm_per_s * ramp.seconds,
+        ramp.rpm_per_s,
+        args.config.as_ref().map_or("built-in machine".into(), |p| p.display().to_string())
+    );
+    for f in &figures {
+        outln!(
+            "  balances on the {:<14} wake median {:>7.1} µs  p99 {:>7.1} µs  slowest {:>8.1} µs  late {:>4} of {}  ({} balances, {} failed)",
+            f.heat_balance, f.median_us, f.p99_us, f.max_us, f.late_wakes, f.wakes, f.balances, f.failures
+        );
+    }
     Ok(())
 }
 

@@ -8,6 +8,7 @@
 
 pub mod calibration;
 mod clock;
+mod heat_worker;
 pub mod inputs;
 mod observer;
 mod oil;
@@ -178,7 +179,7 @@ impl Driver {
     pub fn new(rotor: Rotor, settings: DriverSettings) -> Self {
         let limits = InputLimits::of(&rotor);
         let gate = SpeedGate::new(limits.max_speed_rad_s, settings.input_timeout_s);
-        let oil = oil::OilState::of(&rotor);
+        let oil = oil::OilState::of(&rotor, &settings);
         Self {
             unbalance: vec![None; rotor.unbalance.len()],
             rotor,
@@ -348,6 +349,7 @@ impl Driver {
         self.check_keyphasor_stop(now_ns, emit);
         self.warn_refusals(now_ns, emit);
         let mut taken = 0;
+        self.take_finished_heat();
         self.blend_targets();
         while taken < max_steps && self.session.as_ref().is_some_and(|s| s.stamp_ns() < now_ns) {
             // an applied calibration moves the twin's values on before each step

@@ -8,6 +8,7 @@
 //! [`HEAT_BALANCE_TEMPERATURE_STEP_K`] since the last one (and at the first speed). Between two
 //! balances each film keeps its scale; the step itself only reads the scale (allocates nothing).
 
+use super::heat_worker::{balance, HeatJob, HeatWorker};
 use super::{inputs, Driver, Fed};
 
 /// The heat balance is redone when the speed has moved by more than this fraction since the
@@ -27,7 +28,7 @@ pub fn speed_moved_past_balance(balanced_rad_s: f64, speed_rad_s: f64) -> bool {
 pub const HEAT_BALANCE_TEMPERATURE_STEP_K: f64 = 0.05;
 
 /// The oil state the driver keeps, per film bearing (in the order of the film bearings).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(super) struct OilState {
     /// µ_i(T_s) / µ_reference,i of the supply temperature in force (1 before one is received:
     /// the machine file's viscosity)
@@ -49,24 +50,52 @@ pub(super) struct OilState {
     last_failure: Option<String>,
     /// whether any film bearing models its own heating
     heating: bool,
+    /// the thread the balances run on, when off the model thread (`heat_worker`)
+    worker: Option<HeatWorker>,
 }
 
 impl OilState {
-    /// The state of `rotor`'s film bearings at the machine file's viscosity.
-    pub(super) fn of(rotor: &crate::rotor::Rotor) -> Self {
+    /// The state of `rotor`'s film bearings at the machine file's viscosity; their heat
+    /// balances on a worker thread when `settings` say so and a bearing is heated (on the
+    /// caller's thread if that thread cannot be started).
+    pub(super) fn of(rotor: &crate::rotor::Rotor, settings: &super::DriverSettings) -> Self {
         let n = rotor.film_bearing_count();
+        let heating = rotor.has_oil_heating();
+        let worker = (heating && settings.heat_balance_off_thread)
+            .then(|| HeatWorker::start(rotor, settings.twin.film).ok())
+            .flatten();
         Self {
             law_scales: vec![1.0; n],
             scratch: vec![1.0; n],
             scales: vec![1.0; n],
             heated: vec![None; n],
-            heating: rotor.has_oil_heating(),
+            heating,
+            worker,
             ..Self::default()
         }
     }
 }
 
 impl OilState {
+    /// A finished heat balance counted and kept (a failure keeps the scales of the last good
+    /// one in force, `push_oil_scales`); true when it succeeded.
+    fn take_balance(&mut self, result: Result<Vec<(usize, f64, f64)>, String>) -> bool {
+        self.balances += 1;
+        match result {
+            Ok(films) => {
+                for (i, t_k, scale) in films {
+                    self.heated[i] = Some((t_k, scale));
+                }
+                self.heating_error = None;
+                true
+            }
+            Err(e) => {
+                self.failed(e);
+                false
+            }
+        }
+    }
+
     /// A heat balance failed for `why`: counted, kept as the last failure and as the reason
     /// in force until a balance succeeds.
     fn failed(&mut self, why: String) {
@@ -187,26 +216,39 @@ impl Driver {
             }
         }
         self.oil.balanced_at = Some((speed, supply));
-        self.oil.balances += 1;
-        let film = self.settings.twin.film;
-        match self.rotor.heat_films_with(supply, speed, 1.0, film) {
-            Ok(temps) => {
-                for t in temps {
-                    let i = self.rotor.bearings[..t.bearing]
-                        .iter()
-                        .filter(|b| matches!(b.model, crate::rotor::BearingModel::Film(_)))
-                        .count();
-                    let e = &t.effective;
-                    self.oil.heated[i] = Some((e.effective_temperature_k, t.viscosity_scale));
-                }
-                self.oil.heating_error = None;
+        let job = HeatJob {
+            supply_k: supply,
+            speed_rad_s: speed,
+        };
+        if let Some(w) = self.oil.worker.as_mut() {
+            // taken by `take_finished_heat` at a later wake
+            if let Err(why) = w.request(job) {
+                self.oil.failed(why);
             }
-            Err(e) => {
-                // the scales of the last good balance stay in force (`push_oil_scales`)
-                self.oil.failed(e);
+            return false;
+        }
+        let result = balance(&mut self.rotor, job, self.settings.twin.film);
+        self.oil.take_balance(result);
+        true
+    }
+
+    /// A balance the worker has finished since the last wake, if any: its scales applied.
+    pub(super) fn take_finished_heat(&mut self) {
+        let Some(result) = self.oil.worker.as_mut().and_then(HeatWorker::finished) else {
+            return;
+        };
+        // the worker set the scales on its own copy of the machine: `push_oil_scales` sets them
+        // on this one
+        if self.oil.take_balance(result) {
+            if let Err(why) = self.push_oil_scales() {
+                self.oil.failed(why);
             }
         }
-        true
+    }
+
+    /// Whether a heat balance is running or waiting on the worker thread.
+    pub fn heat_balance_pending(&self) -> bool {
+        self.oil.worker.as_ref().is_some_and(HeatWorker::busy)
     }
 
     /// Sets the scales in force (heated or law, × the calibration's correction) on the machine

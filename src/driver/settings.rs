@@ -103,6 +103,11 @@ pub struct DriverSettings {
     /// the node, whose stamps and clock share the bus; off for a replay, whose bags may come
     /// from tools that stamp on other clocks (the receive time orders the samples there).
     pub check_speed_stamps: bool,
+    /// Heat balances (`oil_heating`) run on a worker thread and their scales are taken at the
+    /// next wake after they finish (`driver::heat_worker`): on for the node, whose model thread
+    /// must not stall for a balance; off for the replay and the offline runs, which balance on
+    /// their own thread so that the same inputs give the same outputs.
+    pub heat_balance_off_thread: bool,
 }
 
 impl DriverSettings {
@@ -122,6 +127,7 @@ impl DriverSettings {
             input_timeout_s: 1.0,
             max_gap_s: 5.0,
             check_speed_stamps: true,
+            heat_balance_off_thread: false,
         }
     }
 }

@@ -249,6 +249,8 @@ pub fn driver_settings(p: &NodeParams, rotor: &Rotor) -> DriverSettings {
     s.session = session_settings(p);
     s.min_speed_rad_s = crate::units::rpm_to_rad_s(p.min_speed_rpm);
     s.input_timeout_s = p.input_timeout_s;
+    // a heat balance (up to 17 ms with the thermal film) must not stall the model thread
+    s.heat_balance_off_thread = true;
     s
 }
 
