@@ -184,7 +184,10 @@ impl ThermalFilm {
                 FilmError::InvalidParameter {
                     name: "thermal film temperature (°C) of a column (the hottest, not the mean)",
                     value: t - super::ZERO_CELSIUS_K,
-                    rule: "must lie within the viscosity law's range: the machine file's valid_range_c, within the table's span",
+                    rule: "must lie within the viscosity law's range (the machine file's valid_range_c, \
+                           within the table's span): the film heats its oil past the supply \
+                           temperature, so the law must reach above it by the film's rise; extend \
+                           the law's table and valid_range_c, or lower the supply temperature",
                 }
             })?;
             *r = mu / self.reference_viscosity_pa_s;
