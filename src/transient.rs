@@ -44,6 +44,9 @@ pub struct TransientResult {
     /// revolutions ([`FLUID_FRACTION_POINTS`] around the bearing): with mass-conserving
     /// cavitation only (empty otherwise: a Reynolds film is full wherever it carries load).
     pub fluid_fraction_maps: Vec<Vec<Vec<f64>>>,
+    /// Where each bearing's mass-conserving plain film is fed (rad from `+x`, fixed through the
+    /// run; None for other films).
+    pub feed_angles_rad: Vec<Option<f64>>,
     /// Order spectrum of each bearing over the last 16 revolutions.
     pub spectra: Vec<Vec<OrderComponent>>,
     /// Simulated time (s).
@@ -495,6 +498,7 @@ pub fn run_driven(
         orbits: (0..n).map(|b| monitor.recent_orbit(b, 2)).collect(),
         pressure_maps: (0..n).map(|b| monitor.recent_pressure(b, 2)).collect(),
         fluid_fraction_maps,
+        feed_angles_rad: (0..n).map(|b| twin.feed_angle_rad(b)).collect(),
         spectra: (0..n).map(|b| monitor.full_spectrum(b)).collect(),
         simulated_s: twin.time_s(),
         wall_time_s,

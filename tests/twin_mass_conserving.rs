@@ -245,12 +245,31 @@ fn a_run_keeps_its_fluid_fraction_map_and_plots_it() {
         );
         assert!(full > 0.3, "the pressure zone is full: {full}");
     }
+    // the plain bearing's feed line: fixed where the gap was widest at the start, opposite the
+    // loaded side (the static load points down, −y: the gap is widest above the journal,
+    // turned on by the attitude, here 144° from +x within the grid's 6° columns); full on every
+    // row of the map
+    assert_eq!(reynolds.feed_angles_rad, vec![None, None]);
+    for (b, map) in r.fluid_fraction_maps.iter().enumerate() {
+        let feed = r.feed_angles_rad[b].expect("a mass-conserving plain film has a feed line");
+        let deg = feed.to_degrees();
+        println!("bearing {b}: feed line at {deg:.1}°");
+        assert!((90.0..180.0).contains(&deg), "above the journal: {deg}°");
+        let k = (deg / 360.0 * FLUID_FRACTION_POINTS as f64).round() as usize;
+        assert!(map.iter().all(|row| row[k % FLUID_FRACTION_POINTS] == 1.0));
+    }
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("fluid_fraction_plot");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("phi.svg");
-    rotor_twin::plot::fluid_fraction_map_svg(&path, "test", &r.fluid_fraction_maps[0]).unwrap();
+    let feed = r.feed_angles_rad[0].map(f64::to_degrees);
+    rotor_twin::plot::fluid_fraction_map_svg(&path, "test", &r.fluid_fraction_maps[0], feed)
+        .unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
     assert!(svg.contains("φ down to"), "the title names the floor");
+    assert!(
+        svg.contains("feed line"),
+        "the feed line is drawn and named"
+    );
 }
 
 /// `simulate` and `sweep` run the mass-conserving film (the JSON says so) and refuse it with the

@@ -733,6 +733,7 @@ fn write_plots(dir: &Path, r: &TransientResult) -> anyhow::Result<()> {
                 &dir.join(format!("fluid_fraction_{name}.svg")),
                 &format!("mid-plane fluid fraction: {name}"),
                 &r.fluid_fraction_maps[i],
+                r.feed_angles_rad[i].map(f64::to_degrees),
             )?;
         }
     }

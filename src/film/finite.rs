@@ -770,6 +770,11 @@ impl FilmModel for FiniteFilm {
         self.midplane_phi(out);
     }
 
+    fn feed_angle_rad(&self) -> Option<f64> {
+        let nt = self.grid.n_theta as f64;
+        (self.feed_column).map(|i| i as f64 * std::f64::consts::TAU / nt)
+    }
+
     fn begin_step(&mut self, step_s: f64) {
         self.twin_begin_step(step_s);
     }

@@ -195,6 +195,13 @@ pub trait FilmModel {
         out.fill(1.0);
     }
 
+    /// Where a mass-conserving plain bearing is fed (rad from `+x`; its feed line, fixed in a
+    /// transient where it was at the start), or None (no such film, or a grooved bearing, whose
+    /// grooves are its feed).
+    fn feed_angle_rad(&self) -> Option<f64> {
+        None
+    }
+
     /// A film with memory (mass-conserving cavitation, issue 18): the next solves belong to a
     /// time step of `step_s` (s) that starts from the last committed state. No-op otherwise.
     fn begin_step(&mut self, _step_s: f64) {}

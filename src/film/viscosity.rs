@@ -441,6 +441,10 @@ impl FilmModel for ViscosityScaledFilm {
         self.inner.midplane_fluid_fraction(out);
     }
 
+    fn feed_angle_rad(&self) -> Option<f64> {
+        self.inner.feed_angle_rad()
+    }
+
     fn begin_step(&mut self, step_s: f64) {
         self.inner.begin_step(step_s);
     }

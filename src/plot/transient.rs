@@ -5,6 +5,7 @@
 use super::legend::{draw_side_legend, Entry, Swatch};
 use crate::monitor::OrderComponent;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// The orbit (last two revolutions) of a journal inside its clearance circle, 1:1, in µm, with
@@ -230,7 +231,7 @@ pub fn pressure_map_svg(
     root.fill(&WHITE)?;
     let root = titled_with_validity(root, &caption, not_valid)?;
     let (map_area, bar_area) = root.split_horizontally(790);
-    draw_map(&map_area, map_pa, |p| {
+    draw_map(&map_area, map_pa, None, |p| {
         if p > top {
             ABOVE_SCALE
         } else {
@@ -251,8 +252,14 @@ fn fraction_shade(phi: f64) -> RGBColor {
 
 /// Mid-plane fluid fraction φ over the last two revolutions (mass-conserving cavitation, issue
 /// 18): bearing angle against shaft rotation (degrees), grey = φ (black: full film, φ = 1;
-/// lighter: the ruptured zone's streamers), with a colour bar 0–1.
-pub fn fluid_fraction_map_svg(path: &Path, title: &str, map: &[Vec<f64>]) -> anyhow::Result<()> {
+/// lighter: the ruptured zone's streamers), with a colour bar 0–1; a plain bearing's feed line
+/// (`feed_deg`, degrees from +x), where the film is held full, drawn across it.
+pub fn fluid_fraction_map_svg(
+    path: &Path,
+    title: &str,
+    map: &[Vec<f64>],
+    feed_deg: Option<f64>,
+) -> anyhow::Result<()> {
     let lowest = (map.iter().flatten().copied())
         .filter(|v| v.is_finite())
         .fold(1.0_f64, f64::min);
@@ -261,17 +268,22 @@ pub fn fluid_fraction_map_svg(path: &Path, title: &str, map: &[Vec<f64>]) -> any
     root.fill(&WHITE)?;
     let root = root.titled(&caption, ("sans-serif", 18))?;
     let (map_area, bar_area) = root.split_horizontally(790);
-    draw_map(&map_area, map, fraction_shade)?;
+    draw_map(&map_area, map, feed_deg, fraction_shade)?;
     colour_bar(&bar_area, ("fluid fraction φ", 1.0), fraction_shade)?;
     root.present()?;
     Ok(())
 }
 
+/// The colour of the feed line drawn on a fluid-fraction map (over black and grey cells).
+const FEED_LINE: RGBColor = RGBColor(230, 80, 20);
+
 /// A map of rows (one a time step, over 720° of shaft rotation) of values around the bearing
-/// (0–360° from +x), each cell filled with `shade(value)`.
+/// (0–360° from +x), each cell filled with `shade(value)`; with `feed_deg`, a line across it
+/// at that bearing angle, labelled.
 fn draw_map<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     map: &[Vec<f64>],
+    feed_deg: Option<f64>,
     shade: impl Fn(f64) -> RGBColor,
 ) -> anyhow::Result<()>
 where
@@ -309,6 +321,27 @@ where
         }
     }
     chart.draw_series(cells)?;
+    if let Some(a) = feed_deg {
+        chart.draw_series(LineSeries::new(
+            [(0.0, a), (720.0, a)],
+            FEED_LINE.stroke_width(2),
+        ))?;
+        // above the line (below it near the top edge)
+        let (y, v) = if a > 340.0 {
+            (a - 3.0, VPos::Top)
+        } else {
+            (a + 3.0, VPos::Bottom)
+        };
+        let label = ("sans-serif", 15)
+            .into_font()
+            .color(&FEED_LINE)
+            .pos(Pos::new(HPos::Left, v));
+        chart.draw_series(std::iter::once(Text::new(
+            format!("feed line {a:.0}°"),
+            (8.0, y),
+            label,
+        )))?;
+    }
     Ok(())
 }
 

@@ -199,6 +199,11 @@ impl Twin {
         self.links[bearing].film.midplane_fluid_fraction(out);
     }
 
+    /// Where bearing `bearing`'s mass-conserving plain film is fed (rad from `+x`), if it is one.
+    pub fn feed_angle_rad(&self, bearing: usize) -> Option<f64> {
+        self.links[bearing].film.feed_angle_rad()
+    }
+
     // --- oil supply temperature (issue 12) ---
     /// Sets the viscosity of every film to `scale` × its reference viscosity (the machine
     /// file's): exact for the isoviscous film ([`crate::film::ViscosityScaledFilm`]). Takes effect
