@@ -3,6 +3,7 @@
 //! iterated through the machine file's viscosity–temperature law).
 
 mod common;
+use common::heating::*;
 use common::*;
 use rotor_twin::film::{
     equilibrium_at_eccentricity, equilibrium_under_load, FilmGrid, FiniteFilm, Lubricant,
@@ -165,27 +166,6 @@ fn the_seed_case_heated_raises_the_threshold() {
     assert!(rpm > cold_rpm + 20.0, "{rpm} vs {cold_rpm}");
 }
 
-/// An oil supply temperature message (°C) as the node decodes it.
-fn supply(celsius: f64) -> rotor_twin::driver::Input {
-    use rotor_twin::messages::{Header, Temperature, Time};
-    rotor_twin::driver::Input::from(&Temperature {
-        header: Header {
-            stamp: Time::from_nanos(0),
-            frame_id: String::new(),
-        },
-        temperature: celsius,
-        variance: 0.0,
-    })
-}
-
-fn speed_rpm(rpm: f64) -> rotor_twin::driver::Input {
-    rotor_twin::driver::Input::Speed {
-        speed_rad_s: rpm * std::f64::consts::PI / 30.0,
-        accel_rad_s2: 0.0,
-        stamp_ns: 0,
-    }
-}
-
 /// The live twin's films (the driver the node and the replay run) against `Rotor::heat_films`
 /// on a fresh machine, the computation `bearing --speeds` and `modes` print: per bearing, T_eff
 /// within `tol_k` and the running twin's scale µ(T_eff)/µ_ref equal to the machine's.
@@ -272,9 +252,7 @@ fn the_live_twin_heats_each_film_as_bearing_speeds_does() {
     assert_eq!(d.feed(t0 + 4 * ms, supply(50.01), &mut emit), Fed::Taken);
     assert_eq!(d.heat_balances().0, 3);
     // the twin steps on at the heated viscosities
-    d.advance_to(t0 + 20 * ms, usize::MAX, &mut emit);
-    let e = d.session().unwrap().twin().output().bearings[0].eccentricity_ratio;
-    assert!(e.is_finite() && e < 1.0, "ε {e}");
+    assert_steps_on(&mut d, t0 + 20 * ms);
 }
 
 /// The node runs the tabulated film: its heat balance takes the table (0.4 ms here against the
@@ -285,9 +263,7 @@ fn the_live_twin_heats_each_film_as_bearing_speeds_does() {
 fn the_live_twin_on_the_table_heats_within_three_hundredths_of_a_kelvin() {
     use rotor_twin::driver::{Driver, DriverSettings, Fed, ModelKind};
     use rotor_twin::dynamics::FilmEvaluation;
-    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
-        common::test_cache_dir(),
-    )));
+    use_test_table_cache();
     let mut rotor = heated_rotor(MDM_CP, 0.5);
     let w = 9000.0 * std::f64::consts::PI / 30.0;
     for film in [
@@ -383,9 +359,7 @@ fn a_failed_heat_balance_warns_and_the_last_good_viscosity_stays() {
     assert_eq!(value(&d, "heat_balance_failures").as_deref(), Some("1"));
     assert!(value(&d, "heat_balance_error").is_some_and(|v| v.contains("law's range")));
     // the twin steps on
-    d.advance_to(t0 + 20 * ms, usize::MAX, &mut emit);
-    let e = d.session().unwrap().twin().output().bearings[0].eccentricity_ratio;
-    assert!(e.is_finite() && e < 1.0, "ε {e}");
+    assert_steps_on(&mut d, t0 + 20 * ms);
     // back to 40 °C: a good balance, no warning, the count kept
     assert_eq!(d.feed(t0 + 21 * ms, supply(40.0), &mut emit), Fed::Taken);
     assert_eq!(d.heat_balances(), (3, None));
@@ -409,28 +383,15 @@ fn a_failed_heat_balance_off_the_model_thread_keeps_the_last_good_viscosity() {
         ..DriverSettings::new(ModelKind::Nonlinear, FilmEvaluation::Direct, w)
     };
     let mut d = Driver::new(heated_rotor(MDM_CP, 1.0), settings);
-    let mut emit = |_: rotor_twin::session::Outgoing| {};
-    let (mut t, ms) = (1_767_225_600_000_000_000_i64, 1_000_000);
-    // wakes of 1 ms until the worker is done (bounded: 600 s of waiting)
-    let mut settle = |d: &mut Driver, t: &mut i64| {
-        for _ in 0..600_000 {
-            *t += ms;
-            d.advance_to(*t, 4, &mut emit);
-            if !d.heat_balance_pending() {
-                return;
-            }
-            std::thread::sleep(std::time::Duration::from_millis(1));
-        }
-        panic!("the worker never finished");
-    };
+    let mut t = 1_767_225_600_000_000_000_i64;
     d.feed(t, speed_rpm(9000.0), &mut |_| {});
-    settle(&mut d, &mut t);
+    settle_heat(&mut d, &mut t);
     assert_eq!(d.heat_balances(), (1, None));
     let twin_scale = |d: &Driver| d.session().unwrap().twin().film_viscosity_scale(0).unwrap();
     let good = twin_scale(&d);
     assert!((good / d.film_oil()[0].viscosity_scale - 1.0).abs() < 1e-12);
     d.feed(t, supply(119.8), &mut |_| {});
-    settle(&mut d, &mut t);
+    settle_heat(&mut d, &mut t);
     let (balances, why) = d.heat_balances();
     println!("off the model thread at 119.8 °C: {balances} balances, {why:?}");
     assert_eq!(balances, 2);

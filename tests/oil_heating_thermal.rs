@@ -5,6 +5,7 @@
 //! node, the replay, `bearing --speeds` and `modes` run.
 
 mod common;
+use common::heating::*;
 use common::*;
 use rotor_twin::driver::{Driver, DriverSettings, Fed, ModelKind};
 use rotor_twin::dynamics::FilmEvaluation;
@@ -158,23 +159,13 @@ fn the_heated_films_against_their_thermal_films_at_rated_speed() {
     }
 }
 
-fn speed_rpm(rpm: f64) -> rotor_twin::driver::Input {
-    rotor_twin::driver::Input::Speed {
-        speed_rad_s: rad_s(rpm),
-        accel_rad_s2: 0.0,
-        stamp_ns: 0,
-    }
-}
-
 /// The live twin on the node's tabulated film: each balance's T̄ is the thermal film's (always
 /// the finite solver) to 1e-9 K of `Rotor::heat_films` on a fresh machine, the running twin
 /// runs at µ(T̄)/µ_ref, the balance is redone past 1 % of speed, and the twin steps on (its
 /// cost per balance printed: it is taken on the model thread at a speed change).
 #[test]
 fn the_live_twin_on_the_table_heats_with_its_thermal_film() {
-    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
-        common::test_cache_dir(),
-    )));
+    use_test_table_cache();
     let rotor = thermal_rotor();
     let settings = DriverSettings::new(
         ModelKind::Nonlinear,
@@ -239,9 +230,7 @@ fn the_live_twin_on_the_table_heats_with_its_thermal_film() {
             f.bearing
         );
     }
-    d.advance_to(t0 + 20 * ms, usize::MAX, &mut emit);
-    let e = d.session().unwrap().twin().output().bearings[0].eccentricity_ratio;
-    assert!(e.is_finite() && e < 1.0, "ε {e}");
+    assert_steps_on(&mut d, t0 + 20 * ms);
 }
 
 /// The node's heat balances run on a worker thread (`heat_balance_off_thread`): the twin
@@ -251,9 +240,7 @@ fn the_live_twin_on_the_table_heats_with_its_thermal_film() {
 /// same speeds balanced on the driver's own thread.
 #[test]
 fn balances_off_the_model_thread_give_the_inline_scales() {
-    rotor_twin::film::set_disk_cache(Some(rotor_twin::film::TableCache::new(
-        common::test_cache_dir(),
-    )));
+    use_test_table_cache();
     let settings = |off_thread: bool| DriverSettings {
         heat_balance_off_thread: off_thread,
         ..DriverSettings::new(
@@ -273,19 +260,10 @@ fn balances_off_the_model_thread_give_the_inline_scales() {
         live.feed(t, speed_rpm(rpm), &mut emit);
     }
     assert_eq!(inline.heat_balances(), (3, None));
-    // wakes every 1 ms of driver time until the worker is done (bounded: 600 s of waiting)
-    let mut wakes = 0;
     let mut t = t0 + 3 * ms;
-    while live.heat_balance_pending() && wakes < 600_000 {
-        std::thread::sleep(std::time::Duration::from_millis(1));
-        t += ms;
-        live.advance_to(t, 8, &mut emit);
-        wakes += 1;
-    }
-    live.advance_to(t + ms, 8, &mut emit);
-    assert!(!live.heat_balance_pending(), "the worker never finished");
+    settle_heat(&mut live, &mut t);
     let (balances, failure) = live.heat_balances();
-    println!("off the model thread: {balances} balances for 3 speeds, {wakes} wakes of 1 ms");
+    println!("off the model thread: {balances} balances for 3 speeds");
     assert_eq!(failure, None);
     assert!((2..=3).contains(&balances), "{balances}");
     for (a, b) in live.film_oil().iter().zip(inline.film_oil()) {

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod calibration;
+pub mod heating;
 pub mod model_loop;
 pub mod node;
 pub mod onset;
