@@ -396,6 +396,8 @@ fn offline_runs_heat_as_the_node_does() {
 /// law's there): the thermal film's hottest column passes 120 °C though its mean does not, and
 /// the balance is refused naming the temperature in °C and the machine file's `valid_range_c`
 /// (the live twin then keeps the last good viscosity with a warning: `driver::oil`).
+/// `bearing --speeds` reports the speeds that balance (5,000–8,000 rpm here, peak rises
+/// 4.1–4.8 K) and names the one that does not (9,000 rpm) with why, then exits with an error.
 #[test]
 fn a_film_hotter_than_the_law_is_refused_naming_the_range() {
     let yaml = THERMAL_YAML
@@ -412,6 +414,29 @@ fn a_film_hotter_than_the_law_is_refused_naming_the_range() {
         err.contains("valid_range_c") && err.contains("°C") && err.contains("120.0"),
         "{err}"
     );
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("hot_supply");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("hot.yaml");
+    std::fs::write(&path, &yaml).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rotor-twin"))
+        .args(["bearing", "--config", path.to_str().unwrap()])
+        .args(["--speeds", "5000:9000:1000", "--json"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("{stderr}");
+    assert!(!out.status.success(), "a failed speed ends with an error");
+    assert!(stderr.contains("1 of 5 speeds") && stderr.contains("9000 rpm"));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows: Vec<f64> = (v["speeds"].as_array().unwrap().iter())
+        .map(|r| r["speed_rpm"].as_f64().unwrap())
+        .collect();
+    assert_eq!(rows, [5000.0, 6000.0, 7000.0, 8000.0]);
+    assert_eq!(v["failed"][0]["speed_rpm"], 9000.0);
+    assert!(v["failed"][0]["error"]
+        .as_str()
+        .unwrap()
+        .contains("valid_range_c"));
 }
 
 /// `rotor-twin bench wakes` runs the node's wakes through a ramp with the balances on the model

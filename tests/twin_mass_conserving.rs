@@ -668,6 +668,20 @@ fn fluid_fraction_map_svg(
     Ok(())
 }
 
+/// The onset study's machine: `MCAV_ONSET_CONFIG` (a machine file's path), else reading (A),
+/// `config/orc_microturbine_100kw_d55.yaml`.
+fn onset_machine() -> Rotor {
+    let path = std::env::var("MCAV_ONSET_CONFIG").unwrap_or_else(|_| {
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/config/orc_microturbine_100kw_d55.yaml"
+        )
+        .to_string()
+    });
+    let desc = MachineDescription::load(Some(std::path::Path::new(&path))).unwrap();
+    Rotor::from_description(&desc)
+}
+
 /// The growth rate (1/s) of a small free whirl of (A) at `rpm` with cavitation `cav`: no
 /// unbalance, a `kick` (N·s) at node 15 from the static equilibrium, then `revs` revolutions;
 /// the largest distance of the pulley-end journal from its equilibrium in each window of 4
@@ -681,12 +695,7 @@ fn free_whirl_growth(
     revs: usize,
 ) -> (f64, f64, f64) {
     let per_rev = 128;
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/config/orc_microturbine_100kw_d55.yaml"
-    );
-    let desc = MachineDescription::load(Some(std::path::Path::new(path))).unwrap();
-    let mut rotor = Rotor::from_description(&desc);
+    let mut rotor = onset_machine();
     rotor.unbalance.clear();
     rotor.set_cavitation(cav).unwrap();
     let w = rpm * PI / 30.0;
@@ -788,15 +797,12 @@ fn onset_speed_with_mass_conservation() {
         if !film.1 {
             // the linear threshold with this film's steady eight coefficients (the
             // mass-conserving film's: central differences of its force with ∂φ/∂t = 0, no memory)
-            let path = concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/config/orc_microturbine_100kw_d55.yaml"
-            );
-            let desc = MachineDescription::load(Some(std::path::Path::new(path))).unwrap();
-            let mut rotor = Rotor::from_description(&desc);
+            let mut rotor = onset_machine();
             rotor.set_cavitation(film.0).unwrap();
             let statics = rotor_twin::rotor::static_solution(&rotor).unwrap();
-            let t = rotor_twin::rotor::stability_threshold(&rotor, &statics, 8000.0, 9200.0, 200.0)
+            let lo = speeds.iter().copied().fold(f64::INFINITY, f64::min) - 500.0;
+            let hi = speeds.iter().copied().fold(0.0, f64::max) + 500.0;
+            let t = rotor_twin::rotor::stability_threshold(&rotor, &statics, lo, hi, 200.0)
                 .unwrap()
                 .map(|t| t.speed_rpm);
             println!("ONSET {film:?}: linear threshold with the steady coefficients {t:?} rpm");

@@ -236,7 +236,7 @@ fn run_speeds(args: &BearingArgs, speeds: &[f64]) -> anyhow::Result<()> {
     } else {
         bearing_speeds::print_table(&report)?;
     }
-    Ok(())
+    report.check_failures()
 }
 
 /// The film solver and lubricant of the flags' bearing.

@@ -235,6 +235,39 @@ pub(crate) struct SweepReport {
     pub load_direction_deg: f64,
     pub frame: &'static str,
     pub speeds: Vec<SpeedRow>,
+    /// The speeds whose equilibrium failed (e.g. a heat balance whose film passes the viscosity
+    /// law's range), each with why: the other speeds are reported all the same.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failed: Vec<FailedSpeed>,
+}
+
+/// A speed of a sweep without an equilibrium, and why.
+#[derive(Debug, Serialize)]
+pub(crate) struct FailedSpeed {
+    pub speed_rpm: f64,
+    pub error: String,
+}
+
+impl SweepReport {
+    /// Err naming the failed speeds and the first reason, if any failed (after the report of
+    /// the others is out: the command then ends with an error).
+    pub(crate) fn check_failures(&self) -> anyhow::Result<()> {
+        let Some(first) = self.failed.first() else {
+            return Ok(());
+        };
+        let rpms: Vec<String> = (self.failed.iter())
+            .map(|f| format!("{:.0}", f.speed_rpm))
+            .collect();
+        anyhow::bail!(
+            "{} of {} speeds of {} have no equilibrium ({} rpm); at {:.0} rpm: {}",
+            self.failed.len(),
+            self.failed.len() + self.speeds.len(),
+            self.bearing,
+            rpms.join(", "),
+            first.speed_rpm,
+            first.error
+        )
+    }
 }
 
 /// The speeds of a sweep end at the journal's surface speed limit
@@ -260,7 +293,8 @@ fn check_top_speed(b: &SweptBearing, speeds: &[f64]) -> anyhow::Result<()> {
 
 /// The equilibrium at each speed of `speeds` (rpm), the solver warm-started from the speed
 /// before; the coefficients turned from the machine frame into the load frame (K' = Rᵀ K R,
-/// R the rotation by the load's direction).
+/// R the rotation by the load's direction). A speed whose equilibrium fails is kept in
+/// `failed` with why, and the sweep goes on; Err if every speed failed.
 pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<SweepReport> {
     let w = b.load_n[0].hypot(b.load_n[1]);
     let load_angle = b.load_n[1].atan2(b.load_n[0]);
@@ -268,10 +302,22 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
     let c = b.film.geometry().radial_clearance_m;
     check_top_speed(b, speeds)?;
     let mut rows = Vec::with_capacity(speeds.len());
+    let mut failed = Vec::new();
     for &rpm in speeds {
         let omega = rpm_to_rad_s(rpm);
-        let (eq, heat) = equilibrium(b, omega)
-            .with_context(|| format!("static equilibrium of {} at {rpm} rpm", b.name))?;
+        let (eq, heat) = match equilibrium(b, omega) {
+            Ok(v) => v,
+            Err(e) if speeds.len() > 1 => {
+                failed.push(FailedSpeed {
+                    speed_rpm: rpm,
+                    error: format!("{e:#}"),
+                });
+                continue;
+            }
+            Err(e) => {
+                return Err(e.context(format!("static equilibrium of {} at {rpm} rpm", b.name)))
+            }
+        };
         let coef = eq.coefficients.turned_back(&r);
         let p = r.inverse() * nalgebra::Vector2::new(eq.position_m[0], eq.position_m[1]);
         let row = SpeedRow {
@@ -300,6 +346,15 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
         );
         rows.push(row);
     }
+    if rows.is_empty() {
+        let first = &failed[0];
+        anyhow::bail!(
+            "static equilibrium of {} at {} rpm (and every other speed): {}",
+            b.name,
+            first.speed_rpm,
+            first.error
+        );
+    }
     Ok(SweepReport {
         machine: b.machine.clone(),
         bearing: b.name.clone(),
@@ -311,6 +366,7 @@ pub(crate) fn sweep(b: &mut SweptBearing, speeds: &[f64]) -> anyhow::Result<Swee
         load_direction_deg: load_angle.to_degrees(),
         frame: FRAME,
         speeds: rows,
+        failed,
     })
 }
 
@@ -403,6 +459,9 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
                 mu * 1e3
             );
         }
+    }
+    for f in &r.failed {
+        outln!("  {:>7.0}  no equilibrium: {}", f.speed_rpm, f.error);
     }
     Ok(())
 }
