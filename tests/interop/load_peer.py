@@ -32,6 +32,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
+from peer_common import wait_matched  # noqa: E402
 
 
 def one_byte(typename):
@@ -83,6 +84,10 @@ def main():
     bad_w = [(DataWriter(bad_dp, Topic(bad_dp, name, ty), qos=qos), ty) for name, ty in
              [("rt/rotor_twin/speed", BadSpeed), ("rt/rotor_twin/probe", BadProbe),
               ("rt/plant/probe_b", BadPoint)]] if bad else []
+    # a reliable, volatile writer drops what it writes before the node's reader matches: every
+    # counted sample must be sent after the match (then 0.5 s for the node's side of it)
+    wait_matched([speed_w, probe_w, point_w], timeout_s=30.0, who="load_peer")
+    time.sleep(0.5)
     out = {"sent_speeds": 0, "sent_probes": 0, "sent_points": 0, "malformed": 0, "journal": 0,
            "nonfinite": 0, "warnings": {}, "speed_after_malformed": None,
            "last_sent_speed": None, "last_journal_speed": None}
@@ -114,6 +119,9 @@ def main():
         tick += 1
         next_tick += 0.01
         time.sleep(max(0.0, next_tick - time.time()))
+    # the last samples may still be unacknowledged: wait for the node's acks before exiting
+    for w in (speed_w, probe_w, point_w):
+        w.wait_for_acks(duration(seconds=5))
     time.sleep(0.5)
     read(journal, warnings, out)
     print(json.dumps(out))

@@ -185,6 +185,9 @@ def main():
         read(one_x, warnings, out, t0)
         next_tick += 2.0 * math.pi / omega / 16
         time.sleep(max(0.0, t0 * 1e-9 + next_tick - time.time()))
+    # the last samples may still be unacknowledged (reliable writers): wait for the node's acks
+    for w in [kp_w, speed_w] + [w for w, _, _ in probe_w] + ([oil_w] if oil_w else []):
+        w.wait_for_acks(duration(seconds=5))
     time.sleep(1.0)
     read(one_x, warnings, out, t0)
     print(json.dumps(out))
