@@ -291,6 +291,8 @@ pub struct HeatFollower {
     film: FilmEvaluation,
     at_speed_rad_s: f64,
     scales: Vec<f64>,
+    /// each film's viscosity field (thermal-film heating; empty where uniform)
+    fields: Vec<Vec<f64>>,
     /// Balances after the first, their slowest and summed times (µs).
     balances: usize,
     slowest_us: f64,
@@ -313,6 +315,7 @@ impl HeatFollower {
             film,
             at_speed_rad_s: speed_rad_s,
             scales: vec![1.0; rotor.film_bearing_count()],
+            fields: Vec::new(),
             balances: 0,
             slowest_us: 0.0,
             total_us: 0.0,
@@ -340,6 +343,7 @@ impl HeatFollower {
         for (s, f) in self.scales.iter_mut().zip(films) {
             *s = f;
         }
+        self.fields = self.rotor.film_viscosity_fields();
         Ok(())
     }
 
@@ -350,7 +354,8 @@ impl HeatFollower {
             return Ok(());
         }
         self.balance(speed_rad_s)?;
-        twin.set_viscosity_scales(&self.scales)
+        twin.set_viscosity_scales(&self.scales)?;
+        twin.set_viscosity_fields(&self.fields)
     }
 
     /// Balances after the first.

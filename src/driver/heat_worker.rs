@@ -23,12 +23,21 @@ pub(super) struct HeatJob {
     pub speed_rad_s: f64,
 }
 
-/// One heated film bearing after a balance: (its index among the film bearings, T_eff K,
-/// µ(T_eff) / µ_reference).
-pub(super) type FilmHeat = (usize, f64, f64);
+/// One heated film bearing after a balance.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct FilmHeat {
+    /// Its index among the film bearings.
+    pub film: usize,
+    /// T_eff (K).
+    pub temperature_k: f64,
+    /// µ(T_eff) / µ_reference.
+    pub scale: f64,
+    /// The thermal film's viscosity field relative to µ(T_eff) (empty for Raimondi–Boyd's).
+    pub field: Vec<f64>,
+}
 
-/// Each heated film bearing's temperature and scale for `job` on `rotor` (whose heated
-/// bearings' scales it sets), the isoviscous film evaluated as `film` says: the balance the
+/// Each heated film bearing's temperature, scale and viscosity field for `job` on `rotor`
+/// (whose heated bearings' scales and fields it sets), the isoviscous film evaluated as `film` says: the balance the
 /// driver does, on its thread or on the worker's.
 pub(super) fn balance(
     rotor: &mut Rotor,
@@ -43,7 +52,12 @@ pub(super) fn balance(
                 .iter()
                 .filter(|b| matches!(b.model, crate::rotor::BearingModel::Film(_)))
                 .count();
-            (i, t.effective.effective_temperature_k, t.viscosity_scale)
+            FilmHeat {
+                film: i,
+                temperature_k: t.effective.effective_temperature_k,
+                scale: t.viscosity_scale,
+                field: t.effective.viscosity_field,
+            }
         })
         .collect())
 }

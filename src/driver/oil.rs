@@ -8,7 +8,7 @@
 //! [`HEAT_BALANCE_TEMPERATURE_STEP_K`] since the last one (and at the first speed). Between two
 //! balances each film keeps its scale; the step itself only reads the scale (allocates nothing).
 
-use super::heat_worker::{balance, HeatJob, HeatWorker};
+use super::heat_worker::{balance, FilmHeat, HeatJob, HeatWorker};
 use super::{inputs, Driver, Fed};
 
 /// The heat balance is redone when the speed has moved by more than this fraction since the
@@ -79,18 +79,18 @@ impl OilState {
 impl OilState {
     /// A finished heat balance counted and kept (a failure keeps the scales of the last good
     /// one in force, `push_oil_scales`); true when it succeeded.
-    fn take_balance(&mut self, result: Result<Vec<(usize, f64, f64)>, String>) -> bool {
+    fn take_balance(&mut self, result: &Result<Vec<FilmHeat>, String>) -> bool {
         self.balances += 1;
         match result {
             Ok(films) => {
-                for (i, t_k, scale) in films {
-                    self.heated[i] = Some((t_k, scale));
+                for f in films {
+                    self.heated[f.film] = Some((f.temperature_k, f.scale));
                 }
                 self.heating_error = None;
                 true
             }
             Err(e) => {
-                self.failed(e);
+                self.failed(e.clone());
                 false
             }
         }
@@ -228,7 +228,7 @@ impl Driver {
             return false;
         }
         let result = balance(&mut self.rotor, job, self.settings.twin.film);
-        self.oil.take_balance(result);
+        self.oil.take_balance(&result);
         true
     }
 
@@ -237,9 +237,16 @@ impl Driver {
         let Some(result) = self.oil.worker.as_mut().and_then(HeatWorker::finished) else {
             return;
         };
-        // the worker set the scales on its own copy of the machine: `push_oil_scales` sets them
-        // on this one
-        if self.oil.take_balance(result) {
+        // the worker set the scales and fields on its own copy of the machine: the fields are
+        // set on this one here, the scales by `push_oil_scales`
+        if let Ok(films) = &result {
+            let mut fields = self.rotor.film_viscosity_fields();
+            for f in films {
+                fields[f.film].clone_from(&f.field);
+            }
+            self.rotor.set_film_viscosity_fields(&fields);
+        }
+        if self.oil.take_balance(&result) {
             if let Err(why) = self.push_oil_scales() {
                 self.oil.failed(why);
             }
@@ -273,6 +280,16 @@ impl Driver {
             s.twin_mut()
                 .set_viscosity_scales(&self.oil.scales)
                 .map_err(|e| format!("oil temperature: {e}"))?;
+        }
+        // a thermal-film balance's viscosity fields (the finite film runs them; a table keeps
+        // its uniform scale)
+        if self.oil.heating {
+            let fields = self.rotor.film_viscosity_fields();
+            if let Some(s) = self.session.as_mut() {
+                s.twin_mut()
+                    .set_viscosity_fields(&fields)
+                    .map_err(|e| format!("oil heating: {e}"))?;
+            }
         }
         Ok(())
     }

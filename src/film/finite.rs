@@ -770,6 +770,10 @@ impl FilmModel for FiniteFilm {
         self.midplane_phi(out);
     }
 
+    fn set_viscosity_field(&mut self, ratio: &[f64]) -> Result<bool, FilmError> {
+        self.set_viscosity_ratio(ratio).map(|()| true)
+    }
+
     fn feed_angle_rad(&self) -> Option<f64> {
         let nt = self.grid.n_theta as f64;
         (self.feed_column).map(|i| i as f64 * std::f64::consts::TAU / nt)

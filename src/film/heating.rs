@@ -157,6 +157,10 @@ pub struct EffectiveTemperature {
     /// Evaluations of the film equilibrium the fixed point took (the thermal film: one a
     /// staggered pass, and the isoviscous one at µ(T_eff)).
     pub evaluations: usize,
+    /// The thermal film's viscosity around the bearing relative to µ(T_eff): µ(T_i)/µ(T̄) per
+    /// grid column, T_i its temperatures at the balance (empty for Raimondi–Boyd's, whose film
+    /// is isoviscous).
+    pub viscosity_field: Vec<f64>,
 }
 
 /// Largest number of film equilibria the fixed point may take.
@@ -334,6 +338,9 @@ fn isoviscous_at(
     let mu0 = thermal.reference_viscosity_pa_s();
     let (law, supply_k) = (thermal.oil().law, thermal.oil().supply_temperature_k);
     let mu = law.checked_viscosity_pa_s(t_k)?;
+    let viscosity_field = (thermal.temperature_k().iter())
+        .map(|&t| law.checked_viscosity_pa_s(t).map(|m| m / mu))
+        .collect::<Result<Vec<f64>, String>>()?;
     film.set_scale(mu / mu0).map_err(|e| e.to_string())?;
     let equilibrium = equilibrium_under_load(film, mu, load_n, speed_rad_s)
         .map_err(|e| format!("film equilibrium at the thermal film's mean {t_k:.2} K: {e}"))?;
@@ -347,6 +354,7 @@ fn isoviscous_at(
         heat_carried_w: s.heat_carried_w,
         equilibrium,
         evaluations: passes + 1,
+        viscosity_field,
     })
 }
 
@@ -375,5 +383,6 @@ fn done(
             * (f.inflow_m3_s - 0.5 * f.side_flow_m3_s),
         equilibrium,
         evaluations,
+        viscosity_field: Vec::new(),
     }
 }

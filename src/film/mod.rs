@@ -202,6 +202,14 @@ pub trait FilmModel {
         None
     }
 
+    /// Sets a viscosity field around the film: µ(ζ_i)/µ per grid column, relative to the
+    /// film's uniform viscosity (the thermal film's field, issue 18; an empty slice restores
+    /// the uniform film). Ok(false) where the film holds only a uniform viscosity (the tables,
+    /// the short film): it then runs at that viscosity. Err if the field does not fit the grid.
+    fn set_viscosity_field(&mut self, _ratio: &[f64]) -> Result<bool, FilmError> {
+        Ok(false)
+    }
+
     /// A film with memory (mass-conserving cavitation, issue 18): the next solves belong to a
     /// time step of `step_s` (s) that starts from the last committed state. No-op otherwise.
     fn begin_step(&mut self, _step_s: f64) {}

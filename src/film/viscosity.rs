@@ -445,6 +445,10 @@ impl FilmModel for ViscosityScaledFilm {
         self.inner.feed_angle_rad()
     }
 
+    fn set_viscosity_field(&mut self, ratio: &[f64]) -> Result<bool, FilmError> {
+        self.inner.set_viscosity_field(ratio)
+    }
+
     fn begin_step(&mut self, step_s: f64) {
         self.inner.begin_step(step_s);
     }

@@ -95,6 +95,11 @@ pub struct FilmBearing {
     /// The films are solved (and tabulated) at `lubricant` and scaled: exact for the isoviscous
     /// film without supply pressure ([`crate::film::ViscosityScaledFilm`]).
     pub viscosity_scale: f64,
+    /// The viscosity around the bearing relative to the scale's, µ(T_i)/µ(T̄) per grid column,
+    /// from the last thermal-film heat balance (`oil_heating: {model: thermal_film}`; empty:
+    /// uniform). The finite film runs with it ([`FilmBearing::fielded`]), a table at the
+    /// uniform scale.
+    pub viscosity_field: Vec<f64>,
     /// The film's fluid inertia (added mass), if the bearing carries it.
     pub inertia: Option<crate::film::FilmInertia>,
     /// Laminar, turbulent or auto (finite model; `src/film/turbulence.rs`).
@@ -148,9 +153,22 @@ impl FilmBearing {
         crate::film::equilibrium_with_inertia(s, self.inertia, mu, load, speed_rad_s)
     }
 
-    /// A film solver at the running viscosity (each user owns one: it carries the warm start).
+    /// A film solver at the running viscosity (each user owns one: it carries the warm start),
+    /// with the bearing's viscosity field where it has one.
     pub fn solver(&self) -> Box<dyn FilmModel + Send> {
-        Box::new(self.scaled(self.reference_solver()))
+        Box::new(self.fielded(self.reference_solver()))
+    }
+
+    /// [`scaled`](Self::scaled), and with the bearing's viscosity field (`viscosity_field`, set
+    /// by a thermal-film heat balance) where `inner` can hold one (the finite film; a table
+    /// runs at the uniform scale) and the field fits its grid.
+    pub fn fielded(&self, inner: Box<dyn FilmModel + Send>) -> crate::film::ViscosityScaledFilm {
+        let mut film = self.scaled(inner);
+        if self.viscosity_field.len() == self.grid.n_theta {
+            // fits the grid, each ratio positive (from the law): cannot fail
+            let _ = film.set_viscosity_field(&self.viscosity_field);
+        }
+        film
     }
 
     /// `inner` (solved at the reference viscosity) scaled to the running one.
@@ -620,6 +638,7 @@ fn bearing_model(b: &BearingSpec, rated_speed_rad_s: f64) -> BearingModel {
                 design_supply_temperature_k: f.design_supply_temperature_k,
                 heating: f.heating,
                 viscosity_scale: 1.0,
+                viscosity_field: Vec::new(),
                 inertia: fluid_inertia(&f.geometry, &f.lubricant, f.fluid_inertia),
                 flow: f.flow,
                 cavitation: crate::film::Cavitation::Reynolds,

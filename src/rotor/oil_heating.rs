@@ -24,6 +24,35 @@ pub struct BearingTemperature {
 }
 
 impl Rotor {
+    /// Each film bearing's viscosity field (in the order of the film bearings; empty where
+    /// uniform): what [`crate::dynamics::Twin::set_viscosity_fields`] takes.
+    pub fn film_viscosity_fields(&self) -> Vec<Vec<f64>> {
+        self.film_bearings()
+            .map(|f| f.viscosity_field.clone())
+            .collect()
+    }
+
+    /// Sets each film bearing's viscosity field, `fields` in the order of the film bearings
+    /// (as [`film_viscosity_fields`](Self::film_viscosity_fields) gives them; the extra or
+    /// missing ones ignored).
+    pub fn set_film_viscosity_fields(&mut self, fields: &[Vec<f64>]) {
+        let films = self.bearings.iter_mut().filter_map(|b| match &mut b.model {
+            BearingModel::Film(f) => Some(f),
+            _ => None,
+        });
+        for (f, field) in films.zip(fields) {
+            f.viscosity_field.clone_from(field);
+        }
+    }
+
+    /// The film bearings, in order.
+    fn film_bearings(&self) -> impl Iterator<Item = &FilmBearing> {
+        self.bearings.iter().filter_map(|b| match &b.model {
+            BearingModel::Film(f) => Some(f),
+            _ => None,
+        })
+    }
+
     /// Whether any film bearing models its own heating.
     pub fn has_oil_heating(&self) -> bool {
         self.bearings
@@ -78,6 +107,7 @@ impl Rotor {
                 crate::film::check_viscosity_scale(effective.viscosity_pa_s / mu_ref * correction)
                     .map_err(|e| format!("bearing {}: {e}", b.name))?;
             f.viscosity_scale = scale;
+            f.viscosity_field.clone_from(&effective.viscosity_field);
             out.push(BearingTemperature {
                 bearing: i,
                 name: b.name.clone(),

@@ -254,6 +254,30 @@ impl Twin {
         Ok(())
     }
 
+    /// Sets each film's viscosity field (µ_i/µ per grid column relative to its scale; an empty
+    /// field: uniform), `fields` in the order of the film bearings, as a thermal-film heat
+    /// balance finds them ([`crate::rotor::FilmBearing::viscosity_field`]). A film that holds
+    /// only a uniform viscosity (a table) keeps it. Next step; the linear coupling is
+    /// re-linearised at once.
+    pub fn set_viscosity_fields(&mut self, fields: &[Vec<f64>]) -> Result<(), TwinError> {
+        if fields.len() != self.links.len() {
+            return Err(TwinError::InvalidInput {
+                name: "viscosity fields (one per film bearing)",
+                value: fields.len() as f64,
+                rule: "must give one field per film bearing",
+            });
+        }
+        for (l, f) in self.links.iter_mut().zip(fields) {
+            l.film
+                .set_viscosity_field(f)
+                .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", l.name)))?;
+        }
+        if self.config.coupling == crate::dynamics::Coupling::Linear {
+            self.relinearise_films(self.state.speed_rad_s);
+        }
+        Ok(())
+    }
+
     /// The viscosity scale of film `i` (in the order of the film bearings), if it exists.
     pub fn film_viscosity_scale(&self, i: usize) -> Option<f64> {
         self.links.get(i).map(|l| l.film.scale())

@@ -235,7 +235,7 @@ fn film_links(
             clearance_m: f.geometry.radial_clearance_m,
             radius_m: f.geometry.radius_m(),
             viscosity_pa_s: f.lubricant.viscosity_pa_s,
-            film: f.scaled(film),
+            film: f.fielded(film),
             linear_reference: None,
             previous_raw: None,
             inertia: f.inertia,
