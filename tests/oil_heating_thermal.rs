@@ -116,9 +116,9 @@ fn thermal_heating_carries_the_thermal_films_threshold() {
 
 /// At 9,000 rpm: T̄ is the coupled thermal film's own flow-weighted mean (`thermal_equilibria`,
 /// Newton on the coupled film: a second solution method, 1e-6 K), the heat carried equals its
-/// dissipation (conservation, 1e-5), and
-/// the isoviscous film at µ(T̄) the twin runs sits within 1 % of the thermal film's own ε
-/// (the route's approximation of the position: printed).
+/// dissipation (conservation, 1e-5), and the film the twin runs — at µ(T̄) with the thermal
+/// film's viscosity field around it (session 20; the mean alone sat +0.5 % off) — sits at the
+/// thermal film's own ε within 1e-4.
 #[test]
 fn the_heated_films_against_their_thermal_films_at_rated_speed() {
     let default = Rotor::from_description(&MachineDescription::load(None).unwrap());
@@ -136,7 +136,7 @@ fn the_heated_films_against_their_thermal_films_at_rated_speed() {
         let e = &t.effective;
         let eps = e.equilibrium.eccentricity_ratio;
         println!(
-            "{}: T̄ {:.4} °C (reference {:.4}), inlet {:.2}, peak {:.2} °C; heat {:.3} W, full-film friction {:.3} W; ε at µ(T̄) {eps:.4}, thermal film's {:.4} ({:+.2} %)",
+            "{}: T̄ {:.4} °C (reference {:.4}), inlet {:.2}, peak {:.2} °C; heat {:.3} W, full-film friction {:.3} W; ε of the twin's film (µ(T̄), the field) {eps:.6}, thermal film's {:.6} ({:+.4} %)",
             t.name,
             e.effective_temperature_k - ZERO_CELSIUS_K,
             r.state.mean_temperature_k - ZERO_CELSIUS_K,
@@ -155,7 +155,7 @@ fn the_heated_films_against_their_thermal_films_at_rated_speed() {
         assert!(e.friction_power_w == e.equilibrium.film.power_loss_w.abs());
         assert!(e.friction_power_w > e.heat_carried_w);
         assert!(
-            rel(eps, r.eccentricity_ratio) < 0.01,
+            rel(eps, r.eccentricity_ratio) < 1e-4,
             "{eps} vs {}",
             r.eccentricity_ratio
         );
@@ -187,12 +187,17 @@ fn the_direct_twin_starts_at_the_thermal_films_equilibrium() {
     let mut uniform = rotor.clone();
     uniform.set_film_viscosity_fields(&[Vec::new(), Vec::new()]);
     let uniform = Twin::new(&uniform, config, w).unwrap();
+    let means = uniform.output().bearings.clone();
     let bearings = &twin.output().bearings;
-    for (((b, r), t), field) in bearings.iter().zip(&reference).zip(&temps).zip(&fields) {
+    for ((((b, r), t), field), m) in (bearings.iter().zip(&reference))
+        .zip(&temps)
+        .zip(&fields)
+        .zip(&means)
+    {
         let (lo, hi) = field
             .iter()
             .fold((f64::MAX, 0.0_f64), |(l, h), &v| (l.min(v), h.max(v)));
-        let mean_eps = t.effective.equilibrium.eccentricity_ratio;
+        let mean_eps = m.eccentricity_ratio;
         println!(
             "{}: field µ/µ(T̄) {lo:.4}…{hi:.4} over {} columns; twin's start ε {:.6}, thermal film's {:.6} ({:+.4} %); the mean's isoviscous film {mean_eps:.6} ({:+.3} %)",
             r.bearing,
@@ -206,14 +211,13 @@ fn the_direct_twin_starts_at_the_thermal_films_equilibrium() {
         // the oil heats along the film (µ down to −3 %) and re-forms cooler (+3 %)
         assert!(lo < 0.98 && hi > 1.02, "{lo}…{hi}");
         assert!(rel(b.eccentricity_ratio, r.eccentricity_ratio) < 1e-4);
+        // the balance reports the film the twin runs
+        let reported = t.effective.equilibrium.eccentricity_ratio;
+        assert!(rel(reported, b.eccentricity_ratio) < 1e-6);
         assert!(
             rel(mean_eps, r.eccentricity_ratio) > 2e-3,
             "the mean alone is off"
         );
-    }
-    for (b, t) in uniform.output().bearings.iter().zip(&temps) {
-        let mean_eps = t.effective.equilibrium.eccentricity_ratio;
-        assert!(rel(b.eccentricity_ratio, mean_eps) < 1e-6);
     }
     // on the table the same machine runs the mean (a table holds a uniform viscosity)
     use_test_table_cache();
@@ -222,8 +226,8 @@ fn the_direct_twin_starts_at_the_thermal_films_equilibrium() {
         ..config
     };
     let twin = Twin::new(&rotor, table, w).unwrap();
-    for (b, t) in twin.output().bearings.iter().zip(&temps) {
-        let mean_eps = t.effective.equilibrium.eccentricity_ratio;
+    for (b, m) in twin.output().bearings.iter().zip(&means) {
+        let mean_eps = m.eccentricity_ratio;
         assert!(
             rel(b.eccentricity_ratio, mean_eps) < 2e-3,
             "{} vs {mean_eps}",

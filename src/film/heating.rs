@@ -152,7 +152,9 @@ pub struct EffectiveTemperature {
     /// the thermal film's, equal to its own dissipation (shear in the ruptured zone in its
     /// streamers only, E2), below the full-film friction.
     pub heat_carried_w: f64,
-    /// The static equilibrium at µ(T_eff) (the isoviscous film, as the twin runs it).
+    /// The static equilibrium at µ(T_eff), of the film as the twin runs it: isoviscous for
+    /// Raimondi–Boyd's and on a table, with the thermal film's viscosity field on the finite
+    /// film.
     pub equilibrium: Equilibrium,
     /// Evaluations of the film equilibrium the fixed point took (the thermal film: one a
     /// staggered pass, and the isoviscous one at µ(T_eff)).
@@ -323,9 +325,10 @@ pub fn thermal_film_temperature(
     ))
 }
 
-/// The isoviscous `film` at µ(`t_k`), `t_k` the mean temperature of `thermal`'s last solves,
-/// and its equilibrium: the [`EffectiveTemperature`] of [`thermal_film_temperature`] after
-/// `passes`.
+/// `film` at µ(`t_k`), `t_k` the mean temperature of `thermal`'s last solves, with the thermal
+/// film's viscosity field around it where `film` can hold one (the finite film; a table runs
+/// the uniform µ(`t_k`)), and its equilibrium — the film as the twin runs it: the
+/// [`EffectiveTemperature`] of [`thermal_film_temperature`] after `passes`.
 fn isoviscous_at(
     t_k: f64,
     thermal: &ThermalFilm,
@@ -342,6 +345,8 @@ fn isoviscous_at(
         .map(|&t| law.checked_viscosity_pa_s(t).map(|m| m / mu))
         .collect::<Result<Vec<f64>, String>>()?;
     film.set_scale(mu / mu0).map_err(|e| e.to_string())?;
+    film.set_viscosity_field(&viscosity_field)
+        .map_err(|e| e.to_string())?;
     let equilibrium = equilibrium_under_load(film, mu, load_n, speed_rad_s)
         .map_err(|e| format!("film equilibrium at the thermal film's mean {t_k:.2} K: {e}"))?;
     Ok(EffectiveTemperature {
