@@ -694,7 +694,11 @@ fn free_whirl_growth(
     kick: f64,
     revs: usize,
 ) -> (f64, f64, f64) {
-    let per_rev = 128;
+    // steps a revolution: 128, or `MCAV_ONSET_STEPS` (the step convergence of the onset)
+    let per_rev: usize = std::env::var("MCAV_ONSET_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(128);
     let mut rotor = onset_machine();
     rotor.unbalance.clear();
     rotor.set_cavitation(cav).unwrap();

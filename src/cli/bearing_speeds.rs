@@ -423,45 +423,56 @@ pub(crate) fn print_table(r: &SweepReport) -> anyhow::Result<()> {
         "cyx",
         "cyy"
     );
+    // the rows and the failed speeds in speed order
+    let mut failed = r.failed.iter().peekable();
     for s in &r.speeds {
-        // xx, xy, yx, yy: the transpose's column-major order is the matrix's row order
-        let flat = |a: Matrix2<f64>, unit: f64| a.transpose() * unit;
-        let (k, c) = (
-            flat(s.stiffness_n_per_m, 1e-6),
-            flat(s.damping_n_s_per_m, 1e-3),
-        );
-        outln!(
-            "  {:>7.0} {:>8.4} {:>6.4} {:>6.2} | {:>8.3} {:>8.3} {:>8.3} {:>8.3}      | {:>7.3} \
-             {:>7.3} {:>7.3} {:>7.3}",
-            s.speed_rpm,
-            s.sommerfeld_number,
-            s.eccentricity_ratio,
-            s.attitude_angle_deg,
-            k[0],
-            k[1],
-            k[2],
-            k[3],
-            c[0],
-            c[1],
-            c[2],
-            c[3]
-        );
-        if let (Some(t), Some(dt), Some(mu), Some(b)) = (
-            s.effective_temperature_c,
-            s.temperature_rise_k,
-            s.effective_viscosity_pa_s,
-            s.heat_balance,
-        ) {
-            outln!(
-                "          {} {t:.2} °C ({} {dt:.2} K), µ_eff {:.4} mPa·s",
-                b.temperature_label(),
-                b.rise_label(),
-                mu * 1e3
-            );
+        while let Some(f) = failed.next_if(|f| f.speed_rpm < s.speed_rpm) {
+            outln!("  {:>7.0}  no equilibrium: {}", f.speed_rpm, f.error);
         }
+        print_row(s)?;
     }
-    for f in &r.failed {
+    for f in failed {
         outln!("  {:>7.0}  no equilibrium: {}", f.speed_rpm, f.error);
+    }
+    Ok(())
+}
+
+/// One speed's line (and its temperature's, when heated) of [`print_table`].
+fn print_row(s: &SpeedRow) -> anyhow::Result<()> {
+    // xx, xy, yx, yy: the transpose's column-major order is the matrix's row order
+    let flat = |a: Matrix2<f64>, unit: f64| a.transpose() * unit;
+    let (k, c) = (
+        flat(s.stiffness_n_per_m, 1e-6),
+        flat(s.damping_n_s_per_m, 1e-3),
+    );
+    outln!(
+        "  {:>7.0} {:>8.4} {:>6.4} {:>6.2} | {:>8.3} {:>8.3} {:>8.3} {:>8.3}      | {:>7.3} \
+         {:>7.3} {:>7.3} {:>7.3}",
+        s.speed_rpm,
+        s.sommerfeld_number,
+        s.eccentricity_ratio,
+        s.attitude_angle_deg,
+        k[0],
+        k[1],
+        k[2],
+        k[3],
+        c[0],
+        c[1],
+        c[2],
+        c[3]
+    );
+    if let (Some(t), Some(dt), Some(mu), Some(b)) = (
+        s.effective_temperature_c,
+        s.temperature_rise_k,
+        s.effective_viscosity_pa_s,
+        s.heat_balance,
+    ) {
+        outln!(
+            "          {} {t:.2} °C ({} {dt:.2} K), µ_eff {:.4} mPa·s",
+            b.temperature_label(),
+            b.rise_label(),
+            mu * 1e3
+        );
     }
     Ok(())
 }

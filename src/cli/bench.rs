@@ -49,12 +49,13 @@ pub struct BenchArgs {
     whip: bool,
     /// ORC-9000: ramp the speed at this rate (rpm/s) from 9,000 rpm while measuring, so that
     /// the step's factor is renewed every 0.2 % of speed (the worst step shows its cost).
+    /// wakes: the ramp's rate from 8,000 rpm (default 400).
     #[arg(long)]
     ramp_rpm_s: Option<f64>,
     /// Seconds to spend on each measured case.
     #[arg(long, default_value_t = 2.0)]
     seconds: f64,
-    /// ORC-9000 and factor: the machine description (YAML) instead of the built-in one (e.g.
+    /// ORC-9000, factor and wakes: the machine description (YAML) instead of the built-in one (e.g.
     /// reading (A) of the seed, `config/orc_microturbine_100kw_d55.yaml`, whose whip runs on
     /// the wall), at the same 9,000 rpm and 128 steps a revolution.
     #[arg(long)]
@@ -96,7 +97,7 @@ struct CaseFigures {
 pub(crate) fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(
         args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 600.0,
-        "--seconds {} must be between 0 and 600",
+        "--seconds {} must be above 0 and at most 600",
         args.seconds
     );
     check_steps(args.steps)?;
@@ -380,6 +381,14 @@ fn wakes_case(args: &BenchArgs) -> anyhow::Result<()> {
         rpm_per_s: args.ramp_rpm_s.unwrap_or(400.0),
         seconds: args.seconds,
     };
+    wakes::check(&rotor, ramp)?;
+    if !rotor.has_oil_heating() {
+        eprintln!(
+            "bench wakes: this machine has no oil_heating: the two runs do the same work (give \
+             --config config/orc_microturbine_100kw_thermal.yaml to see a balance's cost)"
+        );
+    }
+    eprintln!("bench wakes: the node's tabulated film (built or read from the cache first), twice");
     let figures = [false, true]
         .into_iter()
         .map(|off| wakes::run(&rotor, ramp, off))
@@ -400,6 +409,9 @@ fn wakes_case(args: &BenchArgs) -> anyhow::Result<()> {
             "  balances on the {:<14} wake median {:>7.1} µs  p99 {:>7.1} µs  slowest {:>8.1} µs  late {:>4} of {}  ({} balances, {} failed)",
             f.heat_balance, f.median_us, f.p99_us, f.max_us, f.late_wakes, f.wakes, f.balances, f.failures
         );
+        if let Some(why) = &f.last_failure {
+            outln!("    the last failed balance: {why}");
+        }
     }
     Ok(())
 }

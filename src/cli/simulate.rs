@@ -589,7 +589,7 @@ pub(crate) fn run_simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.history_csv {
         super::check_output("--history-csv", path, super::Output::File)?;
     }
-    note_heating(&rotor);
+    note_heating(&rotor, spec.film);
     let result = run_driven(&rotor, &spec, None, &drive).context("transient")?;
     if let Some(dir) = &args.plot {
         write_plots(dir, &result)
@@ -684,13 +684,31 @@ fn write_history_csv(path: &Path, r: &TransientResult) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// With `oil_heating`, says (on stderr) that the run heats its films as the node does.
-fn note_heating(rotor: &Rotor) {
-    if rotor.has_oil_heating() {
+/// With `oil_heating`, says (on stderr) that the run heats its films as the node does, and
+/// with the thermal film, what the `film` evaluation runs of its field.
+fn note_heating(rotor: &Rotor, film: crate::dynamics::FilmEvaluation) {
+    if !rotor.has_oil_heating() {
+        return;
+    }
+    eprintln!(
+        "oil_heating: each film runs at its heat balance's viscosity (the machine file's supply \
+         temperature), redone past {} % of speed, as the node does",
+        100.0 * crate::driver::HEAT_BALANCE_SPEED_STEP
+    );
+    let thermal = rotor.bearings.iter().any(|b| {
+        matches!(&b.model, crate::rotor::BearingModel::Film(f)
+            if f.heating.is_some_and(|h| h.balance == crate::film::HeatBalance::ThermalFilm))
+    });
+    if thermal {
         eprintln!(
-            "oil_heating: each film runs at its heat balance's viscosity (the machine file's supply \
-             temperature), redone past {} % of speed, as the node does",
-            100.0 * crate::driver::HEAT_BALANCE_SPEED_STEP
+            "  thermal_film: {}",
+            match film {
+                crate::dynamics::FilmEvaluation::Direct =>
+                    "the direct film runs the thermal film's viscosity field around each bearing",
+                crate::dynamics::FilmEvaluation::Table =>
+                    "the table runs the thermal film's mean temperature (a table holds a uniform \
+                     viscosity; --film direct runs its field)",
+            }
         );
     }
 }
@@ -821,7 +839,7 @@ pub(crate) fn run_sweep(args: &SweepArgs) -> anyhow::Result<()> {
     let speeds = sweep_speeds(args)?;
     let (desc, rotor) = args.options.machine()?;
     check_sweep_first(args, &rotor)?;
-    note_heating(&rotor);
+    note_heating(&rotor, args.options.film.into());
     let specs = speeds
         .iter()
         .map(|&s| args.options.spec(s, &rotor))

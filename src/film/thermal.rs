@@ -183,7 +183,8 @@ impl ThermalFilm {
             let mu = self.oil.law.checked_viscosity_pa_s(t).map_err(|_| {
                 FilmError::InvalidParameter {
                     name: "thermal film temperature (°C) of a column (the hottest, not the mean)",
-                    value: t - super::ZERO_CELSIUS_K,
+                    // to 0.001 K: the figure a reader compares with the law's range
+                    value: ((t - super::ZERO_CELSIUS_K) * 1000.0).round() / 1000.0,
                     rule: "must lie within the viscosity law's range (the machine file's valid_range_c, \
                            within the table's span): the film heats its oil past the supply \
                            temperature, so the law must reach above it by the film's rise; extend \

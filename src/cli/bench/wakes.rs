@@ -32,6 +32,8 @@ pub struct WakeFigures {
     /// Heat balances done over the run (settling included), and those that failed.
     pub balances: u64,
     pub failures: u64,
+    /// Why the last failed balance failed (None without one).
+    pub last_failure: Option<String>,
 }
 
 /// The ramp: from `from_rpm` at `rpm_per_s` for `seconds` (after [`SETTLE_S`] at `from_rpm`).
@@ -40,6 +42,34 @@ pub struct Ramp {
     pub from_rpm: f64,
     pub rpm_per_s: f64,
     pub seconds: f64,
+}
+
+/// The shortest ramp measured (s): five wakes.
+pub const MIN_SECONDS: f64 = 5.0 * WAKE_PERIOD_NS as f64 * 1e-9;
+
+/// Err naming the option and the value when `ramp` cannot run on `rotor`: too short, a rate
+/// that is not a positive finite number, or an end past the machine's top speed.
+pub fn check(rotor: &Rotor, ramp: Ramp) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        ramp.seconds >= MIN_SECONDS,
+        "--seconds {}: bench wakes measures at least {MIN_SECONDS} s (five wakes of 2 ms)",
+        ramp.seconds
+    );
+    anyhow::ensure!(
+        ramp.rpm_per_s.is_finite() && ramp.rpm_per_s > 0.0,
+        "--ramp-rpm-s {}: the ramp's rate must be a positive number of rpm/s",
+        ramp.rpm_per_s
+    );
+    let top_rpm = crate::units::rad_s_to_rpm(crate::driver::InputLimits::of(rotor).max_speed_rad_s);
+    let end_rpm = ramp.from_rpm + ramp.rpm_per_s * ramp.seconds;
+    anyhow::ensure!(
+        end_rpm <= top_rpm,
+        "--ramp-rpm-s {} for --seconds {} ends at {end_rpm:.0} rpm, past the machine's top speed \
+         {top_rpm:.0} rpm (the node refuses faster speeds)",
+        ramp.rpm_per_s,
+        ramp.seconds
+    );
+    Ok(())
 }
 
 /// Runs `ramp` on a twin of `rotor` with the balances off the model thread or on it.
@@ -74,6 +104,7 @@ pub fn run(rotor: &Rotor, ramp: Ramp, off_thread: bool) -> anyhow::Result<WakeFi
         }
     }
     anyhow::ensure!(driver.session().is_some(), "the twin did not run");
+    anyhow::ensure!(!samples.is_empty(), "no wake measured");
     samples.sort_by(f64::total_cmp);
     let at = |q: f64| samples[((samples.len() - 1) as f64 * q).round() as usize];
     let period_us = WAKE_PERIOD_NS as f64 * 1e-3;
@@ -90,5 +121,6 @@ pub fn run(rotor: &Rotor, ramp: Ramp, off_thread: bool) -> anyhow::Result<WakeFi
         late_wakes: samples.iter().filter(|&&s| s > period_us).count(),
         balances: driver.heat_balances().0,
         failures: driver.heat_balance_failures(),
+        last_failure: driver.heat_balance_report().and_then(|r| r.last_failure),
     })
 }
