@@ -57,6 +57,14 @@ fn the_shipped_thermal_file_is_the_default_with_its_heating() {
     assert_eq!(THERMAL_YAML.matches("model: thermal_film").count(), 2);
 }
 
+/// Each film bearing of the built-in machine as its coupled thermal film (Newton on the film
+/// and its field together, `thermal_equilibria`) at `rpm`, supply 40 °C: the reference.
+fn coupled_thermal_films_at(rpm: f64) -> Vec<rotor_twin::rotor::ThermalBearing> {
+    let default = Rotor::from_description(&MachineDescription::load(None).unwrap());
+    let statics = static_solution(&default).unwrap();
+    thermal_equilibria(&default, &statics, rpm, &oils(&default, 40.0)).unwrap()
+}
+
 /// The threshold with each film's full thermal field, its eight coefficients taken with the
 /// field held (`stability_threshold_thermal`, 9,363.3 rpm on (B), README "Thermal film"), met
 /// by the twin's route: the balance at the threshold speed, found as `modes` finds it (a fixed
@@ -121,9 +129,7 @@ fn thermal_heating_carries_the_thermal_films_threshold() {
 /// thermal film's own ε within 1e-4.
 #[test]
 fn the_heated_films_against_their_thermal_films_at_rated_speed() {
-    let default = Rotor::from_description(&MachineDescription::load(None).unwrap());
-    let statics = static_solution(&default).unwrap();
-    let reference = thermal_equilibria(&default, &statics, 9000.0, &oils(&default, 40.0)).unwrap();
+    let reference = coupled_thermal_films_at(9000.0);
     let mut rotor = thermal_rotor();
     let started = std::time::Instant::now();
     let temps = rotor.heat_films(None, rad_s(9000.0), 1.0).unwrap();
@@ -172,9 +178,7 @@ fn the_heated_films_against_their_thermal_films_at_rated_speed() {
 #[test]
 fn the_direct_twin_starts_at_the_thermal_films_equilibrium() {
     use rotor_twin::dynamics::{Coupling, Twin, TwinConfig};
-    let default = Rotor::from_description(&MachineDescription::load(None).unwrap());
-    let statics = static_solution(&default).unwrap();
-    let reference = thermal_equilibria(&default, &statics, 9000.0, &oils(&default, 40.0)).unwrap();
+    let reference = coupled_thermal_films_at(9000.0);
     let mut rotor = thermal_rotor();
     // no unbalance: the twin starts at the static equilibrium alone
     rotor.unbalance.clear();
