@@ -122,15 +122,20 @@ fn bad_flags_are_named() {
 #[test]
 fn mass_conserving_cavitation_is_a_flag_and_the_default_is_unchanged() {
     // issue 18: the JFO film of the default bearing (fed at its widest gap) against the
-    // Reynolds condition, the default; measured ε 0.5323 vs 0.5328, p_max −0.3 %
+    // Reynolds condition, the default; measured ε 0.5323 vs 0.5328, p_max −0.3 %. Its friction
+    // shears only the streamers of the ruptured zone (φ-weighted, session 20; checked against
+    // the thermal film's streamer count in `film::thermal`), the Reynolds film's the full film
+    // (Raimondi–Boyd's convention): measured 91.0 vs 109.1 W (−17 %)
     let re = json(&["bearing", "--json"]);
     let jfo = json(&["bearing", "--json", "--cavitation", "mass-conserving"]);
     assert_eq!(re["cavitation"], "reynolds");
     assert_eq!(jfo["cavitation"], "mass-conserving");
-    for key in ["eccentricity_ratio", "max_pressure_pa", "power_loss_w"] {
-        let (a, b) = (re[key].as_f64().unwrap(), jfo[key].as_f64().unwrap());
-        assert!((b / a - 1.0).abs() < 0.01, "{key}: {b} vs {a}");
+    let ratio = |key: &str| jfo[key].as_f64().unwrap() / re[key].as_f64().unwrap();
+    for key in ["eccentricity_ratio", "max_pressure_pa"] {
+        assert!((ratio(key) - 1.0).abs() < 0.01, "{key}: {}", ratio(key));
     }
+    let power = ratio("power_loss_w");
+    assert!((0.78..0.88).contains(&power), "power loss ratio {power}");
     let (ok, _, err) = run_cli(&[
         "bearing",
         "--model",

@@ -112,6 +112,8 @@ impl FiniteFilm {
 
     /// Friction torque on the journal (N·m): Couette shear µωR/h over the full 360° (the
     /// Raimondi–Boyd convention) plus the pressure-flow shear (h/2R) ∂p/∂θ where the film is whole.
+    /// A mass-conserving film shears only its streamers in the ruptured zone: there the Couette
+    /// shear is weighted by the fluid fraction φ (issue 18; 1 with the Reynolds condition).
     fn friction_torque(&self, speed_rad_s: f64) -> f64 {
         let (nt, nz) = (self.grid.n_theta, self.grid.n_z);
         let r = self.geometry.radius_m();
@@ -124,7 +126,7 @@ impl FiniteFilm {
             .h_node
             .iter()
             .enumerate()
-            .map(|(i, &h)| ratio(i) * self.factors.couette_shear(h) / h)
+            .map(|(i, &h)| ratio(i) * self.factors.couette_shear(h) / h * self.sheared_share(i))
             .sum();
         let couette =
             mu * speed_rad_s * r.powi(3) * self.geometry.length_m / c * inverse_h * self.dtheta;
@@ -139,6 +141,22 @@ impl FiniteFilm {
             poiseuille += self.row_width(j) * row;
         }
         couette + r * r * c * self.pressure_scale * poiseuille
+    }
+
+    /// The share of column `i` that the journal shears: 1 with the Reynolds condition (the
+    /// full-film convention), the width-weighted mean fluid fraction φ of the column for a
+    /// mass-conserving film (its streamers, φ < 1 in the ruptured zone).
+    fn sheared_share(&self, i: usize) -> f64 {
+        if self.cavitation != crate::film::Cavitation::MassConserving {
+            return 1.0;
+        }
+        let nz = self.grid.n_z;
+        let (mut sum, mut width) = (0.0, 0.0);
+        for j in 0..nz {
+            sum += self.row_width(j) * self.phi[i * nz + j];
+            width += self.row_width(j);
+        }
+        sum / width
     }
 
     /// Flow out of both bearing ends (m³/s): the finite-volume flux through the edge faces.
