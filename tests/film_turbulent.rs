@@ -119,22 +119,64 @@ fn turbulent_short_limit_matches_the_ng_pan_short_bearing() {
     }
 }
 
-/// `flow: turbulent` in the machine file reaches the film; a viscosity scale (Re changes with µ)
-/// is refused by name; a short-bearing entry with turbulent flow is refused. (The table takes
-/// turbulent flow since session 12, over (ε, ψ, Re): `tests/film_turbulent_table.rs`.)
+/// `flow: turbulent` in the machine file reaches the film, and a viscosity scale (a live oil
+/// temperature, a heat balance, a calibration) is exact for it: the scaled film takes its
+/// Reynolds number at the scaled viscosity (session 20; it was refused before, since Re = ρωRc/µ
+/// changes with µ). Reference: a turbulent film built with the scaled viscosity itself, to
+/// 1e-10 in force, power and the eight coefficients, at ×0.8 and ×1.1; scaling the outputs with
+/// Re held at the file's µ (the naive scaling) would be off by more than 0.5 % (printed). A
+/// short-bearing entry with turbulent flow is refused. (The table takes turbulent flow since
+/// session 12, over (ε, ψ, Re): `tests/film_turbulent_table.rs`.)
 #[test]
-fn turbulent_machine_files_refuse_viscosity_scaling_and_the_short_model() {
+fn turbulent_films_scale_with_viscosity_through_their_reynolds_number() {
     use rotor_twin::rotor::{BearingModel, MachineDescription, Rotor};
     let text = std::fs::read_to_string("config/orc_microturbine_100kw.yaml").unwrap();
     let turbulent = text.replace("    grid: 60x10", "    grid: 60x10\n    flow: turbulent");
     let desc = MachineDescription::from_yaml(&turbulent, "t.yaml").unwrap();
     let mut rotor = Rotor::from_description(&desc);
-    let BearingModel::Film(f) = &rotor.bearings[0].model else {
-        panic!("film bearing expected")
-    };
-    assert_eq!(f.flow, FlowRegime::Turbulent);
-    let err = rotor.set_viscosity_scale(1.1).unwrap_err().to_string();
-    assert!(err.contains("turbulent"), "{err}");
+    let grid = FilmGrid::new(60, 10).unwrap();
+    let k = kin(0.6, -0.9, 9000.0, [2e-3, -1e-3]);
+    for scale in [0.8, 1.1] {
+        rotor.set_viscosity_scale(scale).unwrap();
+        let BearingModel::Film(f) = &rotor.bearings[0].model else {
+            panic!("film bearing expected")
+        };
+        assert_eq!(f.flow, FlowRegime::Turbulent);
+        let (a, ca) = f.solver().solve_with_coefficients(&k).unwrap();
+        let g = f.geometry.clone();
+        let oil = Lubricant::new(
+            f.lubricant.density_kg_m3,
+            f.lubricant.viscosity_pa_s * scale,
+        );
+        let mut exact = FiniteFilm::new(g.clone(), oil.unwrap(), grid)
+            .unwrap()
+            .with_flow(FlowRegime::Turbulent);
+        let (b, cb) = exact.solve_with_coefficients(&k).unwrap();
+        let mut naive = FiniteFilm::new(g, f.lubricant, grid)
+            .unwrap()
+            .with_flow(FlowRegime::Turbulent);
+        let n = naive.solve(&k).unwrap();
+        let size = b.force_n[0].hypot(b.force_n[1]);
+        let naive_off =
+            (n.force_n[0] * scale - b.force_n[0]).hypot(n.force_n[1] * scale - b.force_n[1]) / size;
+        println!(
+            "×{scale}: scaled {:?} N, exact {:?} N; naive scaling off by {:.2} %",
+            a.force_n,
+            b.force_n,
+            100.0 * naive_off
+        );
+        for i in 0..2 {
+            assert!((a.force_n[i] - b.force_n[i]).abs() < 1e-10 * size);
+        }
+        assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < 1e-10);
+        let close = |x: &Matrix2<f64>, y: &Matrix2<f64>| (x - y).amax() < 1e-10 * x.amax();
+        assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
+        assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
+        assert!(
+            naive_off > 5e-3,
+            "the check must be able to fail: {naive_off}"
+        );
+    }
     let short = turbulent.replacen("model: finite", "model: short", 1);
     let err = MachineDescription::from_yaml(&short, "s.yaml")
         .unwrap_err()

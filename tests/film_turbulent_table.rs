@@ -268,6 +268,50 @@ fn the_turbulent_table_agrees_with_the_direct_turbulent_solver() {
     }
 }
 
+/// A viscosity scale on the tabulated turbulent film moves its Reynolds number (session 20):
+/// scaled by s, the table is read at Re = ρωRc/(µ₀·s), which makes the scaling exact. At a
+/// speed where that Re is one of the table's slices, the scaled table equals that slice, built
+/// on its own and scaled, to 1e-9 in force and coefficients. The naive scaling (the table read
+/// at µ₀'s Re, its outputs × s) is off by more (printed, and asserted > 0.5 %, so the check
+/// can fail).
+#[test]
+fn a_viscosity_scale_reads_the_turbulent_table_at_the_scaled_reynolds_number() {
+    use rotor_twin::film::ViscosityScaledFilm;
+    let (g, oil, grid) = (seed_bearing(0.5), mdm(), FilmGrid::new(60, 10).unwrap());
+    let axis = ReynoldsAxis::new(FlowRegime::Turbulent, 1500.0, 750.0, 600.0).unwrap();
+    let table = Arc::new(ReynoldsTable::build_with(&g, oil, grid, axis, COARSE).unwrap());
+    let re = axis.reynolds(1);
+    let slice = FilmTable::build_slice(&g, oil, grid, COARSE, Some((FlowRegime::Turbulent, re)));
+    let slice = Arc::new(slice.unwrap());
+    for scale in [0.8, 1.15] {
+        let w = re * scale / re_per_speed(oil);
+        let kin = state(0.6, 1.0, 0.1, -0.05, w);
+        let mut scaled =
+            ViscosityScaledFilm::new(Box::new(ReynoldsTabulatedFilm::new(table.clone())), scale)
+                .unwrap();
+        let mut reference =
+            ViscosityScaledFilm::new(Box::new(TabulatedFilm::new(slice.clone())), scale).unwrap();
+        let mut naive = ReynoldsTabulatedFilm::new(table.clone());
+        let (a, ka) = scaled.solve_with_coefficients(&kin).unwrap();
+        let (b, kb) = reference.solve_with_coefficients(&kin).unwrap();
+        let n = naive.solve(&kin).unwrap();
+        let naive_off = force_error([n.force_n[0] * scale, n.force_n[1] * scale], b.force_n);
+        println!(
+            "×{scale} at Re {re:.0}: table {:?}, slice {:?} ({:.1e}); naive {:.2} % off",
+            a.force_n,
+            b.force_n,
+            force_error(a.force_n, b.force_n),
+            100.0 * naive_off
+        );
+        assert!(force_error(a.force_n, b.force_n) < 1e-9);
+        assert!(common::coefficient_error(&kb, &ka, w) < 1e-9);
+        assert!(
+            naive_off > 5e-3,
+            "the check must be able to fail: {naive_off}"
+        );
+    }
+}
+
 /// Beyond the table's largest Re the tabulated turbulent film refuses the speed by name (never
 /// an extrapolated force); at the largest Re itself it answers.
 #[test]

@@ -97,6 +97,11 @@ pub struct FiniteFilm {
     /// The film Reynolds number ρωRc/µ the flow factors are taken at whatever the speed, if
     /// frozen (the turbulent table's slices, built at ω = 0 for one Re; None: from the speed).
     frozen_reynolds: Option<f64>,
+    /// µ/µ₀ of the oil the film's Reynolds number is taken at (its [`ViscosityScaledFilm`]'s
+    /// scale: the turbulent film's conductances follow the viscosity; 1 by default).
+    ///
+    /// [`ViscosityScaledFilm`]: crate::film::ViscosityScaledFilm
+    reynolds_viscosity_scale: f64,
     /// Per column: ω ∂H/∂θ + 2 ∂H/∂t (1/s).
     source: Vec<f64>,
     /// Per node: true where the film is pressurised (the free set of the complementarity problem).
@@ -195,6 +200,7 @@ impl FiniteFilm {
             flow: FlowRegime::Laminar,
             factors: FlowFactors::new(FlowRegime::Laminar, 0.0, 1.0),
             frozen_reynolds: None,
+            reynolds_viscosity_scale: 1.0,
             source: vec![0.0; nt],
             free: vec![false; nodes],
             pi: vec![0.0; nodes],
@@ -341,9 +347,9 @@ impl FiniteFilm {
         (self.journal_velocity, self.speed_now) = ([vx, vy], kin.speed_rad_s);
         let nt = self.grid.n_theta;
         let r = self.geometry.radius_m();
-        let reynolds = self.frozen_reynolds.unwrap_or(
-            self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / self.lubricant.viscosity_pa_s,
-        );
+        let mu = self.lubricant.viscosity_pa_s * self.reynolds_viscosity_scale;
+        let reynolds = (self.frozen_reynolds)
+            .unwrap_or(self.lubricant.density_kg_m3 * kin.speed_rad_s * r * c / mu);
         self.factors = FlowFactors::new(self.flow, reynolds, r / c);
         for i in 0..nt {
             let hn = 1.0 - x * self.cos_node[i] - y * self.sin_node[i];
@@ -768,6 +774,14 @@ impl FilmModel for FiniteFilm {
 
     fn midplane_fluid_fraction(&self, out: &mut [f64]) {
         self.midplane_phi(out);
+    }
+
+    fn set_reynolds_viscosity_scale(&mut self, scale: f64) {
+        // a laminar film does not depend on Re: its warm start stays
+        if self.reynolds_viscosity_scale != scale && self.flow != FlowRegime::Laminar {
+            self.warm = false;
+        }
+        self.reynolds_viscosity_scale = scale;
     }
 
     fn set_viscosity_field(&mut self, ratio: &[f64]) -> Result<bool, FilmError> {

@@ -210,6 +210,12 @@ pub trait FilmModel {
         Ok(false)
     }
 
+    /// The viscosity scale s = µ/µ₀ its [`ViscosityScaledFilm`] applies, for a film whose flow
+    /// depends on the Reynolds number: it then takes Re = ρωRc/(µ₀·s), so that scaling its
+    /// outputs by s is exact (the turbulent film: its conductances depend on Re, the rest of
+    /// its Π form does not depend on µ). No-op for a laminar film, whose Π does not depend on µ.
+    fn set_reynolds_viscosity_scale(&mut self, _scale: f64) {}
+
     /// A film with memory (mass-conserving cavitation, issue 18): the next solves belong to a
     /// time step of `step_s` (s) that starts from the last committed state. No-op otherwise.
     fn begin_step(&mut self, _step_s: f64) {}

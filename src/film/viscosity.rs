@@ -342,11 +342,10 @@ pub struct ViscosityScaledFilm {
 
 impl ViscosityScaledFilm {
     /// `inner` scaled by `scale` (checked).
-    pub fn new(inner: Box<dyn FilmModel + Send>, scale: f64) -> Result<Self, FilmError> {
-        Ok(Self {
-            inner,
-            scale: check_viscosity_scale(scale)?,
-        })
+    pub fn new(mut inner: Box<dyn FilmModel + Send>, scale: f64) -> Result<Self, FilmError> {
+        let scale = check_viscosity_scale(scale)?;
+        inner.set_reynolds_viscosity_scale(scale);
+        Ok(Self { inner, scale })
     }
 
     /// The scale µ / µ_reference in force.
@@ -357,6 +356,8 @@ impl ViscosityScaledFilm {
     /// Sets the scale (checked; allocates nothing).
     pub fn set_scale(&mut self, scale: f64) -> Result<(), FilmError> {
         self.scale = check_viscosity_scale(scale)?;
+        // a turbulent film's Reynolds number follows the viscosity: then the scaling is exact
+        self.inner.set_reynolds_viscosity_scale(self.scale);
         Ok(())
     }
 

@@ -182,7 +182,6 @@ impl Rotor {
     /// Sets the viscosity scale (µ / µ_reference) of every film bearing (checked).
     pub fn set_viscosity_scale(&mut self, scale: f64) -> Result<(), crate::film::FilmError> {
         let scale = crate::film::check_viscosity_scale(scale)?;
-        self.check_scalable(scale)?;
         for b in &mut self.bearings {
             if let BearingModel::Film(f) = &mut b.model {
                 f.viscosity_scale = scale;
@@ -206,7 +205,7 @@ impl Rotor {
             });
         }
         for &s in scales {
-            self.check_scalable(crate::film::check_viscosity_scale(s)?)?;
+            crate::film::check_viscosity_scale(s)?;
         }
         let films = self.bearings.iter_mut().filter_map(|b| match &mut b.model {
             BearingModel::Film(f) => Some(f),
@@ -223,22 +222,6 @@ impl Rotor {
         (self.bearings.iter())
             .filter(|b| matches!(b.model, BearingModel::Film(_)))
             .count()
-    }
-
-    /// Refuses a scale other than 1 when a film is turbulent (it does not scale with µ).
-    fn check_scalable(&self, scale: f64) -> Result<(), crate::film::FilmError> {
-        let turbulent = self.bearings.iter().any(|b| {
-            matches!(&b.model, BearingModel::Film(f) if f.flow != crate::film::FlowRegime::Laminar)
-        });
-        if turbulent && scale != 1.0 {
-            return Err(crate::film::FilmError::InvalidParameter {
-                name: "viscosity scale (turbulent film)",
-                value: scale,
-                rule: "a viscosity change does not scale a turbulent film (Re = ρωRc/µ changes \
-                       with it); only 1 is accepted with flow: turbulent or auto",
-            });
-        }
-        Ok(())
     }
 
     /// Gives every film bearing its film's fluid inertia, or takes it away (`choice`), whatever

@@ -277,10 +277,15 @@ impl ReynoldsTable {
         &self.slices
     }
 
-    /// The slices and weights at speed `omega` (rad/s); an error beyond the table's Re.
+    /// The slices and weights at speed `omega` (rad/s) with the oil at `viscosity_scale` × the
+    /// table's (Re = ρωRc/µ follows both); an error beyond the table's Re.
     #[inline]
-    fn stencil(&self, omega: f64) -> Result<([usize; 4], [f64; 4]), FilmError> {
-        let re = self.reynolds_per_speed * omega.abs();
+    fn stencil(
+        &self,
+        omega: f64,
+        viscosity_scale: f64,
+    ) -> Result<([usize; 4], [f64; 4]), FilmError> {
+        let re = self.reynolds_per_speed * omega.abs() / viscosity_scale;
         if re > self.axis.re_max * (1.0 + 1e-9) && self.axis.regime != FlowRegime::Laminar {
             return Err(FilmError::InvalidParameter {
                 name: "journal speed (turbulent film table), rad/s",
@@ -303,6 +308,8 @@ fn r_over_c(geometry: &BearingGeometry) -> f64 {
 pub struct ReynoldsTabulatedFilm {
     table: Arc<ReynoldsTable>,
     last: JournalKinematics,
+    /// µ/µ₀ its Reynolds number is taken at (its [`crate::film::ViscosityScaledFilm`]'s scale)
+    viscosity_scale: f64,
 }
 
 impl ReynoldsTabulatedFilm {
@@ -311,6 +318,7 @@ impl ReynoldsTabulatedFilm {
         Self {
             table,
             last: JournalKinematics::default(),
+            viscosity_scale: 1.0,
         }
     }
 
@@ -320,7 +328,7 @@ impl ReynoldsTabulatedFilm {
 
     /// The blended node at (ε, ψ) with its force's slopes d/dε, d/dψ (per unit V).
     fn blend(&self, s: &LineOfCentres, omega: f64) -> Result<(Node, [[f64; 2]; 2]), FilmError> {
-        let (idx, w) = self.table.stencil(omega)?;
+        let (idx, w) = self.table.stencil(omega, self.viscosity_scale)?;
         let mut node = Node::default();
         let mut slopes = [[0.0; 2]; 2];
         for (&j, &wj) in idx.iter().zip(&w) {
@@ -347,6 +355,10 @@ impl FilmModel for ReynoldsTabulatedFilm {
         Box::new(self.clone())
     }
 
+    fn set_reynolds_viscosity_scale(&mut self, scale: f64) {
+        self.viscosity_scale = scale;
+    }
+
     fn solve(&mut self, kin: &JournalKinematics) -> Result<FilmResult, FilmError> {
         kin.validate(self.base().geometry.radial_clearance_m)?;
         self.last = *kin;
@@ -368,7 +380,7 @@ impl FilmModel for ReynoldsTabulatedFilm {
             base.coefficients_from_slopes(kin, &s, [n.force, f_eps, f_psi])
         } else {
             // near the centre: the slices' difference coefficients, blended (linear in the force)
-            let (idx, w) = self.table.stencil(kin.speed_rad_s)?;
+            let (idx, w) = self.table.stencil(kin.speed_rad_s, self.viscosity_scale)?;
             let (mut k, mut d) = (nalgebra::Matrix2::zeros(), nalgebra::Matrix2::zeros());
             for (&j, &wj) in idx.iter().zip(&w) {
                 if wj != 0.0 {
@@ -392,7 +404,10 @@ impl FilmModel for ReynoldsTabulatedFilm {
     /// The profile of the slice that weighs most at the last state's speed (for display and the
     /// monitor's revolution-to-revolution difference, as the laminar table's is bilinear).
     fn midplane_pressure(&self, out: &mut [f64]) {
-        let j = match self.table.stencil(self.last.speed_rad_s) {
+        let j = match self
+            .table
+            .stencil(self.last.speed_rad_s, self.viscosity_scale)
+        {
             Ok((idx, w)) => {
                 let best = (0..4).fold(0, |b, k| if w[k] > w[b] { k } else { b });
                 idx[best]
