@@ -336,12 +336,8 @@ impl HeatFollower {
         self.total_us += us;
         self.balances += 1;
         self.at_speed_rad_s = speed_rad_s;
-        let films = self.rotor.bearings.iter().filter_map(|b| match &b.model {
-            BearingModel::Film(f) => Some(f.viscosity_scale),
-            _ => None,
-        });
-        for (s, f) in self.scales.iter_mut().zip(films) {
-            *s = f;
+        for (s, f) in self.scales.iter_mut().zip(self.rotor.film_bearings()) {
+            *s = f.viscosity_scale;
         }
         self.fields = self.rotor.film_viscosity_fields();
         Ok(())

@@ -6,7 +6,8 @@ mod common;
 use common::finite_difference;
 use nalgebra::Matrix2;
 use rotor_twin::film::{
-    BearingGeometry, FilmGrid, FilmModel, FiniteFilm, FlowRegime, JournalKinematics, Lubricant,
+    BearingGeometry, FilmCoefficients, FilmGrid, FilmModel, FilmResult, FiniteFilm, FlowRegime,
+    JournalKinematics, Lubricant,
 };
 use std::f64::consts::PI;
 
@@ -35,17 +36,30 @@ fn the_turbulent_film_at_vanishing_reynolds_number_is_the_laminar_film() {
         kin(0.53, 0.93, 9000.0, [0.0; 2]),
         kin(0.8, -2.0, 5000.0, [3e-3, -2e-3]),
     ] {
-        let (a, ca) = lam.solve_with_coefficients(&k).unwrap();
-        let (b, cb) = tur.solve_with_coefficients(&k).unwrap();
-        let scale = a.force_n[0].hypot(a.force_n[1]);
-        for i in 0..2 {
-            assert!((a.force_n[i] - b.force_n[i]).abs() < 1e-9 * scale);
-        }
-        assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < 1e-9);
-        let close = |x: &Matrix2<f64>, y: &Matrix2<f64>| (x - y).amax() < 1e-9 * x.amax();
-        assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
-        assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
+        let a = lam.solve_with_coefficients(&k).unwrap();
+        let b = tur.solve_with_coefficients(&k).unwrap();
+        assert_same_film(&a, &b, 1e-9);
     }
+}
+
+/// Force, power loss and the eight coefficients of `a` equal `b`'s to `tol` (relative to the
+/// force's size and each matrix's largest entry).
+fn assert_same_film(
+    (a, ca): &(FilmResult, FilmCoefficients),
+    (b, cb): &(FilmResult, FilmCoefficients),
+    tol: f64,
+) {
+    let size = b.force_n[0].hypot(b.force_n[1]);
+    for i in 0..2 {
+        assert!(
+            (a.force_n[i] - b.force_n[i]).abs() < tol * size,
+            "{a:?} vs {b:?}"
+        );
+    }
+    assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < tol);
+    let close = |x: &Matrix2<f64>, y: &Matrix2<f64>| (x - y).amax() < tol * x.amax();
+    assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
+    assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
 }
 
 /// Second method: the turbulent perturbation coefficients (the conductances' slopes dG/dH with
@@ -165,13 +179,7 @@ fn turbulent_films_scale_with_viscosity_through_their_reynolds_number() {
             b.force_n,
             100.0 * naive_off
         );
-        for i in 0..2 {
-            assert!((a.force_n[i] - b.force_n[i]).abs() < 1e-10 * size);
-        }
-        assert!((a.power_loss_w / b.power_loss_w - 1.0).abs() < 1e-10);
-        let close = |x: &Matrix2<f64>, y: &Matrix2<f64>| (x - y).amax() < 1e-10 * x.amax();
-        assert!(close(&ca.stiffness_n_per_m, &cb.stiffness_n_per_m));
-        assert!(close(&ca.damping_n_s_per_m, &cb.damping_n_s_per_m));
+        assert_same_film(&(a, ca), &(b, cb), 1e-10);
         assert!(
             naive_off > 5e-3,
             "the check must be able to fail: {naive_off}"

@@ -189,7 +189,9 @@ fn the_direct_twin_starts_at_the_thermal_films_equilibrium() {
     let twin = Twin::new(&rotor, config, w).unwrap();
     // the same machine with the fields cleared: the mean's isoviscous film
     let mut uniform = rotor.clone();
-    uniform.set_film_viscosity_fields(&[Vec::new(), Vec::new()]);
+    for film in 0..2 {
+        uniform.set_film_viscosity_field(film, &[]);
+    }
     let uniform = Twin::new(&uniform, config, w).unwrap();
     let means = uniform.output().bearings.clone();
     let bearings = &twin.output().bearings;

@@ -228,7 +228,9 @@ impl Driver {
             return false;
         }
         let result = balance(&mut self.rotor, job, self.settings.twin.film);
-        self.oil.take_balance(&result);
+        if self.oil.take_balance(&result) {
+            self.push_viscosity_fields();
+        }
         true
     }
 
@@ -240,16 +242,28 @@ impl Driver {
         // the worker set the scales and fields on its own copy of the machine: the fields are
         // set on this one here, the scales by `push_oil_scales`
         if let Ok(films) = &result {
-            let mut fields = self.rotor.film_viscosity_fields();
             for f in films {
-                fields[f.film].clone_from(&f.field);
+                self.rotor.set_film_viscosity_field(f.film, &f.field);
             }
-            self.rotor.set_film_viscosity_fields(&fields);
         }
         if self.oil.take_balance(&result) {
+            self.push_viscosity_fields();
             if let Err(why) = self.push_oil_scales() {
                 self.oil.failed(why);
             }
+        }
+    }
+
+    /// After a good balance: the machine's viscosity fields (a thermal-film balance's) on the
+    /// running twin, whose finite films run them (a table keeps its uniform scale). A field the
+    /// twin refuses fails the balance, the last good fields staying in force.
+    fn push_viscosity_fields(&mut self) {
+        let Some(s) = self.session.as_mut() else {
+            return;
+        };
+        let fields = self.rotor.film_viscosity_fields();
+        if let Err(e) = s.twin_mut().set_viscosity_fields(&fields) {
+            self.oil.failed(format!("oil heating: {e}"));
         }
     }
 
@@ -280,16 +294,6 @@ impl Driver {
             s.twin_mut()
                 .set_viscosity_scales(&self.oil.scales)
                 .map_err(|e| format!("oil temperature: {e}"))?;
-        }
-        // a thermal-film balance's viscosity fields (the finite film runs them; a table keeps
-        // its uniform scale)
-        if self.oil.heating {
-            let fields = self.rotor.film_viscosity_fields();
-            if let Some(s) = self.session.as_mut() {
-                s.twin_mut()
-                    .set_viscosity_fields(&fields)
-                    .map_err(|e| format!("oil heating: {e}"))?;
-            }
         }
         Ok(())
     }

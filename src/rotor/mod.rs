@@ -207,14 +207,26 @@ impl Rotor {
         for &s in scales {
             crate::film::check_viscosity_scale(s)?;
         }
-        let films = self.bearings.iter_mut().filter_map(|b| match &mut b.model {
-            BearingModel::Film(f) => Some(f),
-            _ => None,
-        });
-        for (f, &s) in films.zip(scales) {
+        for (f, &s) in self.film_bearings_mut().zip(scales) {
             f.viscosity_scale = s;
         }
         Ok(())
+    }
+
+    /// The film bearings, in order.
+    pub fn film_bearings(&self) -> impl Iterator<Item = &FilmBearing> {
+        self.bearings.iter().filter_map(|b| match &b.model {
+            BearingModel::Film(f) => Some(f),
+            _ => None,
+        })
+    }
+
+    /// The film bearings, in order, to change.
+    pub fn film_bearings_mut(&mut self) -> impl Iterator<Item = &mut FilmBearing> {
+        self.bearings.iter_mut().filter_map(|b| match &mut b.model {
+            BearingModel::Film(f) => Some(f),
+            _ => None,
+        })
     }
 
     /// The number of film bearings.

@@ -32,25 +32,13 @@ impl Rotor {
             .collect()
     }
 
-    /// Sets each film bearing's viscosity field, `fields` in the order of the film bearings
-    /// (as [`film_viscosity_fields`](Self::film_viscosity_fields) gives them; the extra or
-    /// missing ones ignored).
-    pub fn set_film_viscosity_fields(&mut self, fields: &[Vec<f64>]) {
-        let films = self.bearings.iter_mut().filter_map(|b| match &mut b.model {
-            BearingModel::Film(f) => Some(f),
-            _ => None,
-        });
-        for (f, field) in films.zip(fields) {
-            f.viscosity_field.clone_from(field);
+    /// Sets film bearing `film`'s viscosity field (its index among the film bearings; empty:
+    /// uniform); a film index past the last is ignored.
+    pub fn set_film_viscosity_field(&mut self, film: usize, field: &[f64]) {
+        if let Some(f) = self.film_bearings_mut().nth(film) {
+            f.viscosity_field.clear();
+            f.viscosity_field.extend_from_slice(field);
         }
-    }
-
-    /// The film bearings, in order.
-    fn film_bearings(&self) -> impl Iterator<Item = &FilmBearing> {
-        self.bearings.iter().filter_map(|b| match &b.model {
-            BearingModel::Film(f) => Some(f),
-            _ => None,
-        })
     }
 
     /// Whether any film bearing models its own heating.

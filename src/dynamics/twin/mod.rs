@@ -258,7 +258,7 @@ impl Twin {
     /// field: uniform), `fields` in the order of the film bearings, as a thermal-film heat
     /// balance finds them ([`crate::rotor::FilmBearing::viscosity_field`]). A film that holds
     /// only a uniform viscosity (a table) keeps it. Next step; the linear coupling is
-    /// re-linearised at once.
+    /// re-linearised at once when a film took its field.
     pub fn set_viscosity_fields(&mut self, fields: &[Vec<f64>]) -> Result<(), TwinError> {
         if fields.len() != self.links.len() {
             return Err(TwinError::InvalidInput {
@@ -267,12 +267,14 @@ impl Twin {
                 rule: "must give one field per film bearing",
             });
         }
+        let mut taken = false;
         for (l, f) in self.links.iter_mut().zip(fields) {
-            l.film
+            taken |= l
+                .film
                 .set_viscosity_field(f)
                 .map_err(|e| TwinError::Setup(format!("bearing '{}': {e}", l.name)))?;
         }
-        if self.config.coupling == crate::dynamics::Coupling::Linear {
+        if taken && self.config.coupling == crate::dynamics::Coupling::Linear {
             self.relinearise_films(self.state.speed_rad_s);
         }
         Ok(())
