@@ -777,10 +777,7 @@ impl FilmModel for FiniteFilm {
     }
 
     fn set_reynolds_viscosity_scale(&mut self, scale: f64) {
-        // a laminar film does not depend on Re: its warm start stays
-        if self.reynolds_viscosity_scale != scale && self.flow != FlowRegime::Laminar {
-            self.warm = false;
-        }
+        // the factors are taken afresh at every solve (`update_film_shape`), as for a new speed
         self.reynolds_viscosity_scale = scale;
     }
 

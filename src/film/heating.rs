@@ -144,8 +144,9 @@ pub struct EffectiveTemperature {
     pub temperature_rise_k: f64,
     /// Viscosity µ(T_eff) (Pa·s).
     pub viscosity_pa_s: f64,
-    /// Friction power P_f at T_eff (W): the film's `power_loss_w` at µ(T_eff), Couette shear
-    /// over the full film (Raimondi–Boyd's friction variable), for either balance.
+    /// Friction power P_f at T_eff (W): the film's `power_loss_w` at µ(T_eff), for either
+    /// balance: Couette shear over the full film with the Reynolds condition (Raimondi–Boyd's
+    /// friction variable); a mass-conserving film shears its streamers only.
     pub friction_power_w: f64,
     /// Heat the oil carries away at the temperature found (W): Raimondi–Boyd's
     /// ρ c_p ((T_eff − T_s)/k) (Q − Q_s/2), equal to `friction_power_w` at the fixed point (H1);
@@ -173,10 +174,13 @@ const TEMPERATURE_TOLERANCE_K: f64 = 1e-9;
 /// The effective temperature of the bearing whose film (solved at `reference_viscosity_pa_s`,
 /// scaled) is `film`, under static load `load_n` (N, the journal's force on the film, machine
 /// frame) at `speed_rad_s`, with oil supplied at `supply_k` (K) of density `density_kg_m3`
-/// following `law`. g(T) = T_s + k ΔT(µ(T)) falls as T rises (a thinner oil dissipates less),
-/// so h(T) = g(T) − T has one root, bracketed by [T_s, g(T_s)] and found by the Illinois
-/// variant of regula falsi. The film's scale is left at the root. Err says why (a temperature
-/// beyond the law's range, a film that does not carry the load).
+/// following `law`. g(T) = T_s + k ΔT(µ(T)) falls as T rises for a laminar film (a thinner oil
+/// dissipates less), so h(T) = g(T) − T has one root, bracketed by [T_s, g(T_s)]; a turbulent
+/// film, whose Reynolds number follows µ, dissipates more as it thins past Taylor's onset, and
+/// g may rise slowly: the bracket's top is then moved up by twice h there until h < 0 (h's
+/// slope g' − 1 is near −1). The root is found by the Illinois variant of regula falsi. The
+/// film's scale is left at the root. Err says why (a temperature beyond the law's range, a film
+/// that does not carry the load).
 #[allow(clippy::too_many_arguments)]
 pub fn effective_temperature(
     film: &mut ViscosityScaledFilm,
@@ -217,15 +221,21 @@ pub fn effective_temperature(
         ));
     }
     let top = law.range_k()[1];
-    let mut hi = (supply_k + h_lo).min(top);
-    let (mut h_hi, eq_hi) = at(hi)?;
-    if h_hi > 0.0 {
-        return Err(format!(
-            "the effective temperature lies beyond the viscosity law's range (up to {:.1} °C)",
-            top - super::ZERO_CELSIUS_K
-        ));
-    }
     let (mut lo, mut h_lo) = (supply_k, h_lo);
+    let mut hi = (supply_k + h_lo).min(top);
+    let (mut h_hi, mut eq_hi) = at(hi)?;
+    while h_hi > 0.0 {
+        // g rose with T (a turbulent film): the root lies above hi
+        if hi >= top || evaluations.get() >= MAX_EVALUATIONS {
+            return Err(format!(
+                "the effective temperature lies beyond the viscosity law's range (up to {:.1} °C)",
+                top - super::ZERO_CELSIUS_K
+            ));
+        }
+        (lo, h_lo) = (hi, h_hi);
+        hi = (hi + 2.0 * h_hi).min(top);
+        (h_hi, eq_hi) = at(hi)?;
+    }
     // the point evaluated last: the root when |h| or the bracket is below the tolerance
     let (mut last_t, mut last_h, mut last_eq) = (hi, h_hi, eq_hi);
     let mut side = 0;
